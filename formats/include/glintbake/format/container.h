@@ -1,0 +1,205 @@
+// glintbake container: reading and writing versioned, sectioned asset files (.gbk).
+//
+// The byte layout is normative in formats/SPEC.md. This header is the whole public API of the
+// container library (target glintbake::format). It depends on zstd and xxhash only, throws no
+// exceptions and reports every failure through a Status code.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace glintbake::format {
+
+// Container format version written by this library. A reader accepts any minor version of its
+// major version (unknown sections are skipped); a newer major version is refused.
+constexpr uint16_t kFormatVersionMajor = 1;
+constexpr uint16_t kFormatVersionMinor = 0;
+
+// Fixed sizes and limits of the layout (see SPEC.md).
+constexpr size_t kHeaderSize = 128;          // bytes of the file header
+constexpr size_t kIndexEntrySize = 64;       // bytes of one section index entry
+constexpr size_t kSectionAlignment = 64;     // every section and the index start at a multiple
+constexpr uint64_t kDefaultMaxRawSectionSize = uint64_t(1) << 32;  // 4 GiB: readers' default cap
+constexpr uint32_t kMaxSectionCount = 1u << 24;                    // readers refuse more
+
+enum class Status : int32_t {
+  kOk = 0,
+  kIoError = 1,             // open/read/write/rename failed
+  kBadMagic = 2,            // not a glintbake container
+  kUnsupportedVersion = 3,  // newer major version than this reader
+  kCorruptHeader = 4,       // header fields out of range or header checksum mismatch
+  kCorruptIndex = 5,        // index entries out of range, overlapping, misaligned, or checksum mismatch
+  kChecksumMismatch = 6,    // a section's stored bytes or the whole file fail their checksum
+  kDecompressFailed = 7,    // zstd refused the section or it did not decode to its raw size
+  kTooLarge = 8,            // a size exceeds a reader limit (raw size cap, section count cap)
+  kNotFound = 9,            // no section with that type/key
+  kInvalidArgument = 10,    // caller error (bad codec, writer already finished, ...)
+  kTruncated = 11,          // the file is shorter than its header or index says
+};
+
+// Stable, human-readable name of a status ("ok", "i/o error", ...). Never returns null.
+const char* statusString(Status status);
+
+// What an asset file holds. Stored as uint32; unknown values are readable (kind is reported as a number).
+enum class AssetKind : uint32_t {
+  kUnknown = 0,
+  kNdfPyramid = 1,   // ndfgen: NDF images on the footprint pyramid
+  kTensorNdf = 2,    // tensorpack: CP-compressed NDF blocks
+  kLtcTable = 3,     // ltcfit table
+  kRoughness = 4,    // ltcfit roughness mips
+  kWangTiles = 5,    // wangtile
+  kTinyExample = 6,  // tinyexample
+  kGlitter = 7,      // procedural discrete microfacets
+  kTest = 0x7fff,    // containers made by tests and fuzzers
+};
+const char* assetKindString(AssetKind kind);  // "ndf-pyramid", "tensor-ndf", ...; "unknown" otherwise
+bool assetKindFromString(const std::string& name, AssetKind* kind);
+
+enum class Codec : uint32_t {
+  kRaw = 0,   // stored bytes are the raw bytes
+  kZstd = 1,  // one zstd frame whose content size equals raw_size
+};
+const char* codecString(Codec codec);
+
+// Section types. 0-0xFFFF are reserved for this specification (SPEC.md lists them); readers skip
+// types they do not know. The 64-bit key distinguishes sections of the same type (e.g. level and
+// region of an NDF chunk); its meaning is defined per type in SPEC.md.
+enum SectionType : uint32_t {
+  kSectionMetadata = 1,      // UTF-8 JSON object, schemas/container-metadata.schema.json. Exactly one.
+  kSectionNdfLevel = 16,     // ndf-pyramid: per-level descriptor (key = level)
+  kSectionNdfChunk = 17,     // ndf-pyramid: NDF images of one spatial region (key = level << 32 | region)
+  kSectionTensorIndex = 32,  // tensor-ndf sections (32-47)
+  kSectionLtcTable = 48,     // ltc-table sections (48-63)
+  kSectionRoughness = 64,    // roughness mips (64-79)
+  kSectionImage = 0x100,     // generic float image (key = user-defined), see ImageSectionHeader
+  kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
+};
+
+// One row of the section index, as stored (little-endian on disk; see SPEC.md).
+struct SectionInfo {
+  uint32_t type = 0;
+  uint32_t codec = 0;          // Codec
+  uint64_t key = 0;
+  uint64_t offset = 0;         // from the start of the file, multiple of kSectionAlignment
+  uint64_t stored_size = 0;    // bytes in the file
+  uint64_t raw_size = 0;       // bytes after decoding
+  uint64_t checksum = 0;       // XXH3-64 of the stored bytes
+  uint32_t flags = 0;          // reserved, 0
+  uint32_t reserved = 0;
+};
+
+// Header fields a reader exposes.
+struct HeaderInfo {
+  uint16_t version_major = 0;
+  uint16_t version_minor = 0;
+  uint32_t asset_kind = 0;
+  uint64_t file_size = 0;
+  uint32_t section_count = 0;
+  uint64_t index_offset = 0;
+  uint64_t file_checksum = 0;
+};
+
+// 64-bit and 128-bit content hashes (XXH3). Used for section checksums and for provenance hashes
+// of input files ("xxh3-128:<32 hex digits>").
+uint64_t hash64(const void* data, size_t size);
+std::string hash128Hex(const void* data, size_t size);
+// Hash of a whole file, streamed; returns kIoError if it cannot be read.
+Status hashFile128Hex(const std::string& path, std::string* hex_out);
+
+// Writes a container. Sections are compressed and appended as they are added, so a producer
+// never holds more than one section in memory; the index and header are written by finish().
+// Output goes to "<path>.tmp-<random>" in the same directory and is renamed to <path> by
+// finish(); if finish() is not reached (error, destruction, abort()), the temporary file is removed.
+// Not thread-safe: one thread adds sections (compress in parallel upstream and add in a fixed order
+// for deterministic bytes).
+class Writer {
+ public:
+  Writer();
+  ~Writer();
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+
+  // Opens the temporary file next to `path`. zstd_level: 1..19 (default 9).
+  Status open(const std::string& path, AssetKind kind, int zstd_level = 9);
+  // Appends one section. codec kZstd falls back to kRaw when compression does not shrink the data.
+  Status addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec = Codec::kZstd);
+  // Convenience for the JSON metadata section (must be added exactly once before finish()).
+  Status addMetadata(const std::string& json_utf8);
+  // Writes index and header, flushes, renames to the final path.
+  Status finish();
+  // Drops the temporary file. Called by the destructor if finish() did not succeed.
+  void abort();
+  // Path of the temporary file while open (for signal handlers that must unlink it).
+  const std::string& temporaryPath() const;
+  uint64_t bytesWritten() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Options of a reader. All limits apply before any allocation, so untrusted files cannot make the
+// reader allocate or decompress more than these.
+struct ReaderOptions {
+  uint64_t max_raw_section_size = kDefaultMaxRawSectionSize;
+  bool verify_file_checksum = false;  // hash the whole file on open (validate does; queries need not)
+};
+
+// Reads a container with random access: open() reads and checks header and index only; each
+// section is read, checksum-verified and decoded on request. Safe on untrusted input: every offset
+// and size is checked against the file size and the limits above. const methods are thread-safe
+// (they use positioned reads).
+class Reader {
+ public:
+  Reader();
+  ~Reader();
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  Status open(const std::string& path, const ReaderOptions& options = {});
+  // Reads from a caller-owned buffer that must outlive the reader (fuzzing, embedded assets).
+  Status openMemory(const void* data, size_t size, const ReaderOptions& options = {});
+  void close();
+
+  const HeaderInfo& header() const;
+  AssetKind kind() const;
+  // Sections in index order, including types this reader does not know.
+  const std::vector<SectionInfo>& sections() const;
+  // Index of the first section with this type (and key, if given), or -1.
+  int find(uint32_t type) const;
+  int find(uint32_t type, uint64_t key) const;
+
+  // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size.
+  Status readSection(size_t i, std::vector<uint8_t>* out) const;
+  // Same, into a caller buffer of exactly raw_size bytes (no allocation besides zstd's context).
+  Status readSectionInto(size_t i, void* dst, size_t dst_size) const;
+  // Reads the stored (possibly compressed) bytes of section i without decoding.
+  Status readStored(size_t i, std::vector<uint8_t>* out) const;
+  // The metadata JSON text (the single kSectionMetadata section).
+  Status readMetadata(std::string* json_utf8) const;
+  // Hashes every byte after the header and compares with the header's file checksum.
+  Status verifyFileChecksum() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Generic float image section (kSectionImage and any image-like section that uses it): a 32-byte
+// little-endian header followed by width*height*channels float32 values, row-major, top row first.
+struct ImageSectionHeader {
+  uint32_t magic = 0x474D4947;  // "GIMG"
+  uint32_t width = 0;
+  uint32_t height = 0;
+  uint32_t channels = 0;
+  uint32_t layers = 1;          // images stacked one after another
+  uint32_t flags = 0;
+  uint64_t reserved = 0;
+};
+static_assert(sizeof(ImageSectionHeader) == 32, "ImageSectionHeader is 32 bytes");
+
+}  // namespace glintbake::format

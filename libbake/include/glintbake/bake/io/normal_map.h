@@ -1,0 +1,77 @@
+// Normal-map ingest: reads tangent-space normal maps (or height fields) through OpenImageIO and
+// turns them into unit normals with a report of what was repaired.
+//
+// Conventions (formats/SPEC.md, "Coordinates"):
+//  - Texel (column c, row r) has its centre at position u = (c + 0.5, r + 0.5) texels; row 0 is the
+//    top row of the image file, so position y grows downwards.
+//  - The tangent frame of the normals is x = right (increasing column), y = up (decreasing row),
+//    z = out of the surface: the OpenGL convention (green up). DirectX maps (green down) need
+//    flip_green.
+#pragma once
+
+#include <glintbake/bake/result.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace glintbake::bake {
+
+enum class Encoding { kAuto, kUnorm, kSnorm };  // auto: float data with negatives is signed, else 2c-1
+enum class Wrap { kRepeat, kClamp };
+
+const char* encodingString(Encoding e);  // "auto", "unorm", "snorm"
+const char* wrapString(Wrap w);          // "repeat", "clamp"
+
+struct IngestOptions {
+  Encoding encoding = Encoding::kAuto;
+  bool flip_green = false;     // negate n_y after decoding (DirectX maps)
+  bool height = false;         // input is a height field (first channel), normals by central differences
+  double height_scale = 1.0;   // height units per texel (slope = height_scale * dh/dtexel)
+  Wrap wrap = Wrap::kRepeat;   // how the map continues beyond its edges
+  int part = 0;                // subimage/part of multi-part files (EXR)
+  bool fix_nonfinite = false;  // replace NaN/Inf texels by (0,0,1) instead of failing
+  int max_size = 16384;        // largest accepted width or height
+  double unit_tolerance = 0.1; // |len - 1| above this counts as "far from unit length"
+};
+
+// What ingest found and repaired. Counts are over all texels of the map.
+struct IngestReport {
+  std::string file_format;      // OIIO format name ("png", "openexr", ...)
+  std::string pixel_type;       // "uint8", "uint16", "half", "float", ...
+  int channels_in = 0;          // channels of the file (2: XY map with reconstructed z)
+  Encoding encoding_used = Encoding::kUnorm;
+  int64_t texels = 0;
+  int64_t far_from_unit = 0;    // | |n| - 1 | > unit_tolerance before renormalisation
+  int64_t nz_nonpositive = 0;   // n_z <= 0 before repair
+  int64_t nonfinite = 0;        // NaN or Inf in any channel
+  double mean_length = 0.0;     // mean |n| before renormalisation
+  std::string content_hash;     // "xxh3-128:..." of the file bytes
+};
+
+// A map of unit normals, upper hemisphere (n_z >= 0). Texels with n_z <= 0 keep their projected
+// direction (n_x, n_y) and are moved onto the horizon side of the hemisphere: see ingest.cpp.
+struct NormalMap {
+  int width = 0;
+  int height = 0;
+  Wrap wrap = Wrap::kRepeat;
+  std::vector<float> normals;  // 3 floats per texel (x, y, z), row-major, row 0 at the top
+
+  const float* at(int x, int y) const { return &normals[(size_t(y) * size_t(width) + size_t(x)) * 3]; }
+  float* at(int x, int y) { return &normals[(size_t(y) * size_t(width) + size_t(x)) * 3]; }
+  // Texel fetch with the map's wrap mode applied to out-of-range coordinates.
+  const float* fetch(int x, int y) const;
+};
+
+// Reads a normal map (or height field) file. Never throws; errors name the file by the path given.
+Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report);
+
+// Builds a normal map from raw decoded channel data (for tests and generated maps): `channels` = 2,
+// 3 or 4 values per texel already in [-1, 1]; renormalises and repairs like loadNormalMap.
+Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const float* data,
+                                      const IngestOptions& options, IngestReport* report);
+
+// Renormalises in place, repairs n_z <= 0, counts (used by both entry points above).
+Status normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report);
+
+}  // namespace glintbake::bake

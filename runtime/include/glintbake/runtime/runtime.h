@@ -1,0 +1,43 @@
+// Runtime-lite: constant-cost queries on baked glintbake assets. Built without exceptions and
+// RTTI; no allocation per query; const queries are thread-safe.
+#pragma once
+
+#include <cstdint>
+
+namespace glintbake::runtime {
+
+enum class Status : int32_t {
+  kOk = 0,
+  kIoError = 1,
+  kInvalidAsset = 2,        // the container or its sections are malformed
+  kWrongKind = 3,           // the container holds another asset kind
+  kUnsupportedVersion = 4,  // newer container major version
+  kInvalidArgument = 5,
+  kOutOfMemory = 6,
+};
+
+// Stable, human-readable name of a status. Never returns null.
+const char* statusString(Status status);
+
+// A Gaussian pixel footprint on the surface: centre (x, y) and standard deviation sigma, all in
+// texels of the source normal map (texel centres at +0.5, y grows downwards; formats/SPEC.md).
+struct Footprint {
+  double x = 0.0;
+  double y = 0.0;
+  double sigma = 1.0;
+};
+
+// A point of the projected hemisphere (s-plane): s = (h_x, h_y) of a unit direction in the tangent
+// frame, |s| <= 1. NDF values are densities per unit s-plane area.
+struct SPoint {
+  double x = 0.0;
+  double y = 0.0;
+};
+
+// Result of importance sampling the P-NDF: the sampled point and its density (== eval at s).
+struct NdfSample {
+  SPoint s;
+  double pdf = 0.0;
+};
+
+}  // namespace glintbake::runtime
