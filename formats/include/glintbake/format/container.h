@@ -104,7 +104,8 @@ struct HeaderInfo {
 };
 
 // 64-bit and 128-bit content hashes (XXH3). Used for section checksums and for provenance hashes
-// of input files ("xxh3-128:<32 hex digits>").
+// of input files. hash128Hex and hashFile128Hex return the prefixed text form
+// "xxh3-128:<32 lowercase hex digits>" (high 64 bits first).
 uint64_t hash64(const void* data, size_t size);
 std::string hash128Hex(const void* data, size_t size);
 // Hash of a whole file, streamed; returns kIoError if it cannot be read.
