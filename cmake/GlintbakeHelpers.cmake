@@ -62,6 +62,11 @@ function(glintbake_add_tool name)
 endfunction()
 
 function(glintbake_install_package)
+  if(TARGET glintbake_bake)
+    set(GLINTBAKE_CONFIG_WITH_BAKE ON)
+  else()
+    set(GLINTBAKE_CONFIG_WITH_BAKE OFF)
+  endif()
   configure_file(${PROJECT_SOURCE_DIR}/cmake/version.h.in
                  ${PROJECT_BINARY_DIR}/generated/include/glintbake/version.h @ONLY)
   install(FILES ${PROJECT_BINARY_DIR}/generated/include/glintbake/version.h
@@ -74,6 +79,7 @@ function(glintbake_install_package)
   write_basic_package_version_file(${PROJECT_BINARY_DIR}/glintbakeConfigVersion.cmake
                                    COMPATIBILITY SameMajorVersion)
   install(FILES ${PROJECT_BINARY_DIR}/glintbakeConfig.cmake ${PROJECT_BINARY_DIR}/glintbakeConfigVersion.cmake
+                ${PROJECT_SOURCE_DIR}/cmake/FindGlintbakeOIIO.cmake
           DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/glintbake)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/glintbake/schemas)
 endfunction()

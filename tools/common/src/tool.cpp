@@ -241,6 +241,7 @@ int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
     }
     thread_limit_ = std::make_unique<ThreadLimit>(threadCount());
     const int code = body(*this);
+    if (code == kExitOk) finishDepfile();
     std::cout.flush();
     return code;
   } catch (const Error& e) {
@@ -283,8 +284,13 @@ std::string Tool::addInput(const std::string& path) {
 void Tool::addOutput(const std::string& path) { outputs_.push_back(path); }
 
 void Tool::finishDepfile() const {
-  if (common_.depfile.empty()) return;
-  writeDepfile(common_.depfile, outputs_, inputs_);
+  if (common_.depfile.empty() || depfile_written_) return;
+  if (outputs_.empty()) {
+    warning("--depfile ignored: this command writes no output file");
+  } else {
+    writeDepfile(common_.depfile, outputs_, inputs_);
+  }
+  depfile_written_ = true;
 }
 
 Json Tool::makeMetadata(const std::string& asset_kind, const Json& parameters) const {

@@ -79,6 +79,12 @@ enum SectionType : uint32_t {
   kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
 };
 
+// Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
+// "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate, "unknown"
+// otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
+const char* sectionTypeString(uint32_t type);
+bool sectionTypeFromString(const std::string& name, uint32_t* type);
+
 // One row of the section index, as stored (little-endian on disk; see SPEC.md).
 struct SectionInfo {
   uint32_t type = 0;
@@ -176,7 +182,9 @@ class Reader {
 
   // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size.
   Status readSection(size_t i, std::vector<uint8_t>* out) const;
-  // Same, into a caller buffer of exactly raw_size bytes (no allocation besides zstd's context).
+  // Same, into a caller buffer of exactly raw_size bytes (kInvalidArgument otherwise). Raw sections
+  // are read straight into dst; zstd sections of a file reader go through a temporary buffer of
+  // stored_size bytes (none for openMemory), plus zstd's decoding context.
   Status readSectionInto(size_t i, void* dst, size_t dst_size) const;
   // Reads the stored (possibly compressed) bytes of section i without decoding.
   Status readStored(size_t i, std::vector<uint8_t>* out) const;

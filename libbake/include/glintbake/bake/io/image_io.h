@@ -1,6 +1,7 @@
 // Image output through OpenImageIO, atomically (temporary file + rename).
 #pragma once
 
+#include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/result.h>
 
 #include <string>
@@ -16,7 +17,25 @@ struct ImageWriteOptions {
 
 // Writes width x height x channels float32 pixels (row-major, top row first) to path; the format
 // follows the extension (.exr, .png, .tif, ...). The file appears only when complete.
+//
+// Float formats (.exr, .hdr, .pfm) store the values as given (float32, or half when half_float).
+// Every other format stores unsigned integers of png_bits bits (8 for formats that only hold 8,
+// e.g. JPEG): each value is clamped to [0, 1] (NaN becomes 0) and rounded to the nearest level.
+// The pixels go to "<path>.tmp-<pid>-<n>" in the same directory, renamed to path when complete;
+// on failure nothing is left behind. Bytes depend only on the arguments: no timestamps, host or
+// software names are written. Thread-safe (distinct paths). Errors: kBadArgument (bad sizes,
+// channels not in 1..4, png_bits not 8 or 16), kUnsupported (unknown extension), kIo.
 Status writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
                   const ImageWriteOptions& options = {});
+
+// Writes a normal map as an image a renderer or this library can read back:
+//  - float formats (.exr, ...): signed RGB = (n_x, n_y, n_z) as stored (loadNormalMap's auto
+//    encoding detects them as signed whenever any component is negative);
+//  - integer formats (.png, .tif, ...): RGB = (n + 1) / 2 quantised to png_bits (16 by default).
+// Same atomicity, determinism and errors as writeImage.
+Status writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options = {});
+
+// True when writeImage stores float values for this path's extension (.exr, .hdr, .pfm).
+bool isFloatImagePath(const std::string& path);
 
 }  // namespace glintbake::bake

@@ -118,7 +118,8 @@ class Tool {
   std::string addInput(const std::string& path);
   // Records an output file (depfile target).
   void addOutput(const std::string& path);
-  // Writes the depfile if --depfile was given (call after outputs are committed).
+  // Writes the depfile if --depfile was given. run() calls it after a successful body; tools may
+  // call it earlier (it writes once).
   void finishDepfile() const;
   // Container metadata with provenance (schemas/container-metadata.schema.json): tool, version,
   // asset kind, canonical parameters and the name and content hash of every input added so far.
@@ -134,6 +135,7 @@ class Tool {
   CommonOptions common_;
   std::vector<std::string> inputs_, outputs_, input_hashes_;
   std::unique_ptr<struct ThreadLimit> thread_limit_;
+  mutable bool depfile_written_ = false;
 };
 
 // "glintbake <tool> <version> (container format <major>.<minor>)"

@@ -1,0 +1,334 @@
+// Structural checks of a container's header and index (formats/SPEC.md, "Reader requirements").
+#include "container_parse.h"
+
+#include "layout.h"
+
+#include <zstd.h>
+
+#include "hash_stream.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace glintbake::format::detail {
+namespace {
+
+using namespace layout;
+
+std::string hex64(uint64_t v) {
+  static const char* kDigits = "0123456789abcdef";
+  std::string s = "0x";
+  for (int shift = 60; shift >= 0; shift -= 4) s += kDigits[(v >> shift) & 0xF];
+  return s;
+}
+
+// Collects findings; remembers the first failing status.
+class Checker {
+ public:
+  explicit Checker(Diagnostics* diagnostics) : diagnostics_(diagnostics) {}
+
+  // Records an error; returns true if parsing should stop now (no diagnostics sink).
+  bool fail(Status status, int id, const std::string& message) {
+    if (first_ == Status::kOk) first_ = status;
+    if (diagnostics_) diagnostics_->error(id, message);
+    return diagnostics_ == nullptr;
+  }
+  void warn(int id, const std::string& message) {
+    if (diagnostics_) diagnostics_->warning(id, message);
+  }
+  Status status() const { return first_; }
+
+ private:
+  Diagnostics* diagnostics_;
+  Status first_ = Status::kOk;
+};
+
+bool allZero(const uint8_t* p, size_t n) {
+  return std::all_of(p, p + n, [](uint8_t b) { return b == 0; });
+}
+
+Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& check) {
+  const uint64_t actual_size = source.size();
+  uint8_t h[kHeaderSize];
+  const size_t head = size_t(std::min<uint64_t>(actual_size, kHeaderSize));
+  if (!source.readAt(0, h, head)) {
+    check.fail(Status::kIoError, 1002, "cannot read the file header");
+    return check.status();
+  }
+  // Magic first: a short file that is not a container is "not a container", not "truncated".
+  if (std::memcmp(h, kMagic, std::min<size_t>(head, sizeof(kMagic))) != 0) {
+    check.fail(Status::kBadMagic, 2002, "not a glintbake container (bad magic bytes)");
+    return check.status();
+  }
+  if (head < kHeaderSize) {
+    check.fail(Status::kTruncated, 2001,
+               "file is " + std::to_string(actual_size) + " bytes, shorter than the 128-byte header");
+    return check.status();
+  }
+
+  HeaderInfo& hi = out->header;
+  hi.version_major = load16(h + kOffVersionMajor);
+  hi.version_minor = load16(h + kOffVersionMinor);
+  // The version decides how the rest is laid out, so it is checked before the checksum.
+  if (hi.version_major != kFormatVersionMajor) {
+    const std::string v = std::to_string(hi.version_major) + "." + std::to_string(hi.version_minor);
+    const std::string mine = std::to_string(kFormatVersionMajor) + "." + std::to_string(kFormatVersionMinor);
+    if (hi.version_major > kFormatVersionMajor) {
+      check.fail(Status::kUnsupportedVersion, 2003,
+                 "container format " + v + " is newer than this reader (" + mine + "); upgrade glintbake");
+    } else {
+      check.fail(Status::kUnsupportedVersion, 2004, "container format " + v + " is not a released version");
+    }
+    return check.status();
+  }
+
+  uint8_t zeroed[kHeaderSize];
+  std::memcpy(zeroed, h, kHeaderSize);
+  std::memset(zeroed + kOffHeaderChecksum, 0, 8);
+  const uint64_t header_checksum = load64(h + kOffHeaderChecksum);
+  const uint64_t computed = hash64(zeroed, kHeaderSize);
+  if (computed != header_checksum) {
+    check.fail(Status::kCorruptHeader, 2005,
+               "header checksum mismatch (stored " + hex64(header_checksum) + ", computed " + hex64(computed) + ")");
+    return check.status();
+  }
+  if (hi.version_minor > kFormatVersionMinor) {
+    check.warn(2014, "container format 1." + std::to_string(hi.version_minor) +
+                         " is newer than this reader (1." + std::to_string(kFormatVersionMinor) +
+                         "); sections of unknown types are skipped");
+  }
+
+  hi.asset_kind = load32(h + kOffAssetKind);
+  const uint32_t header_size = load32(h + kOffHeaderSize);
+  out->header_flags = load32(h + kOffFlags);
+  hi.section_count = load32(h + kOffSectionCount);
+  hi.index_offset = load64(h + kOffIndexOffset);
+  out->index_size = load64(h + kOffIndexSize);
+  hi.file_size = load64(h + kOffFileSize);
+  hi.file_checksum = load64(h + kOffFileChecksum);
+  out->index_checksum = load64(h + kOffIndexChecksum);
+
+  if (header_size != kHeaderSize) {
+    check.fail(Status::kCorruptHeader, 2006, "header_size is " + std::to_string(header_size) + ", expected 128");
+    return check.status();
+  }
+  if (out->header_flags != 0 || load32(h + kOffHeaderReserved) != 0 ||
+      !allZero(h + kOffHeaderPadding, kHeaderSize - kOffHeaderPadding)) {
+    check.warn(2013, "reserved header fields or padding are not zero");
+  }
+  if (hi.section_count > kMaxSectionCount) {
+    check.fail(Status::kTooLarge, 2007,
+               "section_count " + std::to_string(hi.section_count) + " exceeds the reader limit " +
+                   std::to_string(kMaxSectionCount));
+    return check.status();
+  }
+  if (out->index_size != uint64_t(hi.section_count) * kIndexEntrySize) {
+    check.fail(Status::kCorruptHeader, 2008,
+               "index_size " + std::to_string(out->index_size) + " does not match section_count " +
+                   std::to_string(hi.section_count) + " x 64");
+    return check.status();
+  }
+  if (hi.index_offset < kHeaderSize || hi.index_offset % kSectionAlignment != 0) {
+    check.fail(Status::kCorruptHeader, 2009,
+               "index_offset " + std::to_string(hi.index_offset) + " is not a multiple of 64 at or after the header");
+    return check.status();
+  }
+  if (hi.index_offset > UINT64_MAX - out->index_size || hi.index_offset + out->index_size != hi.file_size) {
+    check.fail(Status::kCorruptHeader, 2010,
+               "file_size " + std::to_string(hi.file_size) + " is not index_offset + index_size");
+    return check.status();
+  }
+  if (actual_size < hi.file_size) {
+    check.fail(Status::kTruncated, 2011,
+               "file is truncated: " + std::to_string(actual_size) + " bytes, header says " +
+                   std::to_string(hi.file_size));
+    return check.status();
+  }
+  if (actual_size > hi.file_size) {
+    check.fail(Status::kCorruptHeader, 2012,
+               "file has " + std::to_string(actual_size - hi.file_size) + " trailing bytes after the index");
+    return check.status();
+  }
+  return check.status();
+}
+
+void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out, Checker& check) {
+  const HeaderInfo& hi = out->header;
+  // index_size <= file size was established by parseHeader, so this allocation is bounded by the file.
+  std::vector<uint8_t> index(size_t(out->index_size));
+  if (!source.readAt(hi.index_offset, index.data(), index.size())) {
+    check.fail(Status::kIoError, 1002, "cannot read the section index");
+    return;
+  }
+  const uint64_t computed = hash64(index.data(), index.size());
+  if (computed != out->index_checksum) {
+    check.fail(Status::kCorruptIndex, 3001,
+               "index checksum mismatch (stored " + hex64(out->index_checksum) + ", computed " + hex64(computed) + ")");
+    return;
+  }
+
+  out->sections.resize(hi.section_count);
+  bool nonzero_reserved = false;
+  for (uint32_t i = 0; i < hi.section_count; ++i) {
+    const uint8_t* e = index.data() + size_t(i) * kIndexEntrySize;
+    SectionInfo& s = out->sections[i];
+    s.type = load32(e + kEntType);
+    s.codec = load32(e + kEntCodec);
+    s.key = load64(e + kEntKey);
+    s.offset = load64(e + kEntOffset);
+    s.stored_size = load64(e + kEntStoredSize);
+    s.raw_size = load64(e + kEntRawSize);
+    s.checksum = load64(e + kEntChecksum);
+    s.flags = load32(e + kEntFlags);
+    s.reserved = load32(e + kEntReserved);
+    if (s.flags != 0 || s.reserved != 0 || !allZero(e + kEntPadding, kIndexEntrySize - kEntPadding)) {
+      nonzero_reserved = true;
+    }
+
+    const std::string name = "section " + std::to_string(i);
+    if (s.offset % kSectionAlignment != 0) {
+      if (check.fail(Status::kCorruptIndex, 3002, name + ": offset " + std::to_string(s.offset) + " is not a multiple of 64"))
+        return;
+    }
+    if (s.offset < kHeaderSize || s.offset > hi.index_offset || s.stored_size > hi.index_offset - s.offset) {
+      if (check.fail(Status::kCorruptIndex, 3003,
+                     name + ": bytes [" + std::to_string(s.offset) + ", +" + std::to_string(s.stored_size) +
+                         ") lie outside the section area [128, " + std::to_string(hi.index_offset) + ")"))
+        return;
+    }
+    if (s.raw_size > options.max_raw_section_size) {
+      if (check.fail(Status::kTooLarge, 3005,
+                     name + ": raw size " + std::to_string(s.raw_size) + " exceeds the reader limit " +
+                         std::to_string(options.max_raw_section_size)))
+        return;
+    }
+    if (s.codec == uint32_t(Codec::kRaw)) {
+      if (s.stored_size != s.raw_size) {
+        if (check.fail(Status::kCorruptIndex, 3006, name + ": raw codec but stored_size != raw_size")) return;
+      }
+    } else if (s.codec == uint32_t(Codec::kZstd)) {
+      // ZSTD_compressBound is only meaningful below ZSTD_MAX_INPUT_SIZE; the cap above keeps
+      // raw_size small enough on 64-bit hosts, the explicit test covers the rest.
+      const size_t bound = s.raw_size <= uint64_t(SIZE_MAX / 2) ? ZSTD_compressBound(size_t(s.raw_size)) : 0;
+      if (s.stored_size == 0 || bound == 0 || ZSTD_isError(bound) || s.stored_size > bound) {
+        if (check.fail(Status::kCorruptIndex, 3007,
+                       name + ": zstd stored_size " + std::to_string(s.stored_size) +
+                           " is impossible for raw_size " + std::to_string(s.raw_size)))
+          return;
+      }
+    } else {
+      check.warn(3009, name + ": unknown codec " + std::to_string(s.codec) + " (section cannot be read)");
+    }
+  }
+  if (nonzero_reserved) check.warn(3010, "reserved index entry fields or padding are not zero");
+
+  // No two sections may share bytes, and (type, key) identifies a section uniquely.
+  std::vector<uint32_t> order(out->sections.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto& secs = out->sections;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return secs[a].offset != secs[b].offset ? secs[a].offset < secs[b].offset : a < b;
+  });
+  for (size_t k = 1; k < order.size(); ++k) {
+    const SectionInfo& prev = secs[order[k - 1]];
+    const SectionInfo& cur = secs[order[k]];
+    if (prev.stored_size == 0 || cur.stored_size == 0) continue;  // empty sections occupy no bytes
+    if (prev.offset <= UINT64_MAX - prev.stored_size && prev.offset + prev.stored_size > cur.offset) {
+      if (check.fail(Status::kCorruptIndex, 3004,
+                     "sections " + std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + " overlap"))
+        return;
+    }
+  }
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    if (secs[a].type != secs[b].type) return secs[a].type < secs[b].type;
+    if (secs[a].key != secs[b].key) return secs[a].key < secs[b].key;
+    return a < b;
+  });
+  for (size_t k = 1; k < order.size(); ++k) {
+    const SectionInfo& prev = secs[order[k - 1]];
+    const SectionInfo& cur = secs[order[k]];
+    if (prev.type == cur.type && prev.key == cur.key) {
+      if (check.fail(Status::kCorruptIndex, 3008,
+                     "sections " + std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) +
+                         " have the same type " + std::to_string(cur.type) + " and key " + std::to_string(cur.key)))
+        return;
+    }
+  }
+}
+
+}  // namespace
+
+Status parseContainer(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out,
+                      Diagnostics* diagnostics) {
+  *out = ParsedContainer{};
+  Checker check(diagnostics);
+  if (parseHeader(source, out, check) != Status::kOk) return check.status();
+  parseIndex(source, options, out, check);
+  if (check.status() != Status::kOk && diagnostics == nullptr) out->sections.clear();
+  return check.status();
+}
+
+Status readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
+  if (dst_size != info.raw_size || (dst == nullptr && dst_size != 0)) return Status::kInvalidArgument;
+  if (info.codec != uint32_t(Codec::kRaw) && info.codec != uint32_t(Codec::kZstd)) return Status::kDecompressFailed;
+  if (info.codec == uint32_t(Codec::kRaw)) {
+    if (info.stored_size != info.raw_size) return Status::kCorruptIndex;
+    if (!source.readAt(info.offset, dst, dst_size)) return Status::kTruncated;
+    if (hash64(dst, dst_size) != info.checksum) return Status::kChecksumMismatch;
+    return Status::kOk;
+  }
+
+  // zstd: stored bytes come straight from memory sources, or through a buffer bounded by the file.
+  std::vector<uint8_t> buffer;
+  const uint8_t* stored = source.data() ? source.data() + info.offset : nullptr;
+  if (!stored) {
+    if (info.stored_size > source.size()) return Status::kTruncated;
+    buffer.resize(size_t(info.stored_size));
+    if (!source.readAt(info.offset, buffer.data(), buffer.size())) return Status::kTruncated;
+    stored = buffer.data();
+  } else if (info.offset > source.size() || info.stored_size > source.size() - info.offset) {
+    return Status::kTruncated;
+  }
+  const size_t stored_size = size_t(info.stored_size);
+  if (hash64(stored, stored_size) != info.checksum) return Status::kChecksumMismatch;
+
+  // One frame, exactly the stored bytes, announcing exactly raw_size: checked before decoding so
+  // a hostile frame can neither overrun dst nor make the decoder produce more than asked.
+  const size_t frame_size = ZSTD_findFrameCompressedSize(stored, stored_size);
+  if (ZSTD_isError(frame_size) || frame_size != stored_size) return Status::kDecompressFailed;
+  const unsigned long long content = ZSTD_getFrameContentSize(stored, stored_size);
+  if (content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR || content != info.raw_size) {
+    return Status::kDecompressFailed;
+  }
+  ZSTD_DCtx* dctx = ZSTD_createDCtx();
+  if (!dctx) return Status::kDecompressFailed;
+  const size_t got = ZSTD_decompressDCtx(dctx, dst, dst_size, stored, stored_size);
+  ZSTD_freeDCtx(dctx);
+  if (ZSTD_isError(got) || got != dst_size) return Status::kDecompressFailed;
+  return Status::kOk;
+}
+
+Status verifyFileChecksumOf(const ByteSource& source, uint64_t expected) {
+  const uint64_t size = source.size();
+  if (size < kHeaderSize) return Status::kTruncated;
+  uint64_t actual = 0;
+  if (const uint8_t* data = source.data()) {
+    actual = hash64(data + kHeaderSize, size_t(size - kHeaderSize));
+  } else {
+    XXH3Streamer hasher;
+    if (!hasher.ok()) return Status::kIoError;
+    std::vector<uint8_t> chunk(size_t(1) << 20);
+    for (uint64_t offset = kHeaderSize; offset < size;) {
+      const size_t n = size_t(std::min<uint64_t>(chunk.size(), size - offset));
+      if (!source.readAt(offset, chunk.data(), n)) return Status::kIoError;
+      hasher.update(chunk.data(), n);
+      offset += n;
+    }
+    actual = hasher.digest();
+  }
+  return actual == expected ? Status::kOk : Status::kChecksumMismatch;
+}
+
+}  // namespace glintbake::format::detail

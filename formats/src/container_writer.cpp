@@ -1,0 +1,244 @@
+// Writer: streams sections into a temporary file, then writes index and header and renames.
+#include <glintbake/format/container.h>
+
+#include "hash_stream.h"
+#include "layout.h"
+
+#include <zstd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace glintbake::format {
+
+using namespace layout;
+
+struct Writer::Impl {
+  std::string final_path;
+  std::string tmp_path;
+  int fd = -1;
+  bool failed = false;
+  bool finished = false;
+  AssetKind kind = AssetKind::kUnknown;
+  int zstd_level = 9;
+  uint64_t position = 0;  // bytes written so far (the file's current size)
+  bool has_metadata = false;
+  std::vector<SectionInfo> sections;
+  std::set<std::pair<uint32_t, uint64_t>> keys;
+  detail::XXH3Streamer file_hash;  // bytes [kHeaderSize, position)
+  ZSTD_CCtx* cctx = nullptr;
+  std::vector<uint8_t> compressed;
+
+  ~Impl() {
+    if (cctx) ZSTD_freeCCtx(cctx);
+  }
+
+  // Writes all of data at the current position (sequential, after the header).
+  bool append(const void* data, size_t size) {
+    const auto* p = static_cast<const uint8_t*>(data);
+    size_t left = size;
+    while (left > 0) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return false;
+      p += n;
+      left -= size_t(n);
+    }
+    file_hash.update(data, size);
+    position += size;
+    return true;
+  }
+
+  bool padTo(uint64_t alignment) {
+    static const uint8_t kZeros[kSectionAlignment] = {};
+    const uint64_t target = alignUp(position, alignment);
+    return append(kZeros, size_t(target - position));
+  }
+
+  Status fail(Status status) {
+    failed = true;
+    return status;
+  }
+};
+
+Writer::Writer() : impl_(std::make_unique<Impl>()) {}
+
+Writer::~Writer() {
+  if (!impl_->finished) abort();
+}
+
+Status Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
+  if (impl_->fd >= 0 || impl_->finished) return Status::kInvalidArgument;
+  if (path.empty() || zstd_level < 1 || zstd_level > 19) return Status::kInvalidArgument;
+  Impl& w = *impl_;
+  w.final_path = path;
+  w.kind = kind;
+  w.zstd_level = zstd_level;
+  std::string pattern = path + ".tmp-XXXXXX";
+  std::vector<char> buffer(pattern.begin(), pattern.end());
+  buffer.push_back('\0');
+  const int fd = ::mkstemp(buffer.data());
+  if (fd < 0) return Status::kIoError;
+  w.fd = fd;
+  w.tmp_path = buffer.data();
+  // mkstemp creates 0600; assets are ordinary shareable files.
+  ::fchmod(fd, 0644);
+  w.cctx = ZSTD_createCCtx();
+  if (!w.cctx || !w.file_hash.ok()) return w.fail(Status::kIoError);
+  // Deterministic frames: fixed level, content size recorded, no checksum (the index has one),
+  // no dictionary id, single-threaded.
+  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_compressionLevel, zstd_level);
+  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_contentSizeFlag, 1);
+  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_checksumFlag, 0);
+  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_dictIDFlag, 0);
+  // The header is written last; reserve its bytes now (they are not part of the file hash).
+  static const uint8_t kZeroHeader[kHeaderSize] = {};
+  size_t left = kHeaderSize;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, kZeroHeader + (kHeaderSize - left), left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return w.fail(Status::kIoError);
+    left -= size_t(n);
+  }
+  w.position = kHeaderSize;
+  return Status::kOk;
+}
+
+Status Writer::addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec) {
+  Impl& w = *impl_;
+  if (w.fd < 0 || w.failed || w.finished) return Status::kInvalidArgument;
+  if (data == nullptr && size != 0) return Status::kInvalidArgument;
+  if (codec != Codec::kRaw && codec != Codec::kZstd) return Status::kInvalidArgument;
+  if (w.sections.size() >= kMaxSectionCount) return Status::kTooLarge;
+  if (uint64_t(size) > kDefaultMaxRawSectionSize) return Status::kTooLarge;
+  if (type == kSectionMetadata && w.has_metadata) return Status::kInvalidArgument;
+  if (!w.keys.insert({type, key}).second) return Status::kInvalidArgument;  // (type, key) is unique
+
+  SectionInfo info;
+  info.type = type;
+  info.key = key;
+  info.raw_size = size;
+  const void* stored = data;
+  size_t stored_size = size;
+  info.codec = uint32_t(Codec::kRaw);
+  if (codec == Codec::kZstd && size > 0) {
+    w.compressed.resize(ZSTD_compressBound(size));
+    const size_t n = ZSTD_compress2(w.cctx, w.compressed.data(), w.compressed.size(), data, size);
+    if (ZSTD_isError(n)) return w.fail(Status::kInvalidArgument);
+    if (n < size) {  // keep zstd only when it shrinks the section
+      info.codec = uint32_t(Codec::kZstd);
+      stored = w.compressed.data();
+      stored_size = n;
+    }
+  }
+  if (!w.padTo(kSectionAlignment)) return w.fail(Status::kIoError);
+  info.offset = w.position;
+  info.stored_size = stored_size;
+  info.checksum = hash64(stored, stored_size);
+  if (!w.append(stored, stored_size)) return w.fail(Status::kIoError);
+  // Release a large compression buffer rather than keep it for the writer's lifetime.
+  if (w.compressed.capacity() > (size_t(64) << 20)) std::vector<uint8_t>().swap(w.compressed);
+  w.sections.push_back(info);
+  if (type == kSectionMetadata) w.has_metadata = true;
+  return Status::kOk;
+}
+
+Status Writer::addMetadata(const std::string& json_utf8) {
+  return addSection(kSectionMetadata, 0, json_utf8.data(), json_utf8.size(), Codec::kZstd);
+}
+
+Status Writer::finish() {
+  Impl& w = *impl_;
+  if (w.fd < 0 || w.finished) return Status::kInvalidArgument;
+  if (w.failed) {
+    abort();
+    return Status::kInvalidArgument;
+  }
+  if (!w.has_metadata) {
+    abort();
+    return Status::kInvalidArgument;
+  }
+
+  if (!w.padTo(kSectionAlignment)) {
+    abort();
+    return Status::kIoError;
+  }
+  const uint64_t index_offset = w.position;
+  std::vector<uint8_t> index(w.sections.size() * kIndexEntrySize, 0);
+  for (size_t i = 0; i < w.sections.size(); ++i) {
+    const SectionInfo& s = w.sections[i];
+    uint8_t* e = index.data() + i * kIndexEntrySize;
+    store32(e + kEntType, s.type);
+    store32(e + kEntCodec, s.codec);
+    store64(e + kEntKey, s.key);
+    store64(e + kEntOffset, s.offset);
+    store64(e + kEntStoredSize, s.stored_size);
+    store64(e + kEntRawSize, s.raw_size);
+    store64(e + kEntChecksum, s.checksum);
+  }
+  if (!w.append(index.data(), index.size())) {
+    abort();
+    return Status::kIoError;
+  }
+
+  uint8_t h[kHeaderSize] = {};
+  std::memcpy(h + kOffMagic, kMagic, sizeof(kMagic));
+  store16(h + kOffVersionMajor, kFormatVersionMajor);
+  store16(h + kOffVersionMinor, kFormatVersionMinor);
+  store32(h + kOffAssetKind, uint32_t(w.kind));
+  store32(h + kOffHeaderSize, uint32_t(kHeaderSize));
+  store32(h + kOffSectionCount, uint32_t(w.sections.size()));
+  store64(h + kOffIndexOffset, index_offset);
+  store64(h + kOffIndexSize, index.size());
+  store64(h + kOffFileSize, w.position);
+  store64(h + kOffFileChecksum, w.file_hash.digest());
+  store64(h + kOffIndexChecksum, hash64(index.data(), index.size()));
+  store64(h + kOffHeaderChecksum, hash64(h, kHeaderSize));  // computed with the field still zero
+
+  bool ok = ::pwrite(w.fd, h, kHeaderSize, 0) == ssize_t(kHeaderSize);
+  ok = ok && ::fsync(w.fd) == 0;
+  ok = (::close(w.fd) == 0) && ok;
+  w.fd = -1;
+  if (!ok || std::rename(w.tmp_path.c_str(), w.final_path.c_str()) != 0) {
+    abort();
+    return Status::kIoError;
+  }
+  w.finished = true;
+  w.tmp_path.clear();
+  // Make the rename durable too: sync the destination directory (best effort).
+  const size_t slash = w.final_path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : w.final_path.substr(0, slash));
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+  return Status::kOk;
+}
+
+void Writer::abort() {
+  Impl& w = *impl_;
+  if (w.fd >= 0) {
+    ::close(w.fd);
+    w.fd = -1;
+  }
+  if (!w.tmp_path.empty()) {
+    ::unlink(w.tmp_path.c_str());
+    w.tmp_path.clear();
+  }
+  w.failed = true;
+}
+
+const std::string& Writer::temporaryPath() const { return impl_->tmp_path; }
+
+uint64_t Writer::bytesWritten() const { return impl_->position; }
+
+}  // namespace glintbake::format

@@ -1,0 +1,376 @@
+// validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
+// its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
+#include <glintbake/format/validate.h>
+
+#include "byte_source.h"
+#include "container_parse.h"
+#include "layout.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace glintbake::format {
+namespace {
+
+constexpr size_t kMaxMetadataBytes = size_t(16) << 20;
+constexpr int kMaxMetadataDepth = 64;
+constexpr const char* kMetadataSchemaId = "glintbake.container-metadata/1";
+
+class Collector final : public detail::Diagnostics {
+ public:
+  explicit Collector(std::vector<ValidationMessage>* messages) : messages_(messages) {}
+  void error(int id, const std::string& message) override { messages_->push_back({id, Severity::kError, message}); }
+  void warning(int id, const std::string& message) override {
+    messages_->push_back({id, Severity::kWarning, message});
+  }
+
+ private:
+  std::vector<ValidationMessage>* messages_;
+};
+
+void addError(std::vector<ValidationMessage>* messages, int id, std::string message) {
+  messages->push_back({id, Severity::kError, std::move(message)});
+}
+void addWarning(std::vector<ValidationMessage>* messages, int id, std::string message) {
+  messages->push_back({id, Severity::kWarning, std::move(message)});
+}
+
+// Section types of the registry in SPEC.md ("Section types").
+bool isRegisteredType(uint32_t type) {
+  return type == kSectionMetadata || type == kSectionNdfLevel || type == kSectionNdfChunk ||
+         (type >= kSectionTensorIndex && type < kSectionRoughness + 16) || type == kSectionImage ||
+         type >= kSectionFirstPrivate;
+}
+
+// The range of section types owned by an asset kind, if it has one.
+bool kindTypeRange(AssetKind kind, uint32_t* first, uint32_t* last) {
+  switch (kind) {
+    case AssetKind::kNdfPyramid: *first = kSectionNdfLevel; *last = kSectionNdfChunk; return true;
+    case AssetKind::kTensorNdf: *first = kSectionTensorIndex; *last = kSectionTensorIndex + 15; return true;
+    case AssetKind::kLtcTable: *first = kSectionLtcTable; *last = kSectionLtcTable + 15; return true;
+    case AssetKind::kRoughness: *first = kSectionRoughness; *last = kSectionRoughness + 15; return true;
+    default: return false;
+  }
+}
+
+std::string describe(size_t index, const SectionInfo& s) {
+  return "section " + std::to_string(index) + " (type " + std::to_string(s.type) + ", key " + std::to_string(s.key) + ")";
+}
+
+void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
+                       std::vector<ValidationMessage>* messages) {
+  const bool has_magic = raw.size() >= 4 && layout::load32(raw.data()) == layout::kImageMagic;
+  if (!has_magic) {
+    // Only the generic image section must carry an image header; others may hold anything.
+    if (s.type == kSectionImage) addError(messages, 4004, describe(index, s) + ": missing the GIMG image header");
+    return;
+  }
+  ImageSectionHeader header;
+  if (!parseImageSection(raw.data(), raw.size(), &header)) {
+    addError(messages, 4005,
+             describe(index, s) + ": image header dimensions do not match the section's " +
+                 std::to_string(raw.size()) + " bytes");
+    return;
+  }
+  if (header.flags != 0 || header.reserved != 0) {
+    addWarning(messages, 4007, describe(index, s) + ": reserved image header fields are not zero");
+  }
+  const size_t count = (raw.size() - layout::kImageHeaderSize) / 4;
+  size_t non_finite = 0;
+  for (size_t i = 0; i < count; ++i) {
+    float v;
+    std::memcpy(&v, raw.data() + layout::kImageHeaderSize + 4 * i, 4);
+    if (!std::isfinite(v)) ++non_finite;
+  }
+  if (non_finite != 0) {
+    addError(messages, 4006, describe(index, s) + ": " + std::to_string(non_finite) + " non-finite values");
+  }
+}
+
+// Nesting depth of a JSON text, counted without parsing (strings skipped), so that deeply nested
+// hostile input is refused before any recursive processing.
+int jsonDepth(const std::string& text) {
+  int depth = 0, max_depth = 0;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '{' || c == '[') {
+      max_depth = std::max(max_depth, ++depth);
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return max_depth;
+}
+
+bool looksLikeAbsolutePath(const std::string& s) {
+  if (s.size() >= 2 && s[0] == '/' && s[1] != ' ') return true;  // POSIX
+  if (s.size() >= 2 && s[0] == '\\' && s[1] == '\\') return true;  // UNC
+  if (s.size() >= 3 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':' && (s[2] == '\\' || s[2] == '/'))
+    return true;  // drive letter
+  if (s.size() >= 2 && s[0] == '~' && s[1] == '/') return true;  // home-relative
+  return false;
+}
+
+bool isHashString(const std::string& s) {
+  static const std::string kPrefix = "xxh3-128:";
+  if (s.size() != kPrefix.size() + 32 || s.compare(0, kPrefix.size(), kPrefix) != 0) return false;
+  return std::all_of(s.begin() + std::ptrdiff_t(kPrefix.size()), s.end(),
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
+}  // namespace
+
+const char* severityString(Severity severity) { return severity == Severity::kWarning ? "warning" : "error"; }
+
+size_t ValidationReport::errorCount() const {
+  return size_t(std::count_if(messages.begin(), messages.end(),
+                              [](const ValidationMessage& m) { return m.severity == Severity::kError; }));
+}
+
+size_t ValidationReport::warningCount() const { return messages.size() - errorCount(); }
+
+bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* header) {
+  if (data == nullptr || size < layout::kImageHeaderSize) return false;
+  ImageSectionHeader h;
+  h.magic = layout::load32(data);
+  h.width = layout::load32(data + 4);
+  h.height = layout::load32(data + 8);
+  h.channels = layout::load32(data + 12);
+  h.layers = layout::load32(data + 16);
+  h.flags = layout::load32(data + 20);
+  h.reserved = layout::load64(data + 24);
+  if (h.magic != layout::kImageMagic) return false;
+  if (h.width == 0 || h.height == 0 || h.channels == 0 || h.layers == 0) return false;
+  // Four 32-bit factors: the product of the first two fits in 64 bits; divide instead of
+  // multiplying further so no product can overflow.
+  const uint64_t payload = uint64_t(size - layout::kImageHeaderSize);
+  if (payload % 4 != 0) return false;
+  uint64_t values = payload / 4;
+  const uint64_t factors[4] = {h.width, h.height, h.channels, h.layers};
+  for (uint64_t f : factors) {
+    if (values % f != 0) return false;
+    values /= f;
+  }
+  if (values != 1) return false;
+  if (header) *header = h;
+  return true;
+}
+
+void validateMetadata(const std::string& text, AssetKind kind, std::vector<ValidationMessage>* messages) {
+  if (text.size() > kMaxMetadataBytes) {
+    addError(messages, 5016, "metadata is " + std::to_string(text.size()) + " bytes, more than the 16 MiB limit");
+    return;
+  }
+  if (jsonDepth(text) > kMaxMetadataDepth) {
+    addError(messages, 5003, "metadata JSON is nested deeper than " + std::to_string(kMaxMetadataDepth) + " levels");
+    return;
+  }
+  const nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) {
+    addError(messages, 5003, "metadata is not valid UTF-8 JSON");
+    return;
+  }
+  if (!doc.is_object()) {
+    addError(messages, 5004, "metadata is not a JSON object");
+    return;
+  }
+
+  auto schema = doc.find("schema");
+  if (schema == doc.end() || !schema->is_string() || schema->get<std::string>() != kMetadataSchemaId) {
+    addError(messages, 5005, std::string("metadata \"schema\" must be \"") + kMetadataSchemaId + "\"");
+  }
+  auto asset_kind = doc.find("asset_kind");
+  if (asset_kind == doc.end() || !asset_kind->is_string()) {
+    addError(messages, 5006, "metadata \"asset_kind\" is missing or not a string");
+  } else if (std::strcmp(assetKindString(kind), "unknown") != 0 &&
+             asset_kind->get<std::string>() != assetKindString(kind)) {
+    addError(messages, 5007,
+             "metadata asset_kind \"" + asset_kind->get<std::string>() + "\" does not match the header's \"" +
+                 assetKindString(kind) + "\"");
+  }
+  auto generator = doc.find("generator");
+  if (generator == doc.end() || !generator->is_object() || !generator->contains("tool") ||
+      !(*generator)["tool"].is_string() || !generator->contains("version") || !(*generator)["version"].is_string()) {
+    addError(messages, 5008, "metadata \"generator\" must be an object with string \"tool\" and \"version\"");
+  }
+  auto parameters = doc.find("parameters");
+  if (parameters == doc.end() || !parameters->is_object()) {
+    addError(messages, 5009, "metadata \"parameters\" is missing or not an object");
+  }
+  auto inputs = doc.find("inputs");
+  if (inputs == doc.end() || !inputs->is_array()) {
+    addError(messages, 5010, "metadata \"inputs\" is missing or not an array");
+  } else {
+    for (size_t i = 0; i < inputs->size(); ++i) {
+      const auto& input = (*inputs)[i];
+      const std::string where = "metadata inputs[" + std::to_string(i) + "]";
+      if (!input.is_object() || !input.contains("name") || !input["name"].is_string() || !input.contains("hash") ||
+          !input["hash"].is_string() || input.size() != 2) {
+        addError(messages, 5010, where + " must be an object with exactly string \"name\" and \"hash\"");
+        continue;
+      }
+      const std::string name = input["name"].get<std::string>();
+      if (name.empty() || name.find_first_of("/\\") != std::string::npos) {
+        addError(messages, 5011, where + ".name \"" + name + "\" must be a file name without '/' or '\\'");
+      }
+      if (!isHashString(input["hash"].get<std::string>())) {
+        addError(messages, 5012, where + ".hash must match xxh3-128:<32 lowercase hex digits>");
+      }
+    }
+  }
+  auto asset = doc.find("asset");
+  if (asset != doc.end() && !asset->is_object()) addError(messages, 5013, "metadata \"asset\" is not an object");
+  for (auto it = doc.begin(); it != doc.end(); ++it) {
+    static const char* kKnown[] = {"schema", "asset_kind", "generator", "parameters", "inputs", "asset"};
+    if (std::none_of(std::begin(kKnown), std::end(kKnown), [&](const char* k) { return it.key() == k; })) {
+      addWarning(messages, 5015, "metadata has an unknown property \"" + it.key() + "\"");
+    }
+  }
+
+  // Provenance must never leak a private path: look at every string, iteratively (depth is bounded
+  // above, but an explicit stack keeps the walk independent of it).
+  std::vector<std::pair<const nlohmann::json*, std::string>> stack{{&doc, ""}};
+  while (!stack.empty()) {
+    auto [node, where] = stack.back();
+    stack.pop_back();
+    if (node->is_string()) {
+      if (looksLikeAbsolutePath(node->get_ref<const std::string&>())) {
+        addError(messages, 5014, "metadata " + (where.empty() ? std::string("value") : where) + " holds an absolute path");
+      }
+    } else if (node->is_object()) {
+      for (auto it = node->begin(); it != node->end(); ++it) stack.emplace_back(&*it, where + "/" + it.key());
+    } else if (node->is_array()) {
+      for (size_t i = 0; i < node->size(); ++i) stack.emplace_back(&(*node)[i], where + "/" + std::to_string(i));
+    }
+  }
+}
+
+namespace {
+
+ValidationReport validateSource(const detail::ByteSource& source, const ValidateOptions& options) {
+  ValidationReport report;
+  Collector collector(&report.messages);
+  ReaderOptions reader_options;
+  reader_options.max_raw_section_size = options.max_raw_section_size;
+  detail::ParsedContainer parsed;
+  report.status = detail::parseContainer(source, reader_options, &parsed, &collector);
+  if (parsed.sections.size() != parsed.header.section_count) return report;  // header unusable
+
+  auto noteStatus = [&](Status status) {
+    if (report.status == Status::kOk) report.status = status;
+  };
+  const auto& sections = parsed.sections;
+  const AssetKind kind = AssetKind(parsed.header.asset_kind);
+  const bool index_sound = report.status == Status::kOk;
+
+  // 4xxx: whole-file checksum, then every section's bytes.
+  if (index_sound) {
+    const Status checksum = detail::verifyFileChecksumOf(source, parsed.header.file_checksum);
+    if (checksum == Status::kIoError) {
+      addError(&report.messages, 1002, "cannot read the file");
+      noteStatus(checksum);
+    } else if (checksum != Status::kOk) {
+      addError(&report.messages, 4001, "whole-file checksum mismatch");
+      noteStatus(checksum);
+    }
+  }
+  std::vector<uint8_t> raw;
+  std::vector<bool> readable(sections.size(), false);
+  for (size_t i = 0; i < sections.size(); ++i) {
+    const SectionInfo& s = sections[i];
+    if (!isRegisteredType(s.type)) {
+      addWarning(&report.messages, 3011, describe(i, s) + ": unknown section type, skipped by readers");
+    }
+    const bool known_codec = s.codec == uint32_t(Codec::kRaw) || s.codec == uint32_t(Codec::kZstd);
+    if (!index_sound || !known_codec || !options.check_payloads) continue;
+    raw.resize(size_t(s.raw_size));
+    const Status status = detail::readSectionFrom(source, s, raw.data(), raw.size());
+    if (status == Status::kChecksumMismatch) {
+      addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
+    } else if (status == Status::kDecompressFailed) {
+      addError(&report.messages, 4003, describe(i, s) + ": zstd data does not decode to exactly raw_size bytes");
+    } else if (status != Status::kOk) {
+      addError(&report.messages, 1002, describe(i, s) + ": cannot be read (" + statusString(status) + ")");
+    }
+    if (status != Status::kOk) {
+      noteStatus(status);
+      continue;
+    }
+    readable[i] = true;
+    if (s.type != kSectionMetadata) checkImagePayload(i, s, raw, &report.messages);
+    if (s.type == kSectionNdfChunk) {
+      ImageSectionHeader image;
+      if (parseImageSection(raw.data(), raw.size(), &image) && image.width != image.height) {
+        addWarning(&report.messages, 6003,
+                   describe(i, s) + ": NDF images are " + std::to_string(image.width) + " x " +
+                       std::to_string(image.height) + ", not square");
+      }
+    }
+  }
+  std::vector<uint8_t>().swap(raw);
+
+  // 5xxx: the metadata section.
+  size_t metadata_count = 0;
+  for (const SectionInfo& s : sections) metadata_count += s.type == kSectionMetadata;
+  if (metadata_count == 0) {
+    addError(&report.messages, 5001, "no metadata section (type 1)");
+  } else if (metadata_count > 1) {
+    addError(&report.messages, 5002, std::to_string(metadata_count) + " metadata sections, expected exactly one");
+  }
+  for (size_t i = 0; i < sections.size(); ++i) {
+    if (sections[i].type != kSectionMetadata || !readable[i]) continue;
+    std::vector<uint8_t> bytes(size_t(sections[i].raw_size));
+    if (detail::readSectionFrom(source, sections[i], bytes.data(), bytes.size()) != Status::kOk) break;
+    validateMetadata(std::string(bytes.begin(), bytes.end()), kind, &report.messages);
+    break;
+  }
+
+  // 6xxx: kind-specific.
+  if (std::strcmp(assetKindString(kind), "unknown") == 0) {
+    addWarning(&report.messages, 6001, "asset kind " + std::to_string(parsed.header.asset_kind) + " is not known to this version");
+  }
+  uint32_t first = 0, last = 0;
+  if (kindTypeRange(kind, &first, &last) &&
+      std::none_of(sections.begin(), sections.end(),
+                   [&](const SectionInfo& s) { return s.type >= first && s.type <= last; })) {
+    addWarning(&report.messages, 6002,
+               std::string("a ") + assetKindString(kind) + " asset holds no section of types " + std::to_string(first) +
+                   "-" + std::to_string(last));
+  }
+
+  return report;
+}
+
+}  // namespace
+
+ValidationReport validate(const void* data, size_t size, const ValidateOptions& options) {
+  static const uint8_t kEmpty = 0;
+  const detail::MemorySource source(data ? data : &kEmpty, data ? size : 0);
+  return validateSource(source, options);
+}
+
+ValidationReport validateFile(const std::string& path, const ValidateOptions& options) {
+  detail::FileSource source;
+  if (!source.open(path)) {
+    ValidationReport report;
+    report.status = Status::kIoError;
+    report.messages.push_back({1001, Severity::kError, "cannot open the file for reading"});
+    return report;
+  }
+  return validateSource(source, options);
+}
+
+}  // namespace glintbake::format

@@ -1,0 +1,87 @@
+// Streams a multi-level pyramid of footprint NDF images (Deng et al. 2022, "Constant-Cost
+// Spatially-Varying Glints") into an ndf-pyramid container.
+//
+// Level l: footprint std sigma_l = sigma0 * 2^l texels; grid_width = max(1, round(map_width /
+// (stride0 * 2^l))) centres per row (likewise per column), actual stride = map size / grid size
+// (so a repeating map's grid is exactly periodic), centre (i, j) at ((i + 0.5) stride_x,
+// (j + 0.5) stride_y). When the grid sizes halve exactly, each level-(l+1) centre is the centre of
+// the 2 x 2 block of level-l centres below it, like mip-map texel centres.
+//
+// Streaming: each level is cut into regions of region_size x region_size centres; the images of one
+// region are computed in parallel (each image independently, by one thread, so results do not
+// depend on the thread count), then written as one kSectionNdfChunk section while the next region
+// is computed. Peak memory: the flakes (24 bytes per flake) plus two chunks
+// (2 * region_size^2 * R^2 * 4 bytes; 32 MiB at the defaults) plus per-thread scratch (R^2 * 8).
+//
+// Automatic level count (levels = 0): before computing level l + 1, the images at sigma_{l+1} and
+// sigma_l are compared at up to 4 x 4 evenly spread centres of level l + 1; if the relative MSE
+// sum |D_{l+1} - D_l|^2 / sum |D_l|^2 is below converge_mse the pyramid stops at level l (queries
+// above clamp to it). It also stops after the first level whose grid is 1 x 1 (the stride reached
+// the map size), or at kMaxPyramidLevels.
+#pragma once
+
+#include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/ndf/splat.h>
+#include <glintbake/bake/result.h>
+#include <glintbake/format/container.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace glintbake::bake::ndf {
+
+constexpr int kMaxPyramidLevels = 24;
+
+struct PyramidOptions {
+  SplatParams splat;             // R (ndf_res), sigma_r, truncation radii
+  int rate = 1;                  // flakes per texel side, [1, kMaxFlakeRate]
+  double stride0 = 16.0;         // level-0 stride, texels, > 0
+  double sigma0 = 8.0;           // level-0 footprint std, texels, > 0
+  int levels = 0;                // 0 = automatic, else exactly this many, [1, kMaxPyramidLevels]
+  double converge_mse = 1e-2;    // relative MSE threshold of the automatic level count, > 0
+  int region_size = 16;          // centres per region side, [1, 256]
+};
+
+// Validates the options (kBadArgument with a message naming the option).
+Status validatePyramidOptions(const PyramidOptions& options);
+
+struct LevelGeometry {
+  int grid_width = 0, grid_height = 0;
+  double stride_x = 0.0, stride_y = 0.0;  // texels
+  double sigma = 0.0;                     // texels
+  int regions_x = 0, regions_y = 0;
+};
+LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions& options, int level);
+
+struct PyramidLevelReport {
+  int level = 0;
+  LevelGeometry geometry;
+  uint64_t images = 0;
+  uint64_t raw_bytes = 0;       // uncompressed chunk bytes
+  uint64_t stored_bytes = 0;    // bytes the level added to the file
+  double seconds = 0.0;         // wall time of the level
+  double mse_vs_previous = -1;  // sampled relative MSE against the level below (-1 for level 0)
+};
+
+struct PyramidReport {
+  std::vector<PyramidLevelReport> levels;
+  std::string stop_reason;         // "levels", "converged", "grid-1x1", "max-levels"
+  double next_level_mse = -1.0;    // sampled MSE of the level that was not written (converged), else -1
+  uint64_t flakes = 0;
+  double flake_seconds = 0.0;
+};
+
+// Progress: called from the writing thread after each chunk with (images done, images of level).
+using PyramidProgress = std::function<void(int level, uint64_t done, uint64_t total)>;
+
+// Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an
+// open writer (the caller adds metadata and calls finish()). Errors: kBadArgument (options),
+// kRuntime (cancelled, out of memory), kIo (writer failure).
+Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
+                       PyramidReport* report, const PyramidProgress& progress = {},
+                       const std::atomic<bool>* cancel = nullptr);
+
+}  // namespace glintbake::bake::ndf

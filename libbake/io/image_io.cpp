@@ -1,0 +1,153 @@
+// Image output through OpenImageIO: atomic (temporary file + rename) and byte-reproducible.
+#include <glintbake/bake/io/image_io.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#ifndef _WIN32
+#include <unistd.h>
+#endif
+
+namespace glintbake::bake {
+namespace {
+
+std::string oneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text.empty() ? std::string("unknown error") : text;
+}
+
+std::string lowerExtension(const std::string& path) {
+  const size_t slash = path.find_last_of("/\\");
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// Formats whose OIIO writers only take 8-bit integers.
+bool eightBitOnly(const std::string& ext) {
+  return ext == "jpg" || ext == "jpeg" || ext == "webp" || ext == "bmp" || ext == "gif" || ext == "tga";
+}
+
+std::string temporaryPath(const std::string& path) {
+  static std::atomic<uint64_t> counter{0};
+#ifndef _WIN32
+  const long pid = long(::getpid());
+#else
+  const long pid = 0;
+#endif
+  return path + ".tmp-" + std::to_string(pid) + "-" + std::to_string(counter.fetch_add(1));
+}
+
+// Quantises [0, 1] values to unsigned integers of `bits` bits, round to nearest, NaN -> 0.
+template <typename T>
+std::vector<T> quantise(const float* pixels, size_t count, int bits) {
+  const double max_level = double((uint32_t(1) << bits) - 1);
+  std::vector<T> out(count);
+  for (size_t i = 0; i < count; ++i) {
+    const float v = pixels[i];
+    const double c = std::isnan(v) ? 0.0 : std::clamp(double(v), 0.0, 1.0);
+    out[i] = T(std::floor(c * max_level + 0.5));
+  }
+  return out;
+}
+
+}  // namespace
+
+bool isFloatImagePath(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == "exr" || ext == "hdr" || ext == "pfm";
+}
+
+Status writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
+                  const ImageWriteOptions& options) {
+  if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || pixels == nullptr) {
+    return makeError(ErrorCode::kBadArgument, path + ": cannot write a " + std::to_string(width) + "x" +
+                                                  std::to_string(height) + "x" + std::to_string(channels) +
+                                                  " image");
+  }
+  if (options.png_bits != 8 && options.png_bits != 16) {
+    return makeError(ErrorCode::kBadArgument,
+                     path + ": integer bit depth must be 8 or 16, got " + std::to_string(options.png_bits));
+  }
+  // The plugin is chosen from the final name; the temporary name only receives the bytes.
+  auto output = OIIO::ImageOutput::create(path);
+  if (!output) {
+    return makeError(ErrorCode::kUnsupported,
+                     path + ": no image writer for this file extension (" + oneLine(OIIO::geterror()) + ")");
+  }
+
+  const std::string ext = lowerExtension(path);
+  const bool is_float = isFloatImagePath(path);
+  const int bits = eightBitOnly(ext) ? 8 : options.png_bits;
+  OIIO::TypeDesc stored = is_float ? (options.half_float ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT)
+                                   : (bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  OIIO::ImageSpec spec(width, height, channels, stored);
+  if (ext == "exr") spec.attribute("compression", "zip");
+  // A fresh spec carries no time or host attributes; make sure none creep in through defaults.
+  for (const char* name : {"DateTime", "Software", "HostComputer", "Artist"}) spec.erase_attribute(name);
+
+  const size_t count = size_t(width) * size_t(height) * size_t(channels);
+  std::vector<uint8_t> data8;
+  std::vector<uint16_t> data16;
+  const void* data = pixels;
+  OIIO::TypeDesc data_type = OIIO::TypeDesc::FLOAT;
+  if (!is_float) {
+    if (bits == 8) {
+      data8 = quantise<uint8_t>(pixels, count, 8);
+      data = data8.data();
+      data_type = OIIO::TypeDesc::UINT8;
+    } else {
+      data16 = quantise<uint16_t>(pixels, count, 16);
+      data = data16.data();
+      data_type = OIIO::TypeDesc::UINT16;
+    }
+  }
+
+  const std::string tmp = temporaryPath(path);
+  if (!output->open(tmp, spec)) {
+    std::string reason = oneLine(output->geterror());
+    std::remove(tmp.c_str());
+    return makeError(ErrorCode::kIo, path + ": cannot create file (" + reason + ")");
+  }
+  const bool written = output->write_image(data_type, data);
+  std::string reason = written ? std::string() : oneLine(output->geterror());
+  const bool closed = output->close();
+  if (written && !closed) reason = oneLine(output->geterror());
+  output.reset();
+  if (!written || !closed) {
+    std::remove(tmp.c_str());
+    return makeError(ErrorCode::kIo, path + ": write failed (" + reason + ")");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return makeError(ErrorCode::kIo, path + ": cannot rename the temporary file into place");
+  }
+  return okStatus();
+}
+
+Status writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options) {
+  if (map.width <= 0 || map.height <= 0 || map.normals.size() != size_t(map.width) * size_t(map.height) * 3) {
+    return makeError(ErrorCode::kBadArgument, path + ": empty or inconsistent normal map");
+  }
+  if (isFloatImagePath(path)) {
+    return writeImage(path, map.width, map.height, 3, map.normals.data(), options);
+  }
+  std::vector<float> encoded(map.normals.size());
+  for (size_t i = 0; i < encoded.size(); ++i) encoded[i] = 0.5f * map.normals[i] + 0.5f;
+  return writeImage(path, map.width, map.height, 3, encoded.data(), options);
+}
+
+}  // namespace glintbake::bake

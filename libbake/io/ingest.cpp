@@ -1,0 +1,268 @@
+// Reading normal maps and height fields from image files through OpenImageIO.
+//
+// Decoding follows algorithms.md section 1: integer files store n = 2 c / max - 1; float files are
+// either signed ([-1, 1]) or encoded like integers ([0, 1]), told apart by the presence of negative
+// values unless the caller forces an encoding. Height fields become normals by central differences
+// with the map's wrap mode.
+#include <glintbake/bake/io/normal_map.h>
+#include <glintbake/format/container.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#ifndef _WIN32
+#include <fcntl.h>
+#include <unistd.h>
+#endif
+
+namespace glintbake::bake {
+namespace {
+
+// Some decoders behind OIIO (libpng's default error handler, for one) print their complaints on
+// stderr before OIIO turns them into an error string. Tools promise a single error line, so the
+// decoder's own output is discarded while a file is decoded; OIIO's error string carries the reason.
+class QuietStderr {
+ public:
+  QuietStderr() {
+#ifndef _WIN32
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int null_fd = ::open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null_fd >= 0) ::dup2(null_fd, STDERR_FILENO);
+    if (null_fd >= 0) ::close(null_fd);
+#endif
+  }
+  ~QuietStderr() {
+#ifndef _WIN32
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, STDERR_FILENO);
+      ::close(saved_);
+    }
+#endif
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+// Reading hints: values exactly as stored (no alpha association, which would scale RGB by alpha).
+OIIO::ImageSpec readConfig() {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  return config;
+}
+
+// OIIO error text can span several lines; tool errors are one line.
+std::string oneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text.empty() ? std::string("unknown error") : text;
+}
+
+std::string pixelTypeName(const OIIO::TypeDesc& type) {
+  switch (type.basetype) {
+    case OIIO::TypeDesc::UINT8: return "uint8";
+    case OIIO::TypeDesc::INT8: return "int8";
+    case OIIO::TypeDesc::UINT16: return "uint16";
+    case OIIO::TypeDesc::INT16: return "int16";
+    case OIIO::TypeDesc::UINT32: return "uint32";
+    case OIIO::TypeDesc::INT32: return "int32";
+    case OIIO::TypeDesc::HALF: return "half";
+    case OIIO::TypeDesc::FLOAT: return "float";
+    case OIIO::TypeDesc::DOUBLE: return "double";
+    default: return type.c_str();
+  }
+}
+
+bool isSignedInteger(const OIIO::TypeDesc& type) {
+  return type.basetype == OIIO::TypeDesc::INT8 || type.basetype == OIIO::TypeDesc::INT16 ||
+         type.basetype == OIIO::TypeDesc::INT32 || type.basetype == OIIO::TypeDesc::INT64;
+}
+
+// Normals from a height field: n = normalize(-k dh/dx, -k dh/dy_up, 1) with central differences
+// fetched through the wrap mode. Tangent y points up, i.e. towards decreasing rows, hence
+// dh/dy_up = (h[r-1] - h[r+1]) / 2. Heights that are not finite were replaced by 0 by the caller.
+void heightsToNormals(const std::vector<float>& heights, double k, NormalMap* map) {
+  const int w = map->width, h = map->height;
+  auto height_at = [&](int x, int y) {
+    if (map->wrap == Wrap::kRepeat) {
+      x = ((x % w) + w) % w;
+      y = ((y % h) + h) % h;
+    } else {
+      x = std::clamp(x, 0, w - 1);
+      y = std::clamp(y, 0, h - 1);
+    }
+    return double(heights[size_t(y) * size_t(w) + size_t(x)]);
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const double dhdx = 0.5 * (height_at(x + 1, y) - height_at(x - 1, y));
+      const double dhdy_up = 0.5 * (height_at(x, y - 1) - height_at(x, y + 1));
+      const double gx = -k * dhdx, gy = -k * dhdy_up;
+      const double inv = 1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
+      float* n = map->at(x, y);
+      n[0] = float(gx * inv);
+      n[1] = float(gy * inv);
+      n[2] = float(inv);
+    }
+  }
+}
+
+bool fileReadable(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return f.good();
+}
+
+}  // namespace
+
+Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report) {
+  IngestReport local;
+  IngestReport* r = report != nullptr ? report : &local;
+  *r = IngestReport{};
+
+  if (!fileReadable(path)) {
+    return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
+  }
+  QuietStderr quiet;
+  const OIIO::ImageSpec config = readConfig();
+  auto input = OIIO::ImageInput::open(path, &config);
+  if (!input) {
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": not a readable image (" + oneLine(OIIO::geterror()) + ")");
+  }
+  if (options.part < 0) {
+    return makeError(ErrorCode::kBadArgument, "part must be >= 0, got " + std::to_string(options.part));
+  }
+  if (options.part > 0 && !input->seek_subimage(options.part, 0)) {
+    input->geterror();  // clear
+    int parts = 1;
+    while (input->seek_subimage(parts, 0)) ++parts;
+    input->geterror();
+    return makeError(ErrorCode::kBadArgument, path + ": has no part " + std::to_string(options.part) + " (it has " +
+                                                  std::to_string(parts) + ")");
+  }
+  const OIIO::ImageSpec spec = input->spec();
+  r->file_format = input->format_name();
+  r->pixel_type = pixelTypeName(spec.format);
+  r->channels_in = spec.nchannels;
+
+  const int width = spec.width, height = spec.height, channels = spec.nchannels;
+  if (width <= 0 || height <= 0 || spec.depth > 1) {
+    return makeError(ErrorCode::kInvalidInput, path + ": invalid image size " + std::to_string(width) + "x" +
+                                                   std::to_string(height));
+  }
+  if (width > options.max_size || height > options.max_size) {
+    return makeError(ErrorCode::kInvalidInput, path + ": size " + std::to_string(width) + "x" +
+                                                   std::to_string(height) + " exceeds the limit of " +
+                                                   std::to_string(options.max_size) +
+                                                   " texels per side (raise it with --max-size)");
+  }
+  if (options.height ? channels < 1 : !(channels >= 2 && channels <= 4)) {
+    std::string expected = options.height ? "at least 1" : "2 (XY), 3 (RGB) or 4 (RGBA); 1-channel height fields need --height";
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": unsupported channel count " + std::to_string(channels) + " (expected " + expected + ")");
+  }
+
+  // Alpha and any extra channels are never read; height fields use the first channel only.
+  const int used = options.height ? 1 : std::min(channels, 3);
+  const size_t texels = size_t(width) * size_t(height);
+  std::vector<float> pixels;
+  try {
+    pixels.resize(texels * size_t(used));
+  } catch (const std::bad_alloc&) {
+    return makeError(ErrorCode::kRuntime, path + ": out of memory reading a " + std::to_string(width) + "x" +
+                                              std::to_string(height) + " image");
+  }
+  if (!input->read_image(options.part, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    return makeError(ErrorCode::kInvalidInput, path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+  }
+  // Some readers report problems only through the error queue.
+  if (input->has_error()) {
+    return makeError(ErrorCode::kInvalidInput, path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+  }
+  input->close();
+
+  NormalMap map;
+  map.width = width;
+  map.height = height;
+  map.wrap = options.wrap;
+  map.normals.resize(texels * 3);
+
+  if (options.height) {
+    // Non-finite heights would spread into their neighbours' normals; count them here, replace
+    // them by 0 when asked, and make their own normal (0,0,1) as for normal maps.
+    int64_t bad = 0;
+    size_t first = 0;
+    for (size_t i = 0; i < texels; ++i) {
+      if (!std::isfinite(pixels[i])) {
+        if (bad++ == 0) first = i;
+        pixels[i] = 0.0f;
+      }
+    }
+    if (bad > 0 && !options.fix_nonfinite) {
+      r->nonfinite = bad;
+      r->texels = int64_t(texels);
+      return makeError(ErrorCode::kInvalidInput,
+                       path + ": " + std::to_string(bad) + " height(s) hold NaN or Inf, the first at column " +
+                           std::to_string(first % size_t(width)) + ", row " + std::to_string(first / size_t(width)) +
+                           " (--fix-nonfinite replaces them)");
+    }
+    heightsToNormals(pixels, options.height_scale, &map);
+    r->encoding_used = Encoding::kUnorm;
+    Status status = normaliseNormals(&map, options, r);
+    if (!status) return makeError(status.error().code, path + ": " + status.error().message);
+    r->nonfinite = bad;
+  } else {
+    // Decide how stored values map to [-1, 1].
+    Encoding encoding = options.encoding;
+    if (encoding == Encoding::kAuto) {
+      if (spec.format.is_floating_point()) {
+        const bool any_negative =
+            std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
+        encoding = any_negative ? Encoding::kSnorm : Encoding::kUnorm;
+      } else {
+        // OIIO already maps signed integer types to [-1, 1].
+        encoding = isSignedInteger(spec.format) ? Encoding::kSnorm : Encoding::kUnorm;
+      }
+    }
+    r->encoding_used = encoding;
+    const float scale = encoding == Encoding::kUnorm ? 2.0f : 1.0f;
+    const float offset = encoding == Encoding::kUnorm ? -1.0f : 0.0f;
+    const float sign_y = options.flip_green ? -1.0f : 1.0f;
+    for (size_t i = 0; i < texels; ++i) {
+      const float* p = &pixels[i * size_t(used)];
+      float* n = &map.normals[i * 3];
+      n[0] = scale * p[0] + offset;
+      n[1] = sign_y * (scale * p[1] + offset);
+      if (used == 2) {
+        const float r2 = n[0] * n[0] + n[1] * n[1];
+        n[2] = std::isfinite(r2) ? std::sqrt(std::max(0.0f, 1.0f - r2)) : r2;
+      } else {
+        n[2] = scale * p[2] + offset;
+      }
+    }
+    Status status = normaliseNormals(&map, options, r);
+    if (!status) return makeError(status.error().code, path + ": " + status.error().message);
+  }
+
+  std::string hex;
+  if (format::hashFile128Hex(path, &hex) != format::Status::kOk) {
+    return makeError(ErrorCode::kIo, path + ": cannot read file to hash it");
+  }
+  r->content_hash = hex.rfind("xxh3-128:", 0) == 0 ? hex : "xxh3-128:" + hex;
+  return map;
+}
+
+}  // namespace glintbake::bake

@@ -1,0 +1,9 @@
+# LTC tables (Heitz et al. 2016), multi-scale roughness (Tao et al. 2021) and roughness mips.
+find_package(Ceres REQUIRED CONFIG)
+list(APPEND GLINTBAKE_BAKE_SOURCES
+  ${CMAKE_CURRENT_LIST_DIR}/ltc.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/cell_fit.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/fit_table.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/published_layout.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/table_io.cpp)
+list(APPEND GLINTBAKE_BAKE_DEPS Ceres::ceres)

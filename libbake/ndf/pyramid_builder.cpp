@@ -1,0 +1,229 @@
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/runtime/ndf_pyramid.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <new>
+
+namespace glintbake::bake::ndf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr int kConvergenceSamplesPerAxis = 4;
+
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Relative MSE of image a against b: sum (a - b)^2 / sum b^2 (0 when both vanish).
+double relativeMse(const float* a, const float* b, size_t n) {
+  double num = 0.0, den = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = double(a[i]) - double(b[i]);
+    num += d * d;
+    den += double(b[i]) * double(b[i]);
+  }
+  return den > 0.0 ? num / den : (num > 0.0 ? 1.0 : 0.0);
+}
+
+}  // namespace
+
+Status validatePyramidOptions(const PyramidOptions& o) {
+  auto bad = [](const std::string& m) { return Status(makeError(ErrorCode::kBadArgument, m)); };
+  if (o.splat.ndf_res < 2 || o.splat.ndf_res > 4096) return bad("--ndf-res must be in [2, 4096]");
+  if (!(o.splat.sigma_r > 0.0 && o.splat.sigma_r <= 1.0)) return bad("--sigma-r must be in (0, 1]");
+  if (!(o.splat.footprint_truncation >= 1.0 && o.splat.footprint_truncation <= 10.0))
+    return bad("footprint truncation must be in [1, 10]");
+  if (!(o.splat.lobe_truncation >= 2.0 && o.splat.lobe_truncation <= 10.0))
+    return bad("lobe truncation must be in [2, 10]");
+  if (o.rate < 1 || o.rate > kMaxFlakeRate) return bad("--rate must be in [1, " + std::to_string(kMaxFlakeRate) + "]");
+  if (!(o.stride0 > 0.0 && o.stride0 <= 1e6)) return bad("--stride must be positive");
+  if (!(o.sigma0 > 0.0 && o.sigma0 <= 1e6)) return bad("--sigma0 must be positive");
+  if (o.levels < 0 || o.levels > kMaxPyramidLevels)
+    return bad("--levels must be auto or in [1, " + std::to_string(kMaxPyramidLevels) + "]");
+  if (!(o.converge_mse > 0.0)) return bad("--converge-mse must be positive");
+  if (o.region_size < 1 || o.region_size > 256) return bad("--region must be in [1, 256]");
+  return okStatus();
+}
+
+LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions& options, int level) {
+  LevelGeometry g;
+  const double stride = options.stride0 * std::ldexp(1.0, level);
+  g.grid_width = std::max(1, int(std::lround(std::min(double(map_width) / stride, 1e9))));
+  g.grid_height = std::max(1, int(std::lround(std::min(double(map_height) / stride, 1e9))));
+  g.stride_x = double(map_width) / g.grid_width;
+  g.stride_y = double(map_height) / g.grid_height;
+  g.sigma = options.sigma0 * std::ldexp(1.0, level);
+  g.regions_x = (g.grid_width + options.region_size - 1) / options.region_size;
+  g.regions_y = (g.grid_height + options.region_size - 1) / options.region_size;
+  return g;
+}
+
+Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
+                       PyramidReport* report, const PyramidProgress& progress,
+                       const std::atomic<bool>* cancel) {
+  if (Status s = validatePyramidOptions(options); !s) return s;
+  PyramidReport local_report;
+  PyramidReport& rep = report ? *report : local_report;
+  rep = PyramidReport{};
+
+  const auto t_flakes = Clock::now();
+  Result<FlakeSet> flakes_or = buildFlakes(map, options.rate);
+  if (!flakes_or) return flakes_or.error();
+  const FlakeSet& flakes = flakes_or.value();
+  rep.flakes = uint64_t(flakes.grid_width) * uint64_t(flakes.grid_height);
+  rep.flake_seconds = secondsSince(t_flakes);
+
+  const int res = options.splat.ndf_res;
+  const size_t image_floats = size_t(res) * size_t(res);
+  tbb::enumerable_thread_specific<Splatter> splatters(flakes, options.splat);
+  auto cancelled = [&] { return cancel && cancel->load(std::memory_order_relaxed); };
+  auto cancelError = [] { return Status(makeError(ErrorCode::kRuntime, "cancelled")); };
+
+  // Chunk buffers: 32-byte image section header (8 floats) followed by the images.
+  const size_t max_layers = size_t(options.region_size) * size_t(options.region_size);
+  std::vector<float> buffers[2];
+  try {
+    buffers[0].resize(8 + max_layers * image_floats);
+    buffers[1].resize(8 + max_layers * image_floats);
+  } catch (const std::bad_alloc&) {
+    return makeError(ErrorCode::kRuntime, "out of memory allocating chunk buffers");
+  }
+
+  const int max_levels = options.levels > 0 ? options.levels : kMaxPyramidLevels;
+  for (int level = 0; level < max_levels; ++level) {
+    const LevelGeometry geo = levelGeometry(map.width, map.height, options, level);
+    double mse_prev = -1.0;
+    if (level > 0 && options.levels == 0) {
+      // Sampled comparison of this level's footprint with the level below, at this level's centres.
+      const LevelGeometry below = levelGeometry(map.width, map.height, options, level - 1);
+      const int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
+      const int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
+      const int ns = nsx * nsy;
+      std::vector<float> a(size_t(ns) * image_floats), b(size_t(ns) * image_floats);
+      std::vector<double> mse(static_cast<size_t>(ns));
+      tbb::parallel_for(0, ns, [&](int k) {
+        const int i = int((k % nsx + 0.5) * geo.grid_width / nsx);
+        const int j = int((k / nsx + 0.5) * geo.grid_height / nsy);
+        const double x = (i + 0.5) * geo.stride_x, y = (j + 0.5) * geo.stride_y;
+        Splatter& sp = splatters.local();
+        sp.image(x, y, geo.sigma, &a[size_t(k) * image_floats]);
+        sp.image(x, y, below.sigma, &b[size_t(k) * image_floats]);
+        mse[size_t(k)] = relativeMse(&a[size_t(k) * image_floats], &b[size_t(k) * image_floats], image_floats);
+      });
+      double sum = 0.0;
+      for (double m : mse) sum += m;  // fixed order: deterministic
+      mse_prev = sum / ns;
+      if (mse_prev < options.converge_mse) {
+        rep.stop_reason = "converged";
+        rep.next_level_mse = mse_prev;
+        return okStatus();
+      }
+    }
+    if (cancelled()) return cancelError();
+
+    const auto t_level = Clock::now();
+    const uint64_t bytes_before = writer.bytesWritten();
+    PyramidLevelReport lrep;
+    lrep.level = level;
+    lrep.geometry = geo;
+    lrep.mse_vs_previous = mse_prev;
+
+    runtime::NdfLevelRecord rec;
+    rec.level = uint32_t(level);
+    rec.ndf_res = uint32_t(res);
+    rec.grid_width = uint32_t(geo.grid_width);
+    rec.grid_height = uint32_t(geo.grid_height);
+    rec.region_size = uint32_t(options.region_size);
+    rec.regions_x = uint32_t(geo.regions_x);
+    rec.regions_y = uint32_t(geo.regions_y);
+    rec.wrap = map.wrap == Wrap::kRepeat ? 0u : 1u;
+    rec.map_width = uint32_t(map.width);
+    rec.map_height = uint32_t(map.height);
+    rec.rate = uint32_t(options.rate);
+    rec.stride_x = geo.stride_x;
+    rec.stride_y = geo.stride_y;
+    rec.origin_x = 0.5 * geo.stride_x;
+    rec.origin_y = 0.5 * geo.stride_y;
+    rec.sigma_texels = geo.sigma;
+    rec.sigma_r = options.splat.sigma_r;
+    if (format::Status st = writer.addSection(format::kSectionNdfLevel, uint64_t(level), &rec, sizeof(rec));
+        st != format::Status::kOk) {
+      return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
+    }
+
+    const int region_count = geo.regions_x * geo.regions_y;
+    const uint64_t level_images = uint64_t(geo.grid_width) * uint64_t(geo.grid_height);
+    uint64_t done = 0;
+
+    // Computes region r into buffers[slot]; returns the number of layers.
+    auto regionExtent = [&](int r, int* cx0, int* cy0, int* cw, int* ch) {
+      const int rx = r % geo.regions_x, ry = r / geo.regions_x;
+      *cx0 = rx * options.region_size;
+      *cy0 = ry * options.region_size;
+      *cw = std::min(options.region_size, geo.grid_width - *cx0);
+      *ch = std::min(options.region_size, geo.grid_height - *cy0);
+    };
+    auto computeRegion = [&](int r, int slot) {
+      int cx0, cy0, cw, ch;
+      regionExtent(r, &cx0, &cy0, &cw, &ch);
+      float* images = buffers[slot].data() + 8;
+      tbb::parallel_for(tbb::blocked_range<int>(0, cw * ch, 1), [&](const tbb::blocked_range<int>& range) {
+        Splatter& sp = splatters.local();
+        for (int k = range.begin(); k != range.end(); ++k) {
+          if (cancelled()) return;
+          const int i = cx0 + k % cw, j = cy0 + k / cw;
+          sp.image((i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, geo.sigma, images + size_t(k) * image_floats);
+        }
+      });
+    };
+
+    // Double buffering: region r + 1 is computed while region r is compressed and written.
+    computeRegion(0, 0);
+    for (int r = 0; r < region_count; ++r) {
+      if (cancelled()) return cancelError();
+      tbb::task_group next;
+      if (r + 1 < region_count) next.run([&, r] { computeRegion(r + 1, (r + 1) % 2); });
+      int cx0, cy0, cw, ch;
+      regionExtent(r, &cx0, &cy0, &cw, &ch);
+      format::ImageSectionHeader header;
+      header.width = uint32_t(res);
+      header.height = uint32_t(res);
+      header.channels = 1;
+      header.layers = uint32_t(cw * ch);
+      std::vector<float>& buf = buffers[r % 2];
+      std::memcpy(buf.data(), &header, sizeof(header));
+      const size_t bytes = sizeof(header) + size_t(cw * ch) * image_floats * sizeof(float);
+      const format::Status st =
+          writer.addSection(format::kSectionNdfChunk, (uint64_t(level) << 32) | uint64_t(r), buf.data(), bytes);
+      next.wait();
+      if (st != format::Status::kOk) {
+        return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
+      }
+      lrep.raw_bytes += bytes;
+      lrep.images += uint64_t(cw * ch);
+      done += uint64_t(cw * ch);
+      if (progress) progress(level, done, level_images);
+    }
+    lrep.stored_bytes = writer.bytesWritten() - bytes_before;
+    lrep.seconds = secondsSince(t_level);
+    rep.levels.push_back(lrep);
+
+    if (options.levels == 0 && geo.grid_width == 1 && geo.grid_height == 1) {
+      rep.stop_reason = "grid-1x1";
+      return okStatus();
+    }
+  }
+  rep.stop_reason = options.levels > 0 ? "levels" : "max-levels";
+  return okStatus();
+}
+
+}  // namespace glintbake::bake::ndf

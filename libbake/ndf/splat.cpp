@@ -1,0 +1,173 @@
+#include <glintbake/bake/ndf/splat.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace glintbake::bake::ndf {
+namespace {
+
+constexpr double kInvSqrt2 = 0.70710678118654752440;
+constexpr double kInvSqrt2Pi = 0.39894228040143267794;
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxSubIntervals = 16;
+
+// Standard normal CDF.
+inline double phiCdf(double z) { return 0.5 * std::erfc(-z * kInvSqrt2); }
+// Standard normal density.
+inline double phiPdf(double z) { return kInvSqrt2Pi * std::exp(-0.5 * z * z); }
+
+}  // namespace
+
+Splatter::Splatter(const FlakeSet& flakes, const SplatParams& params)
+    : flakes_(flakes), params_(params) {
+  const int r = params_.ndf_res;
+  acc_.assign(size_t(r) * size_t(r), 0.0);
+  inside_disk_.resize(size_t(r) * size_t(r));
+  const double h = 2.0 / r;
+  for (int j = 0; j < r; ++j) {
+    for (int i = 0; i < r; ++i) {
+      const double sx = -1.0 + (i + 0.5) * h, sy = 1.0 - (j + 0.5) * h;
+      inside_disk_[size_t(j) * r + i] = (sx * sx + sy * sy <= 1.0) ? 1 : 0;
+    }
+  }
+}
+
+void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, double cxx, double cxy,
+                         double cyy, double mass, double truncation) {
+  // Work in bin coordinates of both axes: a = s_x (columns), b = -s_y (rows), so bin k of either
+  // axis covers [-1 + k h, -1 + (k + 1) h].
+  const double h = 2.0 / res;
+  double mean_a = mean_x, mean_b = -mean_y, caa = cxx, cab = -cxy, cbb = cyy;
+  // Condition on the axis of larger variance: then |slope| <= 1.
+  const bool swapped = cbb > caa;
+  if (swapped) {
+    std::swap(mean_a, mean_b);
+    std::swap(caa, cbb);
+  }
+  const double sd_a = std::sqrt(caa);
+  const double slope = cab / caa;
+  const double cond_var = std::max(cbb - cab * slope, 1e-30);
+  const double cond_sd = std::sqrt(cond_var);
+  const size_t stride_a = swapped ? size_t(res) : 1;  // acc step per bin of axis a
+  const size_t stride_b = swapped ? 1 : size_t(res);
+
+  const double lo = std::max(mean_a - truncation * sd_a, -1.0);
+  const double hi = std::min(mean_a + truncation * sd_a, 1.0);
+  if (lo >= hi) return;
+  const int k0 = std::max(0, int(std::floor((lo + 1.0) / h)));
+  const int k1 = std::min(res - 1, int(std::floor((hi + 1.0) / h)));
+  const double inv_sd_a = 1.0 / sd_a;
+
+  for (int k = k0; k <= k1; ++k) {
+    const double a0 = std::max(lo, -1.0 + k * h);
+    const double a1 = std::min(hi, -1.0 + (k + 1) * h);
+    if (a1 <= a0) continue;
+    // Sub-intervals keep the conditional mean's drift across each below half a conditional std.
+    int subs = int(std::ceil(std::abs(slope) * (a1 - a0) / (0.5 * cond_sd)));
+    subs = std::clamp(subs, 1, kMaxSubIntervals);
+    const double da = (a1 - a0) / subs;
+    double z_prev = (a0 - mean_a) * inv_sd_a;
+    double cdf_prev = phiCdf(z_prev), pdf_prev = phiPdf(z_prev);
+    for (int s = 0; s < subs; ++s) {
+      const double z_next = (a0 + (s + 1) * da - mean_a) * inv_sd_a;
+      const double cdf_next = phiCdf(z_next), pdf_next = phiPdf(z_next);
+      const double w = cdf_next - cdf_prev;
+      if (w > 1e-300) {
+        // Truncated-normal mean and variance of the primary axis on this sub-interval.
+        const double ratio = (pdf_prev - pdf_next) / w;
+        const double t_mean = mean_a + sd_a * ratio;
+        double t_var = caa * (1.0 + (z_prev * pdf_prev - z_next * pdf_next) / w - ratio * ratio);
+        t_var = std::max(t_var, 0.0);
+        const double m_b = mean_b + slope * (t_mean - mean_a);
+        const double sd_b = std::sqrt(cond_var + slope * slope * t_var);
+        const double blo = std::max(m_b - truncation * sd_b, -1.0);
+        const double bhi = std::min(m_b + truncation * sd_b, 1.0);
+        if (blo < bhi) {
+          const int j0 = std::max(0, int(std::floor((blo + 1.0) / h)));
+          const int j1 = std::min(res - 1, int(std::floor((bhi + 1.0) / h)));
+          const double inv_sd_b = 1.0 / sd_b;
+          const double scale = mass * w;
+          double c_prev = phiCdf((-1.0 + j0 * h - m_b) * inv_sd_b);
+          double* row = acc + size_t(k) * stride_a + size_t(j0) * stride_b;
+          for (int j = j0; j <= j1; ++j, row += stride_b) {
+            const double c_next = phiCdf((-1.0 + (j + 1) * h - m_b) * inv_sd_b);
+            *row += scale * (c_next - c_prev);
+            c_prev = c_next;
+          }
+        }
+      }
+      z_prev = z_next;
+      cdf_prev = cdf_next;
+      pdf_prev = pdf_next;
+    }
+  }
+}
+
+int64_t Splatter::image(double x, double y, double sigma, float* out) {
+  const int res = params_.ndf_res;
+  std::fill(acc_.begin(), acc_.end(), 0.0);
+  const FlakeSet& f = flakes_;
+  const double sh2 = f.sigma_h * f.sigma_h;
+  const double sp2 = sigma * sigma;
+  const double s2 = sh2 + sp2;
+  const double radius = params_.footprint_truncation * std::sqrt(s2);
+  const double radius2 = radius * radius;
+  const double spatial_norm = f.area / (2.0 * kPi * s2);
+  const double inv_2s2 = 0.5 / s2;
+  const double t = sh2 / s2;          // mean shift factor of mu_k
+  const double kc = sh2 * sp2 / s2;   // J diag(kc) J^T term of C_k
+  const double sr2 = params_.sigma_r * params_.sigma_r;
+  const double trunc = params_.lobe_truncation;
+
+  // Virtual flake indices whose centres may lie within the radius (unwrapped: periodic images of a
+  // repeating map are visited as distinct positions).
+  const int64_t gx0 = int64_t(std::floor((x - radius) / f.step - 0.5));
+  const int64_t gx1 = int64_t(std::ceil((x + radius) / f.step - 0.5));
+  const int64_t gy0 = int64_t(std::floor((y - radius) / f.step - 0.5));
+  const int64_t gy1 = int64_t(std::ceil((y + radius) / f.step - 0.5));
+  const bool repeat = f.wrap == Wrap::kRepeat;
+  int64_t used = 0;
+  for (int64_t gy = gy0; gy <= gy1; ++gy) {
+    int64_t wy = gy;
+    if (repeat) {
+      wy %= f.grid_height;
+      if (wy < 0) wy += f.grid_height;
+    } else if (gy < 0 || gy >= f.grid_height) {
+      continue;
+    }
+    const double dy = f.positionY(gy) - y;
+    const double dy2 = dy * dy;
+    if (dy2 > radius2) continue;
+    for (int64_t gx = gx0; gx <= gx1; ++gx) {
+      const double dx = f.positionX(gx) - x;
+      const double d2 = dx * dx + dy2;
+      if (d2 > radius2) continue;
+      int64_t wx = gx;
+      if (repeat) {
+        wx %= f.grid_width;
+        if (wx < 0) wx += f.grid_width;
+      } else if (gx < 0 || gx >= f.grid_width) {
+        continue;
+      }
+      const float* k = f.flake(int(wx), int(wy));
+      const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
+      // mu_k = n_k + J_k t (u_Q - u_k), with u_Q - u_k = (-dx, -dy).
+      const double mx = k[0] - t * (j00 * dx + j01 * dy);
+      const double my = k[1] - t * (j10 * dx + j11 * dy);
+      // C_k = sigma_r^2 I + kc J J^T.
+      const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
+      const double cxy = kc * (j00 * j10 + j01 * j11);
+      const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+      const double mass = spatial_norm * std::exp(-d2 * inv_2s2);
+      splatLobe(acc_.data(), res, mx, my, cxx, cxy, cyy, mass, trunc);
+      ++used;
+    }
+  }
+
+  const double inv_bin_area = double(res) * double(res) / 4.0;
+  const size_t n = size_t(res) * size_t(res);
+  for (size_t i = 0; i < n; ++i) out[i] = inside_disk_[i] ? float(acc_[i] * inv_bin_area) : 0.0f;
+  return used;
+}
+
+}  // namespace glintbake::bake::ndf

@@ -1,0 +1,115 @@
+// Runtime-lite reader of ndf-pyramid assets (written by ndfgen): NDF images of Gaussian footprints
+// on a multi-level grid of footprint centres (Deng et al. 2022, section 3), queried with trilinear
+// interpolation.
+//
+// Asset layout (formats/SPEC.md, "ndf-pyramid"):
+//  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord;
+//  - one kSectionNdfChunk section per level and spatial region (key = l << 32 | region, region =
+//    ry * regions_x + rx) holding a format::ImageSectionHeader (width = height = R, channels = 1,
+//    layers = centres in the region) and the region's images, centres in row-major order within the
+//    region;
+//  - level l: grid_width x grid_height centres; centre (i, j) at
+//    (origin_x + i * stride_x, origin_y + j * stride_y) texels with origin = stride / 2, so the grid
+//    covers the map exactly and each centre of level l + 1 is the centre of the 2 x 2 block of level
+//    l centres it replaces whenever the grids nest (grid sizes even);
+//  - footprint std of level l: sigma_texels = sigma0 * 2^l.
+//
+// Queries (Footprint in texels, SPoint in the s-plane):
+//  - level coordinate t = log2(sigma / sigma_0); sigma <= sigma_0 uses level 0 only, t >= top uses
+//    the top level only, otherwise the two bracketing levels are blended linearly in t;
+//  - on each level the four nearest centres are blended bilinearly; repeat maps wrap around the
+//    grid, clamp maps clamp to the edge centres;
+//  - every stored image is piecewise constant per bin, so the blend of up to 8 images is too:
+//    eval(), average(), sample() and pdf() are exactly consistent.
+//
+// Memory: all images are decompressed into memory by open() (R * R * 4 bytes per centre, plus
+// (R + 1) * 8 bytes of row sums for sampling); e.g. a 1024^2 map at stride 16, R = 128 holds about
+// 360 MB. Queries never allocate and are thread-safe (const). open() is safe on untrusted input:
+// every size is checked against the container and against the descriptor before use.
+#pragma once
+
+#include <glintbake/runtime/runtime.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace glintbake::runtime {
+
+// Level descriptor, stored as the raw bytes of this struct (little-endian, 112 bytes).
+struct NdfLevelRecord {
+  uint32_t magic = 0x4C444E47;  // "GNDL"
+  uint32_t version = 1;
+  uint32_t level = 0;
+  uint32_t ndf_res = 0;         // R: bins per side of every image
+  uint32_t grid_width = 0;      // footprint centres per row
+  uint32_t grid_height = 0;     // footprint centres per column
+  uint32_t region_size = 0;     // centres per side of a spatial region (chunk)
+  uint32_t regions_x = 0;       // ceil(grid_width / region_size)
+  uint32_t regions_y = 0;       // ceil(grid_height / region_size)
+  uint32_t wrap = 0;            // 0 = repeat, 1 = clamp
+  uint32_t map_width = 0;       // texels of the source map
+  uint32_t map_height = 0;
+  uint32_t rate = 1;            // flakes per texel side used to bake
+  uint32_t reserved = 0;
+  double stride_x = 0.0;        // texels between centres along x (= map_width / grid_width)
+  double stride_y = 0.0;        // texels between centres along y (= map_height / grid_height)
+  double origin_x = 0.0;        // position of centre (0, 0), texels (= stride / 2)
+  double origin_y = 0.0;
+  double sigma_texels = 0.0;    // footprint std of this level
+  double sigma_r = 0.0;         // intrinsic roughness used to bake
+  double reserved2 = 0.0;
+};
+static_assert(sizeof(NdfLevelRecord) == 112, "NdfLevelRecord is 112 bytes");
+
+// A rectangle of the s-plane [x0, x1] x [y0, y1] (x0 < x1, y0 < y1).
+struct SRect {
+  double x0 = -1.0, y0 = -1.0, x1 = 1.0, y1 = 1.0;
+};
+
+// Most levels a pyramid may have.
+constexpr int kMaxNdfLevels = 32;
+
+class NdfPyramid {
+ public:
+  NdfPyramid();
+  ~NdfPyramid();
+  NdfPyramid(const NdfPyramid&) = delete;
+  NdfPyramid& operator=(const NdfPyramid&) = delete;
+
+  // Loads an ndf-pyramid container (all images). kIoError, kInvalidAsset, kWrongKind,
+  // kUnsupportedVersion, kOutOfMemory. Safe on untrusted input.
+  Status open(const char* path);
+  // Same, from a caller buffer (only needed during the call).
+  Status openMemory(const void* data, size_t size);
+  bool isOpen() const;
+
+  int resolution() const;  // R
+  int levelCount() const;
+  // Descriptor of level l in [0, levelCount()), or null.
+  const NdfLevelRecord* level(int l) const;
+  // Stored image of centre (i, j) of level l (R * R floats), or null when out of range.
+  const float* centreImage(int l, int i, int j) const;
+
+  // Value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const;
+  // Exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2 count as 0).
+  // Cost grows with the number of bins the rectangle covers.
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const;
+  // Samples s from the blended P-NDF with two uniforms in [0, 1); sample->pdf == pdf(footprint, s).
+  // kInvalidArgument if the blend has no mass.
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const;
+  // Density of sample(): eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for
+  // footprints away from the edges of clamp maps, so pdf == eval there).
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const;
+  // Total mass of the blend (integral over the s-plane).
+  Status mass(const Footprint& footprint, double* value) const;
+  // The blended image the runtime sees: out must hold R * R floats (out_count >= R * R).
+  Status image(const Footprint& footprint, float* out, size_t out_count) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glintbake::runtime

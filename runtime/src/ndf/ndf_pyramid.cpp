@@ -1,0 +1,407 @@
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/ndf_pyramid.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <vector>
+
+namespace glintbake::runtime {
+namespace {
+
+constexpr uint32_t kMaxResolution = 4096;
+constexpr uint32_t kMaxGridSide = 1u << 20;
+constexpr uint64_t kMaxTotalFloats = uint64_t(1) << 36;  // 256 GiB: beyond any sane asset
+
+// Heap array that reports allocation failure instead of throwing.
+template <typename T>
+struct Array {
+  T* data = nullptr;
+  size_t size = 0;
+  ~Array() { delete[] data; }
+  bool allocate(size_t n) {
+    delete[] data;
+    data = new (std::nothrow) T[n];
+    size = data ? n : 0;
+    return data != nullptr;
+  }
+};
+
+struct Level {
+  NdfLevelRecord rec;
+  Array<float> images;     // grid_height * grid_width images of R * R, centre-major row-major
+  Array<double> prefix;    // per image R + 1 cumulative row masses
+};
+
+// Up to 8 weighted images (2 levels x 4 centres).
+struct Blend {
+  int count = 0;
+  double weight[8];
+  const float* image[8];
+  const double* prefix[8];
+};
+
+bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
+
+Status fromFormat(format::Status s) {
+  switch (s) {
+    case format::Status::kOk: return Status::kOk;
+    case format::Status::kIoError: return Status::kIoError;
+    case format::Status::kUnsupportedVersion: return Status::kUnsupportedVersion;
+    default: return Status::kInvalidAsset;
+  }
+}
+
+}  // namespace
+
+struct NdfPyramid::Impl {
+  int res = 0;
+  int level_count = 0;
+  double bin = 0.0;       // 2 / R
+  double bin_area = 0.0;  // (2 / R)^2
+  Level levels[kMaxNdfLevels];
+
+  Status load(const format::Reader& reader);
+  void blend(const Footprint& fp, Blend* b) const;
+  void addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const;
+  // Bin of s, or -1 outside [-1,1]^2.
+  int binOf(double sx, double sy) const {
+    if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
+    const int i = std::min(res - 1, int((sx + 1.0) / bin));
+    const int j = std::min(res - 1, int((1.0 - sy) / bin));
+    return j * res + i;
+  }
+  double blendValue(const Blend& b, int bin_index) const {
+    double v = 0.0;
+    for (int k = 0; k < b.count; ++k) v += b.weight[k] * double(b.image[k][bin_index]);
+    return v;
+  }
+  double blendMass(const Blend& b) const {
+    double m = 0.0;
+    for (int k = 0; k < b.count; ++k) m += b.weight[k] * b.prefix[k][res];
+    return m;
+  }
+};
+
+Status NdfPyramid::Impl::load(const format::Reader& reader) {
+  if (reader.kind() != format::AssetKind::kNdfPyramid) return Status::kWrongKind;
+  std::vector<uint8_t> bytes;
+  level_count = 0;
+  for (int l = 0; l < kMaxNdfLevels; ++l) {
+    const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));
+    if (idx < 0) break;
+    if (reader.sections()[size_t(idx)].raw_size != sizeof(NdfLevelRecord)) return Status::kInvalidAsset;
+    NdfLevelRecord rec;
+    if (Status s = fromFormat(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
+    // Descriptor sanity: everything the queries index with is checked here.
+    if (rec.magic != NdfLevelRecord().magic) return Status::kInvalidAsset;
+    if (rec.version != 1) return Status::kUnsupportedVersion;
+    if (rec.level != uint32_t(l) || rec.ndf_res < 2 || rec.ndf_res > kMaxResolution) return Status::kInvalidAsset;
+    if (l > 0 && rec.ndf_res != uint32_t(res)) return Status::kInvalidAsset;
+    if (rec.grid_width < 1 || rec.grid_height < 1 || rec.grid_width > kMaxGridSide || rec.grid_height > kMaxGridSide)
+      return Status::kInvalidAsset;
+    if (rec.region_size < 1 || rec.regions_x != (rec.grid_width + rec.region_size - 1) / rec.region_size ||
+        rec.regions_y != (rec.grid_height + rec.region_size - 1) / rec.region_size)
+      return Status::kInvalidAsset;
+    if (rec.wrap > 1 || !finitePositive(rec.stride_x) || !finitePositive(rec.stride_y) ||
+        !std::isfinite(rec.origin_x) || !std::isfinite(rec.origin_y) || !finitePositive(rec.sigma_texels))
+      return Status::kInvalidAsset;
+    if (l > 0 && !(rec.sigma_texels > levels[l - 1].rec.sigma_texels)) return Status::kInvalidAsset;
+    res = int(rec.ndf_res);
+    Level& lv = levels[l];
+    lv.rec = rec;
+    const uint64_t image_floats = uint64_t(res) * uint64_t(res);
+    const uint64_t centres = uint64_t(rec.grid_width) * uint64_t(rec.grid_height);
+    if (centres * image_floats > kMaxTotalFloats) return Status::kInvalidAsset;
+    if (!lv.images.allocate(size_t(centres * image_floats)) || !lv.prefix.allocate(size_t(centres * (res + 1))))
+      return Status::kOutOfMemory;
+    const double area = 4.0 / (double(res) * double(res));
+
+    // Chunks: one per region, scattered into centre order.
+    for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
+      for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
+        const uint64_t region = uint64_t(ry) * rec.regions_x + rx;
+        const int cidx = reader.find(format::kSectionNdfChunk, (uint64_t(l) << 32) | region);
+        if (cidx < 0) return Status::kInvalidAsset;
+        const uint32_t cx0 = rx * rec.region_size, cy0 = ry * rec.region_size;
+        const uint32_t cw = std::min(rec.region_size, rec.grid_width - cx0);
+        const uint32_t ch = std::min(rec.region_size, rec.grid_height - cy0);
+        const uint64_t expected = sizeof(format::ImageSectionHeader) + uint64_t(cw) * ch * image_floats * 4;
+        if (reader.sections()[size_t(cidx)].raw_size != expected) return Status::kInvalidAsset;
+        Array<uint8_t> chunk;
+        if (!chunk.allocate(size_t(expected))) return Status::kOutOfMemory;
+        if (Status s = fromFormat(reader.readSectionInto(size_t(cidx), chunk.data, chunk.size)); s != Status::kOk)
+          return s;
+        format::ImageSectionHeader header;
+        std::memcpy(&header, chunk.data, sizeof(header));
+        if (header.magic != format::ImageSectionHeader().magic || header.width != uint32_t(res) ||
+            header.height != uint32_t(res) || header.channels != 1 || header.layers != cw * ch)
+          return Status::kInvalidAsset;
+        const uint8_t* src = chunk.data + sizeof(header);
+        for (uint32_t k = 0; k < cw * ch; ++k) {
+          const uint64_t centre = uint64_t(cy0 + k / cw) * rec.grid_width + (cx0 + k % cw);
+          float* dst = lv.images.data + centre * image_floats;
+          std::memcpy(dst, src + uint64_t(k) * image_floats * 4, size_t(image_floats) * 4);
+          double* pre = lv.prefix.data + centre * uint64_t(res + 1);
+          pre[0] = 0.0;
+          for (int j = 0; j < res; ++j) {
+            double row = 0.0;
+            for (int i = 0; i < res; ++i) {
+              const float v = dst[size_t(j) * res + i];
+              if (!(v >= 0.0f) || !std::isfinite(v)) return Status::kInvalidAsset;  // NaN, Inf, negative
+              row += v;
+            }
+            pre[j + 1] = pre[j] + row * area;
+          }
+        }
+      }
+    }
+    level_count = l + 1;
+  }
+  if (level_count == 0) return Status::kInvalidAsset;
+  bin = 2.0 / res;
+  bin_area = bin * bin;
+  return Status::kOk;
+}
+
+void NdfPyramid::Impl::addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const {
+  const Level& lv = levels[l];
+  const NdfLevelRecord& r = lv.rec;
+  const int gw = int(r.grid_width), gh = int(r.grid_height);
+  auto axis = [&](double pos, double map_size, double origin, double stride, int n, int* i0, int* i1, double* f) {
+    if (r.wrap == 0) {
+      pos -= std::floor(pos / map_size) * map_size;  // into [0, map size)
+      double g = (pos - origin) / stride;
+      double fl = std::floor(g);
+      *f = g - fl;
+      int a = int(fl);
+      *i0 = ((a % n) + n) % n;
+      *i1 = (*i0 + 1) % n;
+    } else {
+      double g = (pos - origin) / stride;
+      if (!(g > 0.0)) {
+        *i0 = *i1 = 0;
+        *f = 0.0;
+      } else if (g >= double(n - 1)) {
+        *i0 = *i1 = n - 1;
+        *f = 0.0;
+      } else {
+        double fl = std::floor(g);
+        *i0 = int(fl);
+        *i1 = *i0 + 1;
+        *f = g - fl;
+      }
+    }
+  };
+  int x0, x1, y0, y1;
+  double fx, fy;
+  axis(fp.x, double(r.map_width), r.origin_x, r.stride_x, gw, &x0, &x1, &fx);
+  axis(fp.y, double(r.map_height), r.origin_y, r.stride_y, gh, &y0, &y1, &fy);
+  const size_t image_floats = size_t(res) * size_t(res);
+  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+  const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  for (int k = 0; k < 4; ++k) {
+    if (ws[k] <= 0.0) continue;
+    const size_t centre = size_t(ys[k]) * size_t(gw) + size_t(xs[k]);
+    b->weight[b->count] = level_weight * ws[k];
+    b->image[b->count] = lv.images.data + centre * image_floats;
+    b->prefix[b->count] = lv.prefix.data + centre * size_t(res + 1);
+    ++b->count;
+  }
+}
+
+void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
+  b->count = 0;
+  const double s0 = levels[0].rec.sigma_texels;
+  const double top = levels[level_count - 1].rec.sigma_texels;
+  if (!(fp.sigma > s0)) {
+    addLevel(0, 1.0, fp, b);
+  } else if (fp.sigma >= top) {
+    addLevel(level_count - 1, 1.0, fp, b);
+  } else {
+    int l = 0;
+    while (l + 1 < level_count && levels[l + 1].rec.sigma_texels <= fp.sigma) ++l;
+    const double sa = levels[l].rec.sigma_texels, sb = levels[l + 1].rec.sigma_texels;
+    const double t = std::log(fp.sigma / sa) / std::log(sb / sa);  // linear in log2(sigma)
+    addLevel(l, 1.0 - t, fp, b);
+    addLevel(l + 1, t, fp, b);
+  }
+}
+
+namespace {
+bool validFootprint(const Footprint& fp) {
+  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
+         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
+}
+}  // namespace
+
+NdfPyramid::NdfPyramid() = default;
+NdfPyramid::~NdfPyramid() = default;
+
+Status NdfPyramid::open(const char* path) {
+  impl_.reset();
+  if (!path) return Status::kInvalidArgument;
+  format::Reader reader;
+  if (Status s = fromFormat(reader.open(path)); s != Status::kOk) return s;
+  auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
+  if (!impl) return Status::kOutOfMemory;
+  if (Status s = impl->load(reader); s != Status::kOk) return s;
+  impl_ = std::move(impl);
+  return Status::kOk;
+}
+
+Status NdfPyramid::openMemory(const void* data, size_t size) {
+  impl_.reset();
+  if (!data) return Status::kInvalidArgument;
+  format::Reader reader;
+  if (Status s = fromFormat(reader.openMemory(data, size)); s != Status::kOk) return s;
+  auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
+  if (!impl) return Status::kOutOfMemory;
+  if (Status s = impl->load(reader); s != Status::kOk) return s;
+  impl_ = std::move(impl);
+  return Status::kOk;
+}
+
+bool NdfPyramid::isOpen() const { return impl_ != nullptr; }
+int NdfPyramid::resolution() const { return impl_ ? impl_->res : 0; }
+int NdfPyramid::levelCount() const { return impl_ ? impl_->level_count : 0; }
+
+const NdfLevelRecord* NdfPyramid::level(int l) const {
+  if (!impl_ || l < 0 || l >= impl_->level_count) return nullptr;
+  return &impl_->levels[l].rec;
+}
+
+const float* NdfPyramid::centreImage(int l, int i, int j) const {
+  const NdfLevelRecord* r = level(l);
+  if (!r || i < 0 || j < 0 || uint32_t(i) >= r->grid_width || uint32_t(j) >= r->grid_height) return nullptr;
+  const size_t image_floats = size_t(impl_->res) * size_t(impl_->res);
+  return impl_->levels[l].images.data + (size_t(j) * r->grid_width + size_t(i)) * image_floats;
+}
+
+Status NdfPyramid::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
+    return Status::kInvalidArgument;
+  Blend b;
+  impl_->blend(footprint, &b);
+  const int bin = impl_->binOf(s.x, s.y);
+  *value = bin < 0 ? 0.0 : impl_->blendValue(b, bin);
+  return Status::kOk;
+}
+
+Status NdfPyramid::average(const Footprint& footprint, const SRect& rect, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
+      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  Blend b;
+  m.blend(footprint, &b);
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  double integral = 0.0;
+  if (x1 > x0 && y1 > y0) {
+    const int i0 = std::min(m.res - 1, int((x0 + 1.0) / m.bin)), i1 = std::min(m.res - 1, int((x1 + 1.0) / m.bin));
+    const int j0 = std::min(m.res - 1, int((1.0 - y1) / m.bin)), j1 = std::min(m.res - 1, int((1.0 - y0) / m.bin));
+    for (int j = j0; j <= j1; ++j) {
+      const double top = 1.0 - j * m.bin, bottom = 1.0 - (j + 1) * m.bin;
+      const double hy = std::min(top, y1) - std::max(bottom, y0);
+      if (hy <= 0.0) continue;
+      for (int i = i0; i <= i1; ++i) {
+        const double left = -1.0 + i * m.bin, right = -1.0 + (i + 1) * m.bin;
+        const double hx = std::min(right, x1) - std::max(left, x0);
+        if (hx <= 0.0) continue;
+        integral += hx * hy * m.blendValue(b, j * m.res + i);
+      }
+    }
+  }
+  *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return Status::kOk;
+}
+
+Status NdfPyramid::mass(const Footprint& footprint, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint)) return Status::kInvalidArgument;
+  Blend b;
+  impl_->blend(footprint, &b);
+  *value = impl_->blendMass(b);
+  return Status::kOk;
+}
+
+Status NdfPyramid::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
+    return Status::kInvalidArgument;
+  Blend b;
+  impl_->blend(footprint, &b);
+  const double total = impl_->blendMass(b);
+  const int bin = impl_->binOf(s.x, s.y);
+  *value = (bin < 0 || !(total > 0.0)) ? 0.0 : impl_->blendValue(b, bin) / total;
+  return Status::kOk;
+}
+
+Status NdfPyramid::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  Blend b;
+  m.blend(footprint, &b);
+  const double total = m.blendMass(b);
+  if (!(total > 0.0)) return Status::kInvalidArgument;
+
+  // 1. Component by weighted mass (u1 reused, rescaled to [0, 1) within the chosen component).
+  double target = u1 * total;
+  int c = 0;
+  for (; c < b.count - 1; ++c) {
+    const double mc = b.weight[c] * b.prefix[c][m.res];
+    if (target < mc) break;
+    target -= mc;
+  }
+  while (c > 0 && !(b.weight[c] * b.prefix[c][m.res] > 0.0)) --c;  // never land on an empty component
+  const double* pre = b.prefix[c];
+  const double comp_mass = pre[m.res];
+  double t = std::clamp(target / b.weight[c], 0.0, comp_mass);
+  // 2. Row by binary search of the cumulative row masses.
+  int row = int(std::upper_bound(pre + 1, pre + m.res + 1, t) - (pre + 1));
+  row = std::min(row, m.res - 1);
+  while (row > 0 && !(pre[row + 1] - pre[row] > 0.0)) --row;
+  const double row_mass = pre[row + 1] - pre[row];
+  double fy = row_mass > 0.0 ? (t - pre[row]) / row_mass : 0.5;
+  // 3. Column by a scan of the row (u2), remainder jitters x.
+  const float* img = b.image[c] + size_t(row) * m.res;
+  double row_sum = 0.0;
+  for (int i = 0; i < m.res; ++i) row_sum += img[i];
+  double tx = u2 * row_sum;
+  int col = 0;
+  for (; col < m.res - 1; ++col) {
+    if (tx < img[col]) break;
+    tx -= img[col];
+  }
+  while (col > 0 && !(img[col] > 0.0f)) --col;
+  double fx = img[col] > 0.0f ? tx / img[col] : 0.5;
+  constexpr double kBelowOne = 0.99999999999999989;
+  fx = std::clamp(fx, 0.0, kBelowOne);
+  fy = std::clamp(fy, 0.0, kBelowOne);
+  out->s.x = -1.0 + (col + fx) * m.bin;
+  out->s.y = 1.0 - (row + fy) * m.bin;
+  out->pdf = m.blendValue(b, row * m.res + col) / total;
+  return Status::kOk;
+}
+
+Status NdfPyramid::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!impl_) return Status::kInvalidArgument;
+  const size_t n = size_t(impl_->res) * size_t(impl_->res);
+  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
+  Blend b;
+  impl_->blend(footprint, &b);
+  for (size_t i = 0; i < n; ++i) {
+    double v = 0.0;
+    for (int k = 0; k < b.count; ++k) v += b.weight[k] * double(b.image[k][i]);
+    out[i] = float(v);
+  }
+  return Status::kOk;
+}
+
+}  // namespace glintbake::runtime

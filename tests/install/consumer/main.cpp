@@ -1,0 +1,32 @@
+// A renderer-side consumer of an installed glintbake: writes a container, reads it back through
+// the installed format library, and links the runtime.
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/runtime.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+int main(int argc, char** argv) {
+  if (argc != 2) return 1;
+  namespace fmt = glintbake::format;
+  const std::string meta = R"({"schema":"glintbake.container-metadata/1","asset_kind":"test",)"
+                           R"("generator":{"tool":"consumer","version":"0"},"parameters":{},"inputs":[]})";
+  const std::vector<float> payload(1000, 0.5f);
+  fmt::Writer writer;
+  if (writer.open(argv[1], fmt::AssetKind::kTest) != fmt::Status::kOk) return 2;
+  if (writer.addMetadata(meta) != fmt::Status::kOk) return 2;
+  if (writer.addSection(fmt::kSectionFirstPrivate, 7, payload.data(), payload.size() * sizeof(float)) != fmt::Status::kOk)
+    return 2;
+  if (writer.finish() != fmt::Status::kOk) return 2;
+
+  fmt::Reader reader;
+  if (reader.open(argv[1]) != fmt::Status::kOk) return 3;
+  const int index = reader.find(fmt::kSectionFirstPrivate, 7);
+  std::vector<uint8_t> bytes;
+  if (index < 0 || reader.readSection(size_t(index), &bytes) != fmt::Status::kOk) return 3;
+  if (bytes.size() != payload.size() * sizeof(float)) return 3;
+  std::printf("consumer ok: %s, runtime says '%s'\n", fmt::assetKindString(reader.kind()),
+              glintbake::runtime::statusString(glintbake::runtime::Status::kOk));
+  return 0;
+}

@@ -1,0 +1,74 @@
+// Helpers of the io tests: a scratch directory per test, and raw image writing through OIIO so the
+// inputs do not depend on the code under test.
+#pragma once
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace glintbake::test {
+
+class ScratchDir {
+ public:
+  ScratchDir() {
+    static std::atomic<int> counter{0};
+    path_ = std::filesystem::temp_directory_path() /
+            ("glintbake-io-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(path_)) names.push_back(e.path().filename().string());
+    return names;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Writes `values` (width*height*channels, in the given data type) as `stored` pixels.
+inline void writeRaw(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
+                     OIIO::TypeDesc data_type, const void* values, bool tiled = false) {
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << OIIO::geterror();
+  OIIO::ImageSpec spec(width, height, channels, stored);
+  spec.attribute("oiio:UnassociatedAlpha", 1);  // store alpha as given, RGB untouched
+  if (tiled) {
+    spec.tile_width = 16;
+    spec.tile_height = 16;
+  }
+  ASSERT_TRUE(out->open(path, spec)) << out->geterror();
+  ASSERT_TRUE(out->write_image(data_type, values)) << out->geterror();
+  ASSERT_TRUE(out->close());
+}
+
+inline void writeFloats(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
+                        const std::vector<float>& values, bool tiled = false) {
+  writeRaw(path, width, height, channels, stored, OIIO::TypeDesc::FLOAT, values.data(), tiled);
+}
+
+inline std::string readBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+inline void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+}  // namespace glintbake::test

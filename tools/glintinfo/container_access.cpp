@@ -1,0 +1,66 @@
+#include "container_access.h"
+
+#include <glintbake/format/validate.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace glintbake::glintinfo {
+
+int exitCodeFor(format::Status status) {
+  using format::Status;
+  switch (status) {
+    case Status::kOk: return cli::kExitOk;
+    case Status::kIoError: return cli::kExitIo;
+    case Status::kUnsupportedVersion: return cli::kExitUnsupported;
+    case Status::kInvalidArgument: return cli::kExitBadArguments;
+    case Status::kNotFound: return cli::kExitBadArguments;
+    default: return cli::kExitInvalidInput;
+  }
+}
+
+std::unique_ptr<format::Reader> openContainer(const std::string& path) {
+  auto reader = std::make_unique<format::Reader>();
+  const format::Status status = reader->open(path);
+  if (status == format::Status::kOk) return reader;
+  if (status == format::Status::kIoError) {
+    const int err = errno;
+    throw cli::Error(cli::kExitIo, "cannot read " + path + (err ? std::string(": ") + std::strerror(err) : ""));
+  }
+  // Let the validator explain: its first error names the exact field.
+  format::ValidateOptions options;
+  options.check_payloads = false;
+  const format::ValidationReport report = format::validateFile(path, options);
+  std::string reason = format::statusString(status);
+  for (const auto& m : report.messages) {
+    if (m.severity == format::Severity::kError) {
+      reason = m.message;
+      break;
+    }
+  }
+  throw cli::Error(exitCodeFor(status), path + ": " + reason);
+}
+
+std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i) {
+  std::vector<uint8_t> bytes;
+  const format::Status status = reader.readSection(i, &bytes);
+  if (status != format::Status::kOk) {
+    throw cli::Error(exitCodeFor(status), path + ": section " + std::to_string(i) + ": " + format::statusString(status));
+  }
+  return bytes;
+}
+
+std::string typeLabel(uint32_t type) {
+  const char* name = format::sectionTypeString(type);
+  if (std::strcmp(name, "unknown") == 0 || std::strcmp(name, "private") == 0) return std::to_string(type);
+  return name;
+}
+
+std::string keyLabel(uint32_t type, uint64_t key) {
+  if (type == format::kSectionNdfChunk) {
+    return "level " + std::to_string(key >> 32) + ", region " + std::to_string(key & 0xFFFFFFFFu);
+  }
+  return std::to_string(key);
+}
+
+}  // namespace glintbake::glintinfo

@@ -1,0 +1,28 @@
+// glintinfo: inspects, validates, compares and exports glintbake containers.
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  using namespace glintbake;
+  cli::Tool tool("glintinfo", "Inspects, validates, compares and exports glintbake containers (.gbk)");
+  CLI::App& app = tool.app();
+  // Common options (--json, --quiet, ...) may follow the subcommand.
+  app.fallthrough();
+  app.require_subcommand(1);
+
+  glintinfo::InfoOptions info;
+  glintinfo::ValidateOptions validate;
+  glintinfo::DiffOptions diff;
+  glintinfo::ExportOptions exported;
+  CLI::App* info_cmd = glintinfo::addInfoCommand(app, info);
+  CLI::App* validate_cmd = glintinfo::addValidateCommand(app, validate);
+  CLI::App* diff_cmd = glintinfo::addDiffCommand(app, diff);
+  CLI::App* export_cmd = glintinfo::addExportCommand(app, exported);
+
+  return tool.run(argc, argv, [&](cli::Tool& t) {
+    if (info_cmd->parsed()) return glintinfo::runInfo(t, info);
+    if (validate_cmd->parsed()) return glintinfo::runValidate(t, validate);
+    if (diff_cmd->parsed()) return glintinfo::runDiff(t, diff);
+    if (export_cmd->parsed()) return glintinfo::runExport(t, exported);
+    throw cli::Error(cli::kExitBadArguments, "no command given");
+  });
+}

@@ -1,0 +1,191 @@
+// ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
+// ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md).
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/tool.h>
+#include <glintbake/format/container.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace {
+
+using glintbake::cli::Error;
+using glintbake::cli::Json;
+namespace bake = glintbake::bake;
+namespace cli = glintbake::cli;
+namespace format = glintbake::format;
+
+int exitCodeOf(bake::ErrorCode code) { return int(code); }
+
+Json levelJson(const bake::ndf::PyramidLevelReport& l, int region_size) {
+  Json j;
+  j["level"] = l.level;
+  j["stride"] = {l.geometry.stride_x, l.geometry.stride_y};
+  j["sigma"] = l.geometry.sigma;
+  j["grid"] = {l.geometry.grid_width, l.geometry.grid_height};
+  j["first_centre"] = {0.5 * l.geometry.stride_x, 0.5 * l.geometry.stride_y};
+  j["region_size"] = region_size;
+  j["regions"] = l.geometry.regions_x * l.geometry.regions_y;
+  return j;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Tool tool("ndfgen", "Bakes the footprint pyramid of P-NDF images of a normal map (ndf-pyramid asset)");
+  std::string input, output, levels_text = "auto";
+  bake::IngestOptions ingest;
+  bake::ndf::PyramidOptions opt;
+  int zstd_level = 3;
+  CLI::App& app = tool.app();
+  app.add_option("map", input, "Normal map (or height field with --height)")->required();
+  app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();
+  app.add_option("--ndf-res", opt.splat.ndf_res, "NDF image resolution R (bins per side, 2..4096)")
+      ->capture_default_str();
+  app.add_option("--sigma-r", opt.splat.sigma_r, "Intrinsic roughness: s-plane std of every flake (0, 1]")
+      ->capture_default_str();
+  app.add_option("--stride", opt.stride0, "Level-0 spacing of footprint centres, texels (> 0)")->capture_default_str();
+  app.add_option("--sigma0", opt.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str();
+  app.add_option("--levels", levels_text, "Number of levels, or auto (stop on convergence or a 1x1 grid)")
+      ->capture_default_str();
+  app.add_option("--converge-mse", opt.converge_mse,
+                 "auto levels: stop when the relative MSE between neighbouring levels is below this")
+      ->capture_default_str();
+  app.add_option("--rate", opt.rate, "Flakes per texel side (1..16)")->capture_default_str();
+  app.add_option("--region", opt.region_size, "Footprint centres per side of a streamed chunk (1..256)")
+      ->capture_default_str();
+  app.add_option("--zstd-level", zstd_level, "zstd compression level of the chunks (1..19)")->capture_default_str();
+  cli::addIngestOptions(app, ingest);
+
+  return tool.run(argc, argv, [&](cli::Tool& t) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (levels_text == "auto") {
+      opt.levels = 0;
+    } else {
+      try {
+        size_t used = 0;
+        opt.levels = std::stoi(levels_text, &used);
+        if (used != levels_text.size() || opt.levels < 1) throw std::invalid_argument("levels");
+      } catch (const std::exception&) {
+        throw Error(cli::kExitBadArguments, "--levels must be auto or a positive integer");
+      }
+    }
+    if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
+    if (bake::Status s = bake::ndf::validatePyramidOptions(opt); !s) {
+      throw Error(exitCodeOf(s.error().code), s.error().message);
+    }
+
+    bake::IngestReport ingest_report;
+    const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
+    if (map.width < 2 || map.height < 2) {
+      throw Error(cli::kExitInvalidInput, input + ": a normal map needs at least 2x2 texels (got " +
+                                              std::to_string(map.width) + "x" + std::to_string(map.height) + ")");
+    }
+
+    format::Writer writer;
+    if (format::Status s = writer.open(output, format::AssetKind::kNdfPyramid, zstd_level); s != format::Status::kOk) {
+      throw Error(cli::kExitIo, "cannot create " + output + ": " + format::statusString(s));
+    }
+    cli::registerTemporary(writer.temporaryPath());
+    struct Unregister {
+      std::string path;
+      ~Unregister() { cli::unregisterTemporary(path); }
+    } unregister{writer.temporaryPath()};
+
+    std::unique_ptr<cli::Progress> bar;
+    int bar_level = -1;
+    uint64_t bar_done = 0;
+    bake::ndf::PyramidReport report;
+    bake::Status built = bake::ndf::buildNdfPyramid(
+        map, opt, writer, &report, [&](int level, uint64_t done, uint64_t total) {
+          if (level != bar_level) {
+            if (bar) bar->finish();
+            bar = t.progress("level " + std::to_string(level), total);
+            bar_level = level;
+            bar_done = 0;
+          }
+          bar->advance(done - bar_done);
+          bar_done = done;
+        });
+    if (bar) bar->finish();
+    if (!built) {
+      writer.abort();
+      throw Error(exitCodeOf(built.error().code), built.error().message);
+    }
+
+    Json params;
+    params["ndf_res"] = opt.splat.ndf_res;
+    params["sigma_r"] = opt.splat.sigma_r;
+    params["stride"] = opt.stride0;
+    params["sigma0"] = opt.sigma0;
+    params["levels"] = levels_text == "auto" ? Json("auto") : Json(opt.levels);
+    params["converge_mse"] = opt.converge_mse;
+    params["rate"] = opt.rate;
+    params["region"] = opt.region_size;
+    params["footprint_truncation"] = opt.splat.footprint_truncation;
+    params["zstd_level"] = zstd_level;
+    params["ingest"] = cli::ingestOptionsJson(ingest);
+    Json meta = t.makeMetadata("ndf-pyramid", params);
+    Json asset;
+    asset["ndf_res"] = opt.splat.ndf_res;
+    asset["sigma_r"] = opt.splat.sigma_r;
+    asset["map_size"] = {map.width, map.height};
+    asset["wrap"] = bake::wrapString(map.wrap);
+    asset["rate"] = opt.rate;
+    asset["centre_grid"] = "centre (i, j) of level l at ((i + 0.5) stride_x, (j + 0.5) stride_y) texels";
+    asset["levels"] = Json::array();
+    for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
+    asset["stop_reason"] = report.stop_reason;
+    meta["asset"] = asset;
+    if (format::Status s = writer.addMetadata(meta.dump()); s != format::Status::kOk) {
+      throw Error(cli::kExitIo, "cannot write " + output + ": " + format::statusString(s));
+    }
+    if (format::Status s = writer.finish(); s != format::Status::kOk) {
+      throw Error(cli::kExitIo, "cannot write " + output + ": " + format::statusString(s));
+    }
+    t.addOutput(output);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    uint64_t raw = 0, stored = 0, images = 0;
+    for (const auto& l : report.levels) {
+      raw += l.raw_bytes;
+      stored += l.stored_bytes;
+      images += l.images;
+    }
+    if (t.common().json) {
+      Json doc;
+      doc["tool"] = "ndfgen";
+      doc["input"] = cli::baseName(input);
+      doc["output"] = cli::baseName(output);
+      doc["map"] = {{"width", map.width}, {"height", map.height}, {"wrap", bake::wrapString(map.wrap)}};
+      doc["ingest"] = cli::ingestReportJson(ingest_report);
+      doc["parameters"] = params;
+      Json levels = Json::array();
+      for (const auto& l : report.levels) {
+        Json j = levelJson(l, opt.region_size);
+        j["images"] = l.images;
+        j["raw_bytes"] = l.raw_bytes;
+        j["stored_bytes"] = l.stored_bytes;
+        j["seconds"] = l.seconds;
+        j["mse_vs_previous"] = l.mse_vs_previous < 0 ? Json(nullptr) : Json(l.mse_vs_previous);
+        levels.push_back(j);
+      }
+      doc["levels"] = levels;
+      doc["stop_reason"] = report.stop_reason;
+      doc["next_level_mse"] = report.next_level_mse < 0 ? Json(nullptr) : Json(report.next_level_mse);
+      doc["flakes"] = report.flakes;
+      doc["images"] = images;
+      doc["raw_bytes"] = raw;
+      doc["file_bytes"] = writer.bytesWritten();
+      doc["seconds"] = seconds;
+      t.printJson(doc);
+    } else {
+      t.info("wrote " + output + ": " + std::to_string(report.levels.size()) + " levels, " + std::to_string(images) +
+             " images, " + std::to_string(writer.bytesWritten()) + " bytes (" + std::to_string(raw) +
+             " raw) in " + std::to_string(seconds) + " s");
+    }
+    return cli::kExitOk;
+  });
+}
