@@ -96,8 +96,9 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
                                    : (bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   OIIO::ImageSpec spec(width, height, channels, stored);
   if (ext == "exr") spec.attribute("compression", "zip");
-  // A fresh spec carries no time or host attributes; make sure none creep in through defaults.
-  for (const char* name : {"DateTime", "Software", "HostComputer", "Artist"}) spec.erase_attribute(name);
+  // OIIO's EXR and TIFF writers stamp the current time when no DateTime is given; an explicit empty
+  // value keeps the bytes reproducible (EXR then stores an empty capDate, TIFF no date at all).
+  spec.attribute("DateTime", "");
 
   const size_t count = size_t(width) * size_t(height) * size_t(channels);
   std::vector<uint8_t> data8;

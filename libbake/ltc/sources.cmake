@@ -5,5 +5,7 @@ list(APPEND GLINTBAKE_BAKE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/cell_fit.cpp
   ${CMAKE_CURRENT_LIST_DIR}/fit_table.cpp
   ${CMAKE_CURRENT_LIST_DIR}/published_layout.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/table_io.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/table_io.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/multiscale.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/roughness.cpp)
 list(APPEND GLINTBAKE_BAKE_DEPS Ceres::ceres)

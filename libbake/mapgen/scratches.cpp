@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace glintbake::bake::mapgen {
@@ -52,14 +53,36 @@ NormalMap scratches(const MapParams& params) {
     // Across-groove direction; the groove floor is the centre line, walls rise to either side.
     const double px = -s.dy, py = s.dx;
 
-    // Texels whose square can reach the groove; the span stays below one period (validated
-    // width <= size / 4 and length <= size / 2), so no texel is visited twice per groove.
-    const double ex = std::abs(s.dx) * s.half_length + std::abs(px) * half_width + 1.0;
-    const double ey = std::abs(s.dy) * s.half_length + std::abs(py) * half_width + 1.0;
-    const int c0 = int(std::floor(s.cx - ex)), c1 = int(std::ceil(s.cx + ex));
-    const int r0 = int(std::floor(s.cy - ey)), r1 = int(std::ceil(s.cy + ey));
-    for (int r = r0; r <= r1; ++r) {
-      for (int c = c0; c <= c1; ++c) {
+    // Texels whose square can reach the groove, row by row: the x extent of the groove rectangle
+    // clipped to the row's band, plus a texel of margin. The span stays below one period
+    // (validated width <= size / 4 and length <= size / 2), so no texel is visited twice per groove.
+    const double hx = s.dx * s.half_length, hy = s.dy * s.half_length;
+    const double wx = px * half_width, wy = py * half_width;
+    const double corner_x[4] = {s.cx - hx - wx, s.cx + hx - wx, s.cx + hx + wx, s.cx - hx + wx};
+    const double corner_y[4] = {s.cy - hy - wy, s.cy + hy - wy, s.cy + hy + wy, s.cy - hy + wy};
+    const double y_min = *std::min_element(corner_y, corner_y + 4);
+    const double y_max = *std::max_element(corner_y, corner_y + 4);
+    for (int r = int(std::floor(y_min)) - 1; r <= int(std::ceil(y_max)); ++r) {
+      const double band0 = r - 1.0, band1 = r + 2.0;  // the row's band with a texel of margin
+      double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo;
+      for (int e = 0; e < 4; ++e) {
+        const double ax = corner_x[e], ay = corner_y[e];
+        const double bx = corner_x[(e + 1) % 4], by = corner_y[(e + 1) % 4];
+        if (std::max(ay, by) < band0 || std::min(ay, by) > band1) continue;
+        double t0 = 0.0, t1 = 1.0;
+        if (ay != by) {
+          const double ta = (band0 - ay) / (by - ay), tb = (band1 - ay) / (by - ay);
+          t0 = std::max(0.0, std::min(ta, tb));
+          t1 = std::min(1.0, std::max(ta, tb));
+        }
+        for (double t : {t0, t1}) {
+          const double x = ax + t * (bx - ax);
+          x_lo = std::min(x_lo, x);
+          x_hi = std::max(x_hi, x);
+        }
+      }
+      if (!(x_lo <= x_hi)) continue;
+      for (int c = int(std::floor(x_lo)) - 1; c <= int(std::ceil(x_hi)); ++c) {
         double gx = 0.0, grow = 0.0;
         for (int j = 0; j < kSubSamples; ++j) {
           for (int k = 0; k < kSubSamples; ++k) {

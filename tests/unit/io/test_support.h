@@ -8,7 +8,6 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -62,8 +61,12 @@ inline void writeFloats(const std::string& path, int width, int height, int chan
 }
 
 inline std::string readBytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  if (!f) return {};
+  std::string bytes(size_t(f.tellg()), '\0');
+  f.seekg(0);
+  f.read(bytes.data(), std::streamsize(bytes.size()));
+  return bytes;
 }
 
 inline void writeBytes(const std::string& path, const std::string& bytes) {

@@ -158,9 +158,11 @@ TEST(Mapgen, ScratchesTiltOnlyInsideGrooves) {
   expectUnitUpperHemisphere(map);
   int64_t flat = 0, tilted = 0;
   for (size_t i = 2; i < map.normals.size(); i += 3) (map.normals[i] == 1.0f ? flat : tilted)++;
-  // About 49 grooves of mean length 0.3 * 128 and width 3 cover roughly a third of the map.
-  EXPECT_GT(flat, tilted);
-  EXPECT_GT(tilted, int64_t(map.normals.size() / 3 / 20));
+  // About 49 grooves of mean length 0.3 * 128 and width 3 (about 4 with the partly covered
+  // texels on their edges) cover roughly 40% of the map, less where they overlap.
+  const double fraction = double(tilted) / double(flat + tilted);
+  EXPECT_GT(fraction, 0.25);
+  EXPECT_LT(fraction, 0.5);
   // A single groove wall has slope 0.5: the largest tilt is atan(0.5) unless grooves cross.
   const MapStatistics s = measureMap(map);
   EXPECT_GT(s.max_angle_degrees, 0.9 * std::atan(0.5) * 180.0 / kPi);

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace glintbake::reference {
@@ -21,7 +22,31 @@ struct PndfSample {
   double sy;
 };
 
-// `count` samples of the footprint's P-NDF, deterministic for a seed on every platform with IEEE
+// A stream of samples of one footprint's P-NDF (for sample counts too large to hold in memory).
+// Construction gathers the lobes (pndf.h, footprintLobes) and their running weight sums.
+// Not thread-safe (holds the generator state); use one sampler per thread.
+class PndfSampler {
+ public:
+  // Requires fp.sigma > 0 and sigma_r > 0 (aborts otherwise).
+  PndfSampler(const FlakeSet& set, const Footprint& fp, double sigma_r, uint64_t seed);
+  PndfSampler(PndfSampler&&) noexcept;
+  PndfSampler& operator=(PndfSampler&&) noexcept;
+  ~PndfSampler();
+
+  // False when no lobe has positive weight (a clamp footprint far outside the map): next() must
+  // not be called then.
+  bool valid() const;
+  size_t lobeCount() const;
+  // Sum of the lobe weights (footprintWeight): the sample density is evalPndf / totalWeight.
+  double totalWeight() const;
+  PndfSample next();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// `count` samples of the footprint's P-NDF (the first `count` of PndfSampler's stream), deterministic for a seed on every platform with IEEE
 // double arithmetic and the same libm: PCG32 (O'Neill 2014) random numbers, Box-Muller normals, no
 // std:: distributions. Requires fp.sigma > 0, sigma_r > 0 and at least one lobe with positive
 // weight (a footprint that sees flakes; returns an empty vector otherwise).

@@ -1,0 +1,123 @@
+// Roughness mips of a normal map: box-filtered unnormalised normals, |b| -> alpha_me -> alpha.
+#include <glintbake/bake/ltc/roughness.h>
+
+#include <OpenImageIO/imageio.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <unistd.h>
+
+namespace glintbake::bake::ltc {
+
+namespace {
+
+struct NormalLevel {
+  int width = 0, height = 0;
+  std::vector<double> b;  // 3 per texel, unnormalised averages
+};
+
+NormalLevel downsample(const NormalLevel& in) {
+  NormalLevel out;
+  out.width = (in.width + 1) / 2;
+  out.height = (in.height + 1) / 2;
+  out.b.assign(size_t(out.width) * size_t(out.height) * 3, 0.0);
+  tbb::parallel_for(0, out.height, [&](int y) {
+    for (int x = 0; x < out.width; ++x) {
+      double sum[3] = {0, 0, 0};
+      int count = 0;
+      for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+          const int sx = 2 * x + dx, sy = 2 * y + dy;
+          if (sx >= in.width || sy >= in.height) continue;
+          const double* p = &in.b[(size_t(sy) * size_t(in.width) + size_t(sx)) * 3];
+          sum[0] += p[0], sum[1] += p[1], sum[2] += p[2];
+          ++count;
+        }
+      }
+      double* q = &out.b[(size_t(y) * size_t(out.width) + size_t(x)) * 3];
+      for (int c = 0; c < 3; ++c) q[c] = sum[c] / count;
+    }
+  });
+  return out;
+}
+
+RoughnessLevel toRoughness(const NormalLevel& level, const RoughnessOptions& options) {
+  RoughnessLevel out;
+  out.width = level.width;
+  out.height = level.height;
+  const size_t n = size_t(level.width) * size_t(level.height);
+  out.alpha.resize(n);
+  out.mean_length.resize(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    const double* b = &level.b[i * 3];
+    const double length = std::min(1.0, std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]));
+    const double alpha_meso = options.exact_meso ? alphaMesoExact(length) : options.meso.eval(length);
+    out.mean_length[i] = float(length);
+    out.alpha[i] = float(options.combine.eval(options.alpha_micro, alpha_meso));
+  });
+  return out;
+}
+
+}  // namespace
+
+Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const RoughnessOptions& options) {
+  if (!(options.alpha_micro >= 0.0 && options.alpha_micro <= 1.0))
+    return makeError(ErrorCode::kBadArgument, "alpha-micro must be in [0, 1]");
+  if (map.width < 1 || map.height < 1 || map.normals.size() != size_t(map.width) * size_t(map.height) * 3)
+    return makeError(ErrorCode::kInvalidInput, "the normal map is empty or inconsistent");
+  NormalLevel level;
+  level.width = map.width;
+  level.height = map.height;
+  level.b.assign(map.normals.begin(), map.normals.end());
+  std::vector<RoughnessLevel> levels;
+  for (;;) {
+    levels.push_back(toRoughness(level, options));
+    if (level.width == 1 && level.height == 1) break;
+    level = downsample(level);
+  }
+  return levels;
+}
+
+Status writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path) {
+  if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no roughness levels to write");
+  static std::atomic<unsigned> counter{0};
+  char suffix[64];
+  std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%u", long(getpid()), counter.fetch_add(1));
+  const std::string tmp = path + suffix;
+  auto output = OIIO::ImageOutput::create("openexr");
+  if (!output) return makeError(ErrorCode::kIo, "cannot write " + path + ": no OpenEXR writer");
+  const bool mipmapped = levels.size() > 1;
+  if (mipmapped && !output->supports("mipmap"))
+    return makeError(ErrorCode::kUnsupported, "the EXR writer does not support mipmaps");
+  auto fail = [&](const std::string& what) -> Status {
+    output->close();
+    std::remove(tmp.c_str());
+    return makeError(ErrorCode::kIo, "cannot write " + path + ": " + what);
+  };
+  for (size_t i = 0; i < levels.size(); ++i) {
+    OIIO::ImageSpec spec(levels[i].width, levels[i].height, 1, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"alpha"};
+    spec.alpha_channel = -1;
+    spec.attribute("compression", "zip");
+    if (mipmapped) {
+      // OpenEXR stores mip levels in tiled files; levels round up (ceil(w / 2^l)) like ours.
+      spec.tile_width = 64;
+      spec.tile_height = 64;
+      spec.attribute("openexr:levelmode", 1);     // MIPMAP_LEVELS
+      spec.attribute("openexr:roundingmode", 1);  // ROUND_UP
+    }
+    const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel;
+    if (!output->open(tmp, spec, mode)) return fail(output->geterror());
+    if (!output->write_image(OIIO::TypeDesc::FLOAT, levels[i].alpha.data())) return fail(output->geterror());
+  }
+  if (!output->close()) return fail(output->geterror());
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return makeError(ErrorCode::kIo, "cannot write " + path + ": rename failed");
+  }
+  return okStatus();
+}
+
+}  // namespace glintbake::bake::ltc

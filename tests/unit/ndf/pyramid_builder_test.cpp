@@ -1,0 +1,146 @@
+// The streamed pyramid: geometry, section layout, determinism across thread counts.
+#include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/ndf_pyramid.h>
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace glintbake::bake::ndf {
+namespace {
+
+std::string tempPath(const std::string& name) {
+  return std::string(::testing::TempDir()) + "/ndf_builder_" + name + ".gbk";
+}
+
+std::vector<char> readAll(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::vector<char>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+Status buildTo(const NormalMap& map, const PyramidOptions& o, const std::string& path, PyramidReport* rep) {
+  format::Writer w;
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
+  Status s = buildNdfPyramid(map, o, w, rep);
+  if (!s) return s;
+  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
+  EXPECT_EQ(w.finish(), format::Status::kOk);
+  return s;
+}
+
+PyramidOptions smallOptions() {
+  PyramidOptions o;
+  o.splat.ndf_res = 32;
+  o.stride0 = 8;
+  o.sigma0 = 4;
+  o.region_size = 3;  // several regions, partial ones at the edges
+  return o;
+}
+
+TEST(PyramidGeometry, GridsCoverTheMapAndNest) {
+  PyramidOptions o;
+  o.stride0 = 16;
+  LevelGeometry g0 = levelGeometry(1024, 512, o, 0), g2 = levelGeometry(1024, 512, o, 2);
+  EXPECT_EQ(g0.grid_width, 64);
+  EXPECT_EQ(g0.grid_height, 32);
+  EXPECT_DOUBLE_EQ(g0.stride_x, 16.0);
+  EXPECT_EQ(g2.grid_width, 16);
+  EXPECT_DOUBLE_EQ(g2.sigma, o.sigma0 * 4);
+  // A map that is not a multiple of the stride: the stride stretches so the grid stays periodic.
+  LevelGeometry odd = levelGeometry(100, 100, o, 0);
+  EXPECT_EQ(odd.grid_width, 6);
+  EXPECT_DOUBLE_EQ(odd.stride_x * odd.grid_width, 100.0);
+  EXPECT_EQ(levelGeometry(100, 100, o, 10).grid_width, 1);
+}
+
+TEST(PyramidBuilder, RejectsBadOptions) {
+  PyramidOptions o = smallOptions();
+  o.stride0 = 0;
+  EXPECT_FALSE(validatePyramidOptions(o).ok());
+  o = smallOptions();
+  o.splat.ndf_res = 1;
+  EXPECT_FALSE(validatePyramidOptions(o).ok());
+  o = smallOptions();
+  o.converge_mse = -1;
+  EXPECT_FALSE(validatePyramidOptions(o).ok());
+}
+
+TEST(PyramidBuilder, WritesLevelsAndChunksThatMatchTheSplat) {
+  MapParams mp;
+  mp.size = 40;
+  const NormalMap map = generateMap(MapKind::kBeckmann, mp);
+  PyramidOptions o = smallOptions();
+  o.levels = 3;
+  const std::string path = tempPath("layout");
+  PyramidReport rep;
+  ASSERT_TRUE(buildTo(map, o, path, &rep).ok());
+  ASSERT_EQ(rep.levels.size(), 3u);
+  EXPECT_EQ(rep.stop_reason, "levels");
+
+  format::Reader r;
+  ASSERT_EQ(r.open(path), format::Status::kOk);
+  EXPECT_EQ(r.kind(), format::AssetKind::kNdfPyramid);
+  for (int l = 0; l < 3; ++l) {
+    const int idx = r.find(format::kSectionNdfLevel, uint64_t(l));
+    ASSERT_GE(idx, 0);
+    std::vector<uint8_t> bytes;
+    ASSERT_EQ(r.readSection(size_t(idx), &bytes), format::Status::kOk);
+    ASSERT_EQ(bytes.size(), sizeof(runtime::NdfLevelRecord));
+    runtime::NdfLevelRecord rec;
+    std::memcpy(&rec, bytes.data(), sizeof(rec));
+    const LevelGeometry g = levelGeometry(40, 40, o, l);
+    EXPECT_EQ(int(rec.grid_width), g.grid_width);
+    EXPECT_DOUBLE_EQ(rec.sigma_texels, 4.0 * (1 << l));
+    EXPECT_DOUBLE_EQ(rec.origin_x, 0.5 * rec.stride_x);
+    EXPECT_EQ(int(rec.regions_x * rec.regions_y), g.regions_x * g.regions_y);
+  }
+  // Level 0 has 5x5 centres in 3x3-centre regions: region 3 = (rx 1, ry 1) holds centres 3..4 x 3..4.
+  const int idx = r.find(format::kSectionNdfChunk, uint64_t(3));
+  ASSERT_GE(idx, 0);
+  std::vector<uint8_t> chunk;
+  ASSERT_EQ(r.readSection(size_t(idx), &chunk), format::Status::kOk);
+  format::ImageSectionHeader h;
+  std::memcpy(&h, chunk.data(), sizeof(h));
+  EXPECT_EQ(h.magic, format::ImageSectionHeader().magic);
+  EXPECT_EQ(h.width, 32u);
+  EXPECT_EQ(h.layers, 4u);
+  // Layer 1 = centre (4, 3) at ((4 + 0.5) * 8, (3 + 0.5) * 8).
+  Result<FlakeSet> flakes = buildFlakes(map, 1);
+  ASSERT_TRUE(flakes.ok());
+  Splatter sp(flakes.value(), o.splat);
+  std::vector<float> expect(32 * 32), stored(32 * 32);
+  sp.image(36.0, 28.0, 4.0, expect.data());
+  std::memcpy(stored.data(), chunk.data() + sizeof(h) + 32 * 32 * 4, 32 * 32 * 4);
+  EXPECT_EQ(stored, expect);
+  std::remove(path.c_str());
+}
+
+TEST(PyramidBuilder, IdenticalBytesForEveryThreadCount) {
+  MapParams mp;
+  mp.size = 48;
+  const NormalMap map = generateMap(MapKind::kFlakes, mp);
+  PyramidOptions o = smallOptions();  // automatic level count
+  const std::string p1 = tempPath("j1"), p2 = tempPath("j2");
+  PyramidReport r1, r2;
+  tbb::task_arena one(1), two(2);
+  one.execute([&] { ASSERT_TRUE(buildTo(map, o, p1, &r1).ok()); });
+  two.execute([&] { ASSERT_TRUE(buildTo(map, o, p2, &r2).ok()); });
+  EXPECT_FALSE(r1.stop_reason.empty());
+  EXPECT_EQ(r1.levels.size(), r2.levels.size());
+  EXPECT_EQ(readAll(p1), readAll(p2));
+  std::printf("[ measured ] auto levels: %zu, stop %s, next-level MSE %.3g\n", r1.levels.size(),
+              r1.stop_reason.c_str(), r1.next_level_mse);
+  std::remove(p1.c_str());
+  std::remove(p2.c_str());
+}
+
+}  // namespace
+}  // namespace glintbake::bake::ndf

@@ -1,0 +1,75 @@
+// ltcfit subcommands: each registers its options on a CLI11 subcommand and runs when selected.
+#pragma once
+
+#include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/ltc/ltc.h>
+#include <glintbake/bake/ltc/table.h>
+#include <glintbake/bake/result.h>
+#include <glintbake/cli/tool.h>
+
+#include <string>
+
+namespace glintbake::ltcfit {
+
+struct TableArgs {
+  std::string brdf = "ggx";
+  int size = 64;
+  int samples = 32;
+  std::string method = "refined";
+  int columns = 0;
+  std::string output, exr_prefix, header;
+};
+
+struct EvalArgs {
+  std::string table1, table2;
+  std::string brdf = "ggx";
+  int samples = 128;
+  bool per_cell = false;
+};
+
+struct MultiscaleArgs {
+  std::string output;
+  int meso_points = 256;
+  int grid = 9;
+};
+
+struct RoughnessArgs {
+  std::string input, output, container;
+  double alpha_micro = 0.1;
+  bool exact_meso = false;
+  bake::IngestOptions ingest;
+};
+
+int runTable(cli::Tool& tool, const TableArgs& args);
+int runEval(cli::Tool& tool, const EvalArgs& args);
+int runMultiscale(cli::Tool& tool, const MultiscaleArgs& args);
+int runRoughness(cli::Tool& tool, const RoughnessArgs& args);
+
+// Throws cli::Error with the error's exit code if the result failed.
+template <typename T>
+T unwrap(bake::Result<T> result) {
+  if (!result.ok()) throw cli::Error(int(result.error().code), result.error().message);
+  return std::move(result).value();
+}
+inline void check(const bake::Status& status) {
+  if (!status.ok()) throw cli::Error(int(status.error().code), status.error().message);
+}
+
+// Writes an image section (format::ImageSectionHeader + floats) to a container writer.
+void addImageSection(class ContainerOutput& out, uint32_t type, uint64_t key, int width, int height, int channels,
+                     const float* data);
+
+// A container output that is removed unless finish() succeeds.
+class ContainerOutput {
+ public:
+  ContainerOutput(cli::Tool& tool, const std::string& path, uint32_t asset_kind);
+  ~ContainerOutput();
+  void addSection(uint32_t type, uint64_t key, const void* data, size_t size);
+  void finish(const cli::Json& metadata);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace glintbake::ltcfit
