@@ -267,7 +267,12 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   reader_options.max_raw_section_size = options.max_raw_section_size;
   detail::ParsedContainer parsed;
   report.status = detail::parseContainer(source, reader_options, &parsed, &collector);
-  if (parsed.sections.size() != parsed.header.section_count) return report;  // header unusable
+  // Header errors, or an index that fails its checksum, leave nothing trustworthy to look at.
+  const bool structure_unusable =
+      std::any_of(report.messages.begin(), report.messages.end(), [](const ValidationMessage& m) {
+        return m.severity == Severity::kError && (m.id < 3000 || m.id == 3001);
+      });
+  if (structure_unusable || parsed.sections.size() != parsed.header.section_count) return report;
 
   auto noteStatus = [&](Status status) {
     if (report.status == Status::kOk) report.status = status;

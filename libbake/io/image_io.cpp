@@ -117,7 +117,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
     }
   }
 
-  const std::string tmp = temporaryPath(path);
+  const std::string tmp = options.temporary_path.empty() ? temporaryPath(path) : options.temporary_path;
   if (!output->open(tmp, spec)) {
     std::string reason = oneLine(output->geterror());
     std::remove(tmp.c_str());
@@ -132,6 +132,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
     std::remove(tmp.c_str());
     return makeError(ErrorCode::kIo, path + ": write failed (" + reason + ")");
   }
+  if (!options.rename) return okStatus();
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     return makeError(ErrorCode::kIo, path + ": cannot rename the temporary file into place");

@@ -8,10 +8,13 @@
 #include <glintbake/format/container.h>
 
 #include <OpenImageIO/imageio.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -106,18 +109,20 @@ void heightsToNormals(const std::vector<float>& heights, double k, NormalMap* ma
     }
     return double(heights[size_t(y) * size_t(w) + size_t(x)]);
   };
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const double dhdx = 0.5 * (height_at(x + 1, y) - height_at(x - 1, y));
-      const double dhdy_up = 0.5 * (height_at(x, y - 1) - height_at(x, y + 1));
-      const double gx = -k * dhdx, gy = -k * dhdy_up;
-      const double inv = 1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
-      float* n = map->at(x, y);
-      n[0] = float(gx * inv);
-      n[1] = float(gy * inv);
-      n[2] = float(inv);
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      for (int x = 0; x < w; ++x) {
+        const double dhdx = 0.5 * (height_at(x + 1, y) - height_at(x - 1, y));
+        const double dhdy_up = 0.5 * (height_at(x, y - 1) - height_at(x, y + 1));
+        const double gx = -k * dhdx, gy = -k * dhdy_up;
+        const double inv = 1.0 / std::sqrt(gx * gx + gy * gy + 1.0);
+        float* n = map->at(x, y);
+        n[0] = float(gx * inv);
+        n[1] = float(gy * inv);
+        n[2] = float(inv);
+      }
     }
-  }
+  });
 }
 
 bool fileReadable(const std::string& path) {
@@ -132,6 +137,13 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   IngestReport* r = report != nullptr ? report : &local;
   *r = IngestReport{};
 
+  if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
+    return makeError(ErrorCode::kBadArgument, "height scale must be a finite value > 0");
+  }
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return makeError(ErrorCode::kIo, path + ": is a directory, not an image file");
+  }
   if (!fileReadable(path)) {
     return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
   }
@@ -159,6 +171,9 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   r->channels_in = spec.nchannels;
 
   const int width = spec.width, height = spec.height, channels = spec.nchannels;
+  if (spec.deep) {
+    return makeError(ErrorCode::kUnsupported, path + ": deep images are not supported");
+  }
   if (width <= 0 || height <= 0 || spec.depth > 1) {
     return makeError(ErrorCode::kInvalidInput, path + ": invalid image size " + std::to_string(width) + "x" +
                                                    std::to_string(height));

@@ -1,13 +1,11 @@
 // Roughness mips of a normal map: box-filtered unnormalised normals, |b| -> alpha_me -> alpha.
 #include <glintbake/bake/ltc/roughness.h>
 
-#include <OpenImageIO/imageio.h>
+#include "ltc/exr_writer.h"
+
 #include <tbb/parallel_for.h>
 
-#include <atomic>
 #include <cmath>
-#include <cstdio>
-#include <unistd.h>
 
 namespace glintbake::bake::ltc {
 
@@ -82,42 +80,10 @@ Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const Ro
 
 Status writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path) {
   if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no roughness levels to write");
-  static std::atomic<unsigned> counter{0};
-  char suffix[64];
-  std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%u", long(getpid()), counter.fetch_add(1));
-  const std::string tmp = path + suffix;
-  auto output = OIIO::ImageOutput::create("openexr");
-  if (!output) return makeError(ErrorCode::kIo, "cannot write " + path + ": no OpenEXR writer");
-  const bool mipmapped = levels.size() > 1;
-  if (mipmapped && !output->supports("mipmap"))
-    return makeError(ErrorCode::kUnsupported, "the EXR writer does not support mipmaps");
-  auto fail = [&](const std::string& what) -> Status {
-    output->close();
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, "cannot write " + path + ": " + what);
-  };
-  for (size_t i = 0; i < levels.size(); ++i) {
-    OIIO::ImageSpec spec(levels[i].width, levels[i].height, 1, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = {"alpha"};
-    spec.alpha_channel = -1;
-    spec.attribute("compression", "zip");
-    if (mipmapped) {
-      // OpenEXR stores mip levels in tiled files; levels round up (ceil(w / 2^l)) like ours.
-      spec.tile_width = 64;
-      spec.tile_height = 64;
-      spec.attribute("openexr:levelmode", 1);     // MIPMAP_LEVELS
-      spec.attribute("openexr:roundingmode", 1);  // ROUND_UP
-    }
-    const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel;
-    if (!output->open(tmp, spec, mode)) return fail(output->geterror());
-    if (!output->write_image(OIIO::TypeDesc::FLOAT, levels[i].alpha.data())) return fail(output->geterror());
-  }
-  if (!output->close()) return fail(output->geterror());
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, "cannot write " + path + ": rename failed");
-  }
-  return okStatus();
+  std::vector<ExrLevel> images;
+  for (const auto& level : levels) images.push_back({level.width, level.height, level.alpha.data()});
+  if (images.size() == 1) return writeExr(path, {"Y"}, images[0]);
+  return writeMipmappedExr(path, "Y", images);
 }
 
 }  // namespace glintbake::bake::ltc

@@ -1,10 +1,12 @@
 // Published-layout LTC tables as image files.
-#include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/ltc/table.h>
+
+#include "ltc/exr_writer.h"
 
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace glintbake::bake::ltc {
 
@@ -41,9 +43,12 @@ Result<std::vector<float>> readRgba(const std::string& path, int* size) {
 }  // namespace
 
 Status writePublishedExr(const PublishedTable& table, const std::string& prefix) {
-  Status status = writeImage(prefix + "_1.exr", table.size, table.size, 4, table.ltc1.data());
+  const std::vector<std::string> rgba = {"R", "G", "B", "A"};
+  Status status = writeExr(prefix + "_1.exr", rgba, {table.size, table.size, table.ltc1.data()});
   if (!status.ok()) return status;
-  return writeImage(prefix + "_2.exr", table.size, table.size, 4, table.ltc2.data());
+  status = writeExr(prefix + "_2.exr", rgba, {table.size, table.size, table.ltc2.data()});
+  if (!status.ok()) std::remove((prefix + "_1.exr").c_str());
+  return status;
 }
 
 Result<PublishedTable> readPublishedImages(const std::string& path1, const std::string& path2) {

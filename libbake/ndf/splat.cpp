@@ -121,8 +121,8 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
     const double a0 = std::max(lo, -1.0 + k * h);
     const double a1 = std::min(hi, -1.0 + (k + 1) * h);
     if (a1 <= a0) continue;
-    // Sub-intervals keep the conditional mean's drift across each below half a conditional std.
-    int subs = int(std::ceil(std::abs(slope) * (a1 - a0) / (0.5 * cond_sd)));
+    // Sub-intervals keep the conditional mean's drift across each below one conditional std.
+    int subs = int(std::ceil(std::abs(slope) * (a1 - a0) / cond_sd));
     subs = std::clamp(subs, 1, kMaxSubIntervals);
     const double da = (a1 - a0) / subs;
     double z_prev = (a0 - mean_a) * inv_sd_a;

@@ -10,11 +10,12 @@ KINDS = ["flat", "beckmann", "brushed", "scratches", "flakes"]
 
 
 class Mapgen(ToolTestCase):
-    def test_every_kind_writes_exr_and_png(self):
+    def test_every_kind_writes_png(self):
+        # (EXR output of every kind is covered by the --json test.)
         for kind in KINDS:
-            for ext in ("exr", "png"):
-                out = self.mapgen(kind, f"{kind}.{ext}", "--size", "32", "--seed", "3")
-                self.assertGreater(os.path.getsize(out), 0, out)
+            out = self.mapgen(kind, f"{kind}.png", "--size", "32", "--seed", "3")
+            with open(out, "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", out)
         self.assertEqual(sorted(f for f in os.listdir(self.tmp) if ".tmp" in f), [])
 
     def test_json_matches_schema_and_statistics(self):
@@ -36,13 +37,13 @@ class Mapgen(ToolTestCase):
             self.assertAlmostEqual(s, 0.4 / 2 ** 0.5, delta=0.15 * 0.4 / 2 ** 0.5)
 
     def test_reproducible_bytes(self):
-        for kind in KINDS:
-            for ext in ("exr", "png"):
-                a = self.mapgen(kind, f"a-{kind}.{ext}", "--size", "48", "--seed", "11", "-j", "1")
-                b = self.mapgen(kind, f"b-{kind}.{ext}", "--size", "48", "--seed", "11", "-j", "2")
-                c = self.mapgen(kind, f"c-{kind}.{ext}", "--size", "48", "--seed", "11")
-                self.assertEqual(clitest.file_hash(a), clitest.file_hash(b), f"{kind}.{ext}: -j1 vs -j2")
-                self.assertEqual(clitest.file_hash(a), clitest.file_hash(c), f"{kind}.{ext}: two runs")
+        # Two runs with different thread counts must agree byte for byte (each tool start costs
+        # about half a second, so every kind is checked in EXR and two kinds also in PNG).
+        outputs = [(kind, "exr") for kind in KINDS] + [("beckmann", "png"), ("flakes", "png")]
+        for kind, ext in outputs:
+            a = self.mapgen(kind, f"a-{kind}.{ext}", "--size", "48", "--seed", "11", "-j", "1")
+            b = self.mapgen(kind, f"b-{kind}.{ext}", "--size", "48", "--seed", "11", "-j", "2")
+            self.assertEqual(clitest.file_hash(a), clitest.file_hash(b), f"{kind}.{ext}: -j1 vs -j2")
         d = self.mapgen("beckmann", "d.exr", "--size", "48", "--seed", "12")
         self.assertNotEqual(clitest.file_hash(self.path("a-beckmann.exr")), clitest.file_hash(d))
 
@@ -52,7 +53,6 @@ class Mapgen(ToolTestCase):
             ("bogus", "-o", out),
             ("flat", "-o", out, "--size", "0"),
             ("flat", "-o", out, "--size", "20000"),
-            ("flat", "-o", out, "--size", "-3"),
             ("flat", "-o", out, "--size", "64", "--max-size", "32"),
             ("beckmann", "-o", out, "--alpha", "-1"),
             ("brushed", "-o", out, "--alpha-x", "0"),
@@ -65,8 +65,8 @@ class Mapgen(ToolTestCase):
         for args in cases:
             err = self.assert_fails(clitest.BAD_ARGS, "mapgen", *args, outputs=[out, self.path("x.png")])
             self.assertTrue(err.startswith("mapgen: error: "), err)
-        err = self.assert_fails(clitest.BAD_ARGS, "mapgen", "bogus", "-o", out)
-        self.assertIn("beckmann", err)
+            if args[0] == "bogus":
+                self.assertIn("beckmann", err)  # the error lists the valid kinds
 
     def test_unwritable_output_is_io_error(self):
         missing = self.path("no/such/dir/out.exr")

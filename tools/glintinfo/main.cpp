@@ -7,7 +7,7 @@ int main(int argc, char** argv) {
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();
-  app.require_subcommand(1);
+  app.require_subcommand(0, 1);
 
   glintinfo::InfoOptions info;
   glintinfo::ValidateOptions validate;
@@ -23,6 +23,6 @@ int main(int argc, char** argv) {
     if (validate_cmd->parsed()) return glintinfo::runValidate(t, validate);
     if (diff_cmd->parsed()) return glintinfo::runDiff(t, diff);
     if (export_cmd->parsed()) return glintinfo::runExport(t, exported);
-    throw cli::Error(cli::kExitBadArguments, "no command given");
+    throw cli::Error(cli::kExitBadArguments, "no command given: use info, validate, diff or export (see --help)");
   });
 }

@@ -104,6 +104,11 @@ TEST_F(Corruption, NotAContainer) {
                            "..................................................";
   Reader reader;
   EXPECT_EQ(reader.openMemory(text.data(), text.size()), Status::kBadMagic);
+  // The validator says exactly that, and nothing about sections or metadata it cannot see.
+  const ValidationReport not_container = validate(text.data(), text.size());
+  ASSERT_EQ(not_container.messages.size(), 1u);
+  EXPECT_EQ(not_container.messages[0].id, 2002);
+  EXPECT_EQ(not_container.status, Status::kBadMagic);
   EXPECT_EQ(reader.openMemory(nullptr, 0), Status::kTruncated);
   EXPECT_EQ(reader.open(dir_.path("absent.gbk")), Status::kIoError);
   EXPECT_EQ(reader.open(dir_.path("")), Status::kIoError);  // a directory
@@ -186,6 +191,7 @@ TEST_F(Corruption, NewerMajorRefused) {
   EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kUnsupportedVersion);
   const ValidationReport report = validate(bad.data(), bad.size());
   EXPECT_EQ(report.status, Status::kUnsupportedVersion);
+  ASSERT_EQ(report.messages.size(), 1u);
   EXPECT_EQ(report.messages.at(0).id, 2003);
 }
 

@@ -122,6 +122,18 @@ TEST(ImageIo, OverwritesAtomicallyAndLeavesNoTemporary) {
   EXPECT_NEAR(back[0], 0.25f, 1e-4);
 }
 
+TEST(ImageIo, CallerChosenTemporaryWithoutRename) {
+  ScratchDir dir;
+  std::vector<float> px = ramp(4, 4, 3);
+  ImageWriteOptions options;
+  options.temporary_path = dir.file("staging.tmp-1");
+  options.rename = false;
+  ASSERT_TRUE(writeImage(dir.file("final.exr"), 4, 4, 3, px.data(), options).ok());
+  // The format follows the final name even though the bytes went to the staging name.
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"staging.tmp-1"});
+  EXPECT_EQ(test::readBytes(dir.file("staging.tmp-1")).substr(0, 4), std::string("\x76\x2f\x31\x01"));
+}
+
 TEST(ImageIo, FailuresLeaveNothing) {
   ScratchDir dir;
   std::vector<float> px = ramp(4, 4, 3);

@@ -205,6 +205,23 @@ TEST(Ingest, HeightFieldPlaneGivesKnownNormal) {
   // A tilted plane must tilt its normal away from the rising direction: h grows to the right, so
   // the normal leans left (n_x < 0).
   EXPECT_LT(map.value().at(5, 5)[0], 0.0f);
+
+  // Clamp at the left edge: dh/dx = (h[1] - h[0]) / 2. Repeat: (h[1] - h[W-1]) / 2.
+  auto edge_nx = [&](double dhdx, double dhdy_up) {
+    const double ex = -k * dhdx, ey = -k * dhdy_up;
+    return ex / std::sqrt(ex * ex + ey * ey + 1.0);
+  };
+  EXPECT_NEAR(map.value().at(0, 5)[0], edge_nx(0.5 * a, -b), 1e-5);
+  options.wrap = Wrap::kRepeat;
+  auto wrapped = load(path, nullptr, options);
+  ASSERT_TRUE(wrapped.ok());
+  EXPECT_NEAR(wrapped.value().at(0, 5)[0], edge_nx(0.5 * (a - a * (kW - 1)), -b), 1e-5);
+  EXPECT_NEAR(wrapped.value().at(5, 5)[0], map.value().at(5, 5)[0], 1e-6);
+
+  options.height_scale = 0.0;
+  auto bad_scale = load(path, nullptr, options);
+  ASSERT_FALSE(bad_scale.ok());
+  EXPECT_EQ(bad_scale.error().code, ErrorCode::kBadArgument);
 }
 
 TEST(Ingest, SingleChannelNeedsHeightFlag) {
@@ -429,6 +446,11 @@ TEST(Ingest, MissingFileIsIoError) {
   ASSERT_FALSE(map.ok());
   EXPECT_EQ(map.error().code, ErrorCode::kIo);
   expectOneLineNaming(map.error(), "absent.exr");
+  std::filesystem::create_directories(dir.file("folder.png"));
+  auto folder = load(dir.file("folder.png"), nullptr);
+  ASSERT_FALSE(folder.ok());
+  EXPECT_EQ(folder.error().code, ErrorCode::kIo);
+  expectOneLineNaming(folder.error(), "folder.png");
 }
 
 TEST(Ingest, ContentHashFollowsBytes) {

@@ -13,6 +13,13 @@ struct ImageWriteOptions {
   // formats (EXR) always store float32 (or half if half_float).
   int png_bits = 16;
   bool half_float = false;
+  // Where the bytes are written before they become `path`. Empty: "<path>.tmp-<pid>-<n>" in the
+  // same directory. Tools pass a name they registered for removal on SIGINT/SIGTERM
+  // (cli::AtomicOutput), usually together with rename = false.
+  std::string temporary_path;
+  // true: rename the temporary file to `path` when complete. false: leave the complete file at
+  // temporary_path for the caller to move into place (it is still removed on failure).
+  bool rename = true;
 };
 
 // Writes width x height x channels float32 pixels (row-major, top row first) to path; the format

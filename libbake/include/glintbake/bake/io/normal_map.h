@@ -26,8 +26,11 @@ const char* wrapString(Wrap w);          // "repeat", "clamp"
 struct IngestOptions {
   Encoding encoding = Encoding::kAuto;
   bool flip_green = false;     // negate n_y after decoding (DirectX maps)
-  bool height = false;         // input is a height field (first channel), normals by central differences
-  double height_scale = 1.0;   // height units per texel (slope = height_scale * dh/dtexel)
+  // Height field input (first channel, as read: integer files in [0, 1]): normals by central
+  // differences with the wrap mode, n = normalize(-k dh/dx, -k dh/dy, 1), where
+  // dh/dx = (h[c+1] - h[c-1]) / 2 and dh/dy = (h[r-1] - h[r+1]) / 2 (y up = towards row 0).
+  bool height = false;
+  double height_scale = 1.0;   // k: slope = height_scale * dh/dtexel, > 0
   Wrap wrap = Wrap::kRepeat;   // how the map continues beyond its edges
   int part = 0;                // subimage/part of multi-part files (EXR)
   bool fix_nonfinite = false;  // replace NaN/Inf texels by (0,0,1) instead of failing
@@ -50,7 +53,8 @@ struct IngestReport {
 };
 
 // A map of unit normals, upper hemisphere (n_z >= 0). Texels with n_z <= 0 keep their projected
-// direction (n_x, n_y) and are moved onto the horizon side of the hemisphere: see ingest.cpp.
+// direction (n_x, n_y) and are moved onto the horizon (n_z = 0, |s| = 1); a zero vector becomes
+// (0, 0, 1): see normaliseNormals. Plain data: concurrent reads are safe.
 struct NormalMap {
   int width = 0;
   int height = 0;
@@ -59,11 +63,27 @@ struct NormalMap {
 
   const float* at(int x, int y) const { return &normals[(size_t(y) * size_t(width) + size_t(x)) * 3]; }
   float* at(int x, int y) { return &normals[(size_t(y) * size_t(width) + size_t(x)) * 3]; }
-  // Texel fetch with the map's wrap mode applied to out-of-range coordinates.
+  // Texel fetch with the map's wrap mode applied to any int coordinates (repeat: positive
+  // modulo; clamp: nearest edge texel). Requires a non-empty map.
   const float* fetch(int x, int y) const;
 };
 
-// Reads a normal map (or height field) file. Never throws; errors name the file by the path given.
+// Reads a normal map (or height field) file. Never throws; errors name the file by the path given,
+// on one line, with OIIO's reason where it has one:
+//   kIo           the file is missing or unreadable;
+//   kInvalidInput not a decodable image, corrupt or truncated data, a size of 0 or above
+//                 options.max_size (width or height), an unsupported channel count (2, 3, 4 are
+//                 accepted, 1 only with options.height; alpha is ignored), NaN/Inf values without
+//                 options.fix_nonfinite (the message gives the count and the first texel);
+//   kBadArgument  options.part is negative or beyond the file's parts;
+//   kRuntime      out of memory.
+// Channels read as float through OIIO: integer files decode as n = 2 c / max - 1; float files
+// follow options.encoding (auto: signed if any value is negative). Height fields: see
+// IngestOptions::height. Safe on untrusted files as far as OIIO's decoders are (sizes are
+// checked against max_size before any allocation). Decoder messages that libraries print on
+// stderr are discarded while reading (the process-wide stderr is redirected briefly), so tools keep
+// their one-line errors. Thread-safe for distinct calls, but that redirection is process-wide.
+// `report` may be null; it is filled as far as reading got, also on failure.
 Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report);
 
 // Builds a normal map from raw decoded channel data (for tests and generated maps): `channels` = 2,
@@ -71,7 +91,11 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
 Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const float* data,
                                       const IngestOptions& options, IngestReport* report);
 
-// Renormalises in place, repairs n_z <= 0, counts (used by both entry points above).
+// Renormalises in place, repairs n_z <= 0, counts (used by both entry points above). Non-finite
+// texels are an error (kInvalidInput, message with count and first texel) unless
+// options.fix_nonfinite, which sets them to (0, 0, 1). Fills texels, far_from_unit, nz_nonpositive,
+// nonfinite and mean_length (over finite texels, before renormalisation) of `report` (may be null).
+// Multithreaded (TBB); results and counts do not depend on the thread count.
 Status normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report);
 
 }  // namespace glintbake::bake

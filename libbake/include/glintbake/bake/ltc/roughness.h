@@ -31,7 +31,8 @@ struct RoughnessLevel {
 // 1 x 1. Thread-safe; levels are computed in parallel, bit-identically for any thread count.
 Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const RoughnessOptions& options);
 
-// Writes the levels as one mipmapped single-channel float EXR ("alpha"), atomically.
+// Writes the levels as one tiled, mipmapped single-channel float EXR (channel "Y"), atomically and
+// byte-reproducibly (no capture date).
 Status writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path);
 
 }  // namespace glintbake::bake::ltc

@@ -1,0 +1,119 @@
+// CP (CANDECOMP/PARAFAC) compression of groups of angular NDF blocks (Deng et al. 2022, "Constant-
+// Cost Spatially-Varying Glints", sec. 4; algorithms after Kolda & Bader 2009, "Tensor
+// Decompositions and Applications", sec. 3.4).
+//
+// A group tensor T is B x B x K: K angular blocks of B x B bins each (bin column i, row j, block k).
+// A rank-R CP model approximates it by
+//     T(i, j, k) ~ sum_r A(i, r) B(j, r) C(k, r),
+// with the column scales (lambda) folded into C, so that A and B have unit-norm columns.
+//
+// Methods (CpMethod):
+//   kCompressed (default, "compressed"): deterministic HOSVD start; the mode-3 fibres are compressed
+//     onto a K x L orthonormal basis found by a seeded randomised range finder (Halko et al. 2011,
+//     alg. 4.4 with one power iteration); ALS with extrapolation runs on the small B x B x L core;
+//     the result is expanded and refined by at most `refine_sweeps` full extrapolated sweeps.
+//   kAls ("als"): deterministic HOSVD start and full-tensor sweeps with extrapolation.
+//   kAlsPlain ("als-plain"): the published method: seeded uniform random start, plain ALS sweeps,
+//     stop when the fit changes by less than `tol` or after `max_iters` sweeps.
+// Every sweep uses the dimension tree of algorithms.md sec. 2: W = C^T X once, A and B from W,
+// C from X (B kr A): the tensor is read twice per sweep. The R x R normal equations are solved by
+// Cholesky with a ridge of `ridge` * trace / R; Gram matrices and the error are accumulated in
+// double (error^2 = |X|^2 - 2 <M_C, C> + 1^T (A^T A .* B^T B .* C^T C) 1).
+// Extrapolation is Nesterov-style momentum with restart (Mitchell et al. 2018, "Nesterov
+// Acceleration of Alternating Least Squares for Canonical Tensor Decomposition"): a sweep starts
+// from the extrapolated factors; if its error is not lower, the momentum is dropped and the sweep
+// is redone from the last accepted factors.
+//
+// nonneg = true replaces the least-squares updates by HALS column updates (Cichocki & Phan 2009)
+// projected onto A, B, C >= 0, on full sweeps from a non-negative start (|HOSVD| for kCompressed
+// and kAls, uniform random for kAlsPlain); the range finder is not used (its core is not
+// non-negative). Every reconstructed value and every range sum is then >= 0.
+//
+// Determinism: results depend only on the tensor and the options (seeded generators, fixed
+// summation order, no threading inside one decomposition): identical bytes on every run and for
+// any thread count of decomposeCpBatch.
+// Thread safety: all functions are reentrant; decomposeCpBatch uses TBB internally.
+// Untrusted input: non-finite values and inconsistent sizes are rejected with kInvalidInput.
+#pragma once
+
+#include <glintbake/bake/result.h>
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace glintbake::bake::tensor {
+
+constexpr int kMaxCpRank = 64;        // largest supported rank (the runtime's limit too)
+constexpr int kMaxBlockBins = 256;    // largest block side B
+
+// K blocks of B x B bins: bin (i, j) of block k is values[(k * B + j) * B + i] (row-major images,
+// row j = 0 at the top, like NDF images). Values are NDF densities (any non-negative scale works;
+// negative values are allowed but unusual).
+struct GroupTensor {
+  int bins = 32;   // B, [1, kMaxBlockBins]
+  int blocks = 0;  // K, >= 1
+  std::vector<float> values;  // blocks * bins * bins
+
+  float at(int k, int i, int j) const { return values[(static_cast<size_t>(k) * bins + j) * bins + i]; }
+};
+
+enum class CpMethod { kCompressed, kAls, kAlsPlain };
+
+// "compressed", "als", "als-plain".
+const char* cpMethodName(CpMethod method);
+std::optional<CpMethod> parseCpMethod(std::string_view name);
+
+struct CpOptions {
+  int rank = 16;                      // R, [1, kMaxCpRank]
+  CpMethod method = CpMethod::kCompressed;
+  bool nonneg = false;                // non-negative factors (HALS)
+  int max_iters = 500;                // sweeps of the main ALS loop, >= 1
+  double tol = 1e-5;                  // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
+  double ridge = 1e-7;                // relative Tikhonov term of the normal equations, [0, 1)
+  int compressed_basis = 64;          // L of kCompressed (ignored when K <= L), [1, 4096]
+  int refine_sweeps = 10;             // full sweeps after expanding the compressed solution, >= 0
+  bool extrapolate = true;            // momentum with restart (kCompressed and kAls)
+  uint64_t seed = 0x243F6A8885A308D3ull;  // seeds the range finder and the random start
+};
+
+// Validates ranges (kBadArgument naming the option).
+Status validateCpOptions(const CpOptions& options);
+
+// A rank-R model of one group. Matrices are row-major: A(i, r) = a[i * rank + r] (bins x rank),
+// B(j, r) = b[j * rank + r], C(k, r) = c[k * rank + r] (blocks x rank, lambda folded in).
+struct CpFactors {
+  int bins = 0;
+  int blocks = 0;
+  int rank = 0;
+  std::vector<float> a, b, c;
+  double relative_error = 0.0;  // |T - model|_F / |T|_F from the Gram identity (0 for T = 0)
+  int sweeps = 0;               // full-tensor sweeps performed (core sweeps not counted)
+  int core_sweeps = 0;          // sweeps on the compressed core (kCompressed)
+
+  // Model value at bin (i, j) of block k (float products, double sum).
+  float value(int k, int i, int j) const;
+};
+
+// Decomposes one group tensor at options.rank. Errors: kBadArgument (options), kInvalidInput
+// (sizes or non-finite values). Cost: about 4 B^2 K R flops per full sweep.
+Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& options);
+
+// Error-target mode: the smallest rank in [1, options.rank] whose relative error is <= target
+// (binary search over ranks; each candidate rank is decomposed with the same options, so the result
+// equals decomposeCp at that rank). When no rank meets the target, the options.rank result.
+// target_error in [0, 1].
+Result<CpFactors> decomposeCpToError(const GroupTensor& tensor, const CpOptions& options, double target_error);
+
+// Decomposes many tensors in parallel (one tensor per task, TBB, `threads` workers, 0 = all
+// cores). target_error < 0: fixed rank; otherwise error-target mode. Output i belongs to input i
+// and is identical whatever the thread count.
+std::vector<Result<CpFactors>> decomposeCpBatch(const std::vector<GroupTensor>& tensors, const CpOptions& options,
+                                                int threads, double target_error = -1.0);
+
+// Explicit relative reconstruction error |T - model|_F / |T|_F, accumulated in double (a check of
+// relative_error; costs B^2 K R).
+double cpReconstructionError(const GroupTensor& tensor, const CpFactors& factors);
+
+}  // namespace glintbake::bake::tensor

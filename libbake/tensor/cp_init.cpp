@@ -1,0 +1,93 @@
+// Deterministic starts (HOSVD, seeded random) and the randomised mode-3 range finder.
+#include "cp_init.h"
+
+#include "random.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+
+#include <cmath>
+
+namespace glintbake::bake::tensor {
+
+namespace {
+
+// Columns of the `rank` leading eigenvectors of a symmetric B x B matrix, largest first, with the
+// largest-magnitude entry of each made positive; extra columns are seeded Gaussian.
+MatF leadingVectors(const MatD& gram_matrix, int rank, SplitMix64& rng, bool nonneg) {
+  const Eigen::Index n = gram_matrix.rows();
+  Eigen::SelfAdjointEigenSolver<MatD> solver(gram_matrix);
+  MatF out(n, rank);
+  for (int r = 0; r < rank; ++r) {
+    Eigen::VectorXd v(n);
+    if (r < n && solver.info() == Eigen::Success) {
+      v = solver.eigenvectors().col(n - 1 - r);
+      Eigen::Index arg = 0;
+      v.cwiseAbs().maxCoeff(&arg);
+      if (v[arg] < 0.0) v = -v;
+    } else {
+      for (Eigen::Index i = 0; i < n; ++i) v[i] = rng.normal();
+      v.normalize();
+    }
+    if (nonneg) v = v.cwiseAbs();
+    out.col(r) = v.cast<float>();
+  }
+  return out;
+}
+
+}  // namespace
+
+void hosvdStart(const float* x, int bins, int blocks, int rank, uint64_t seed, bool nonneg, CpState& state) {
+  SplitMix64 rng(seed ^ 0x5851F42D4C957F2Dull);
+  const Eigen::Index n = bins;
+  // Mode 1: bins i are the rows of the B x (B K) column-major view of the data.
+  Eigen::Map<const MatF> unfold1(x, n, n * blocks);
+  MatF g1(n, n);
+  g1.noalias() = unfold1 * unfold1.transpose();
+  // Mode 2: sum over blocks of M_k^T M_k, M_k(i, j) the block as a B x B column-major matrix.
+  MatF g2 = MatF::Zero(n, n);
+  for (int k = 0; k < blocks; ++k) {
+    Eigen::Map<const MatF> mk(x + static_cast<size_t>(k) * n * n, n, n);
+    g2.noalias() += mk.transpose() * mk;
+  }
+  state.a = leadingVectors(g1.cast<double>(), rank, rng, nonneg);
+  state.b = leadingVectors(g2.cast<double>(), rank, rng, nonneg);
+  state.c = MatF::Zero(blocks, rank);
+}
+
+void randomStart(int bins, int blocks, int rank, uint64_t seed, CpState& state) {
+  SplitMix64 rng(seed);
+  auto fill = [&rng](MatF& m, Eigen::Index rows, int cols) {
+    m.resize(rows, cols);
+    for (int c = 0; c < cols; ++c) {
+      for (Eigen::Index r = 0; r < rows; ++r) m(r, c) = static_cast<float>(rng.uniform());
+    }
+  };
+  fill(state.a, bins, rank);
+  fill(state.b, bins, rank);
+  fill(state.c, blocks, rank);
+}
+
+MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed) {
+  const Eigen::Index n = static_cast<Eigen::Index>(bins) * bins;
+  Eigen::Map<const MatF> xt(x, n, blocks);  // X^T, (B*B) x K
+  SplitMix64 rng(seed ^ 0x2545F4914F6CDD1Dull);
+  MatF omega(n, basis);
+  for (int c = 0; c < basis; ++c) {
+    for (Eigen::Index r = 0; r < n; ++r) omega(r, c) = static_cast<float>(rng.normal());
+  }
+  auto orthonormalise = [blocks, basis](const MatF& y) {
+    Eigen::HouseholderQR<MatF> qr(y);
+    MatF q = qr.householderQ() * MatF::Identity(blocks, basis);
+    return q;
+  };
+  MatF y(blocks, basis);
+  y.noalias() = xt.transpose() * omega;
+  MatF q = orthonormalise(y);
+  MatF z(n, basis);
+  z.noalias() = xt * q;
+  y.noalias() = xt.transpose() * z;
+  return orthonormalise(y);
+}
+
+}  // namespace glintbake::bake::tensor

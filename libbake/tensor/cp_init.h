@@ -1,0 +1,21 @@
+// Starting points of the CP decompositions and the mode-3 range finder (private to libbake/tensor).
+#pragma once
+
+#include "cp_engine.h"
+
+namespace glintbake::bake::tensor {
+
+// Leading left singular vectors of the mode-1 and mode-2 unfoldings (HOSVD, De Lathauwer et al.
+// 2000), from the B x B Gram matrices in double; each vector's largest entry is made positive.
+// Ranks above B are filled with seeded Gaussian columns. x: K x (B*B) row-major.
+// nonneg: absolute values of the vectors (a non-negative start for HALS).
+void hosvdStart(const float* x, int bins, int blocks, int rank, uint64_t seed, bool nonneg, CpState& state);
+
+// Seeded uniform [0, 1) entries in A, B and C (the published random start).
+void randomStart(int bins, int blocks, int rank, uint64_t seed, CpState& state);
+
+// Orthonormal K x L basis of the mode-3 fibres' range: a seeded Gaussian sketch with one power
+// iteration and QR re-orthonormalisation (Halko, Martinsson & Tropp 2011, alg. 4.4).
+MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed);
+
+}  // namespace glintbake::bake::tensor

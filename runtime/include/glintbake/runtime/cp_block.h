@@ -1,0 +1,123 @@
+// Constant-cost queries on CP-compressed angular NDF blocks (Deng et al. 2022, "Constant-Cost
+// Spatially-Varying Glints", sec. 4.3), the core that the tensor-ndf asset wraps.
+//
+// A group holds K blocks of B x B bins as a rank-R CP model (bake/tensor/cp_decomposition.h):
+//     value(k, i, j) = sum_r A(i, r) B(j, r) C(k, r)        (bin column i, row j, block k)
+// plus per-block 1D summed-area tables of the columns of A and B, so that the sum over any
+// rectangle of bins is a rank-R product of two prefix-sum differences: O(R) whatever its size.
+//
+// The asset-level runtime blends up to kCpMaxBlend weighted blocks (trilinear interpolation over
+// footprint centres and pyramid levels); every query here acts on such a blend, CpMix. Blocks of
+// the same group share A and B, so their C rows are summed first (weights applied): a blend of
+// 8 blocks from 2 groups costs 2 rank-R products per query.
+//
+// Non-negativity and consistency. CP models of non-negative data may dip below zero (plain ALS).
+// The queries are defined on the clamped model so that every returned density is >= 0:
+//   value(i, j)       = max(0, raw value)
+//   rangeAverage(...) = max(0, raw range sum) / bin count
+//   sample / pdf      : a quadtree descent whose children are weighted by max(0, raw range sum);
+//                       pdf(i, j) is the product of the child probabilities along the path to (i, j)
+//                       and sample() returns exactly that number for the bin it lands in.
+// For a non-negative model (HALS) all three agree: pdf(i, j) * blockMass() == value(i, j) and
+// rangeAverage equals the mean of value over the rectangle, up to float rounding. For a signed
+// model they differ where clamping bites; pdf() still matches sample() bit for bit.
+//
+// Units: bin coordinates; a sampled point (x, y) lies in [0, B)^2, bin (i, j) covering
+// [i, i + 1) x [j, j + 1). pdf is a density per unit bin area relative to the block's clamped
+// mass (it integrates to 1 over the block); the asset converts it to s-plane units.
+// Cost: init O(count * R); value O(groups * R); rangeSum O(groups * R); sample and pdf
+// O(ceil(log2 B) * groups * R). No allocation; CpMix lives on the stack (about 2 KiB).
+// Thread safety: views and mixes are immutable after init; all queries are const and reentrant.
+// Untrusted input: validateCpGroupView() checks a view's sizes; the data it points to must hold
+// finite values (the asset reader validates sections). Query arguments are range-checked: out-of-
+// range bins give 0.
+#pragma once
+
+#include <glintbake/runtime/runtime.h>
+
+#include <cstdint>
+
+namespace glintbake::runtime {
+
+constexpr int32_t kCpMaxRank = 64;
+constexpr int32_t kCpMaxBins = 256;
+constexpr int32_t kCpMaxBlend = 8;
+
+// A non-owning view of one compressed group (float32, row-major, rank entries per row):
+//   a, b:                 B x R factors;  c: K x R (scales folded in);
+//   a_prefix, b_prefix:   (B + 1) x R prefix sums, P[t][r] = sum_{i < t} F[i][r].
+struct CpGroupView {
+  int32_t bins = 0;    // B, [1, kCpMaxBins]
+  int32_t rank = 0;    // R, [1, kCpMaxRank]
+  int32_t blocks = 0;  // K, >= 1
+  const float* a = nullptr;
+  const float* b = nullptr;
+  const float* c = nullptr;
+  const float* a_prefix = nullptr;
+  const float* b_prefix = nullptr;
+};
+
+// kOk, or kInvalidArgument for null pointers or sizes out of range.
+Status validateCpGroupView(const CpGroupView& view);
+
+// One weighted block of a blend. The weight is usually an interpolation weight in [0, 1].
+struct CpBlendTerm {
+  const CpGroupView* group = nullptr;
+  int32_t block = 0;
+  float weight = 0.0f;
+};
+
+// A sampled bin and point. pdf: see the header comment.
+struct CpBlockSample {
+  float x = 0.0f, y = 0.0f;  // [0, B), bin units
+  int32_t i = 0, j = 0;      // bin containing (x, y)
+  double pdf = 0.0;
+};
+
+class CpMix {
+ public:
+  // Builds the blend of `count` terms (count in [0, kCpMaxBlend]). Terms with weight 0 are
+  // skipped; all groups must share B and hold valid views (validateCpGroupView) and the block
+  // index must be in [0, K). Returns kInvalidArgument otherwise (the mix is then empty: every query
+  // returns 0). Zero terms give an empty mix.
+  Status init(const CpBlendTerm* terms, int32_t count);
+
+  int32_t bins() const { return bins_; }
+  bool empty() const { return group_count_ == 0; }
+
+  // Unclamped model value of bin (i, j) (may be negative for signed models).
+  float rawValue(int32_t i, int32_t j) const;
+  // max(0, rawValue); 0 outside [0, B)^2.
+  float value(int32_t i, int32_t j) const;
+
+  // Unclamped sum over the half-open bin rectangle [i0, i1) x [j0, j1), 0 <= i0 <= i1 <= B.
+  float rawRangeSum(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const;
+  // Average over the inclusive rectangle [i0, i1] x [j0, j1] (clipped to the block), clamped at 0:
+  // max(0, rawRangeSum) / (bin count). 0 for an empty rectangle.
+  float rangeAverage(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const;
+  // max(0, raw sum over the whole block): the weight with which an asset chooses this block.
+  float blockMass() const;
+
+  // Draws a point by quadtree descent with clamped range weights (u1 steers the column split,
+  // u2 the row split, both rescaled at each level and finally used to jitter inside the bin).
+  // u1, u2 in [0, 1). Returns false (and leaves *out untouched) when the block mass is 0.
+  bool sample(double u1, double u2, CpBlockSample* out) const;
+
+  // Probability density with which sample() produces a point of bin (i, j) (per unit bin area).
+  // 0 outside the block or when the mass is 0.
+  double pdf(int32_t i, int32_t j) const;
+  // The same for a point in bin units (floor of x and y).
+  double pdfAt(float x, float y) const;
+
+ private:
+  // Clamped weights of the four children of [x0, x1) x [y0, y1) split at (xm, ym), in the order
+  // (left-top, right-top, left-bottom, right-bottom).
+  void childWeights(int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t ym, int32_t y1, float w[4]) const;
+
+  int32_t bins_ = 0;
+  int32_t group_count_ = 0;
+  const CpGroupView* groups_[kCpMaxBlend] = {};
+  float coef_[kCpMaxBlend][kCpMaxRank] = {};
+};
+
+}  // namespace glintbake::runtime
