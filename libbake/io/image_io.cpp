@@ -75,8 +75,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
                   const ImageWriteOptions& options) {
   if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || pixels == nullptr) {
     return makeError(ErrorCode::kBadArgument, path + ": cannot write a " + std::to_string(width) + "x" +
-                                                  std::to_string(height) + "x" + std::to_string(channels) +
-                                                  " image");
+                                                  std::to_string(height) + "x" + std::to_string(channels) + " image");
   }
   if (options.png_bits != 8 && options.png_bits != 16) {
     return makeError(ErrorCode::kBadArgument,
@@ -96,6 +95,9 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
                                    : (bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   OIIO::ImageSpec spec(width, height, channels, stored);
   if (ext == "exr") spec.attribute("compression", "zip");
+  // Values are data, not colours: a fourth channel is stored as given and never divides RGB
+  // (OIIO otherwise assumes premultiplied input and un-premultiplies for PNG).
+  spec.attribute("oiio:UnassociatedAlpha", 1);
   // OIIO's EXR and TIFF writers stamp the current time when no DateTime is given; an explicit empty
   // value keeps the bytes reproducible (EXR then stores an empty capDate, TIFF no date at all).
   spec.attribute("DateTime", "");

@@ -76,16 +76,26 @@ std::string oneLine(std::string text) {
 
 std::string pixelTypeName(const OIIO::TypeDesc& type) {
   switch (type.basetype) {
-    case OIIO::TypeDesc::UINT8: return "uint8";
-    case OIIO::TypeDesc::INT8: return "int8";
-    case OIIO::TypeDesc::UINT16: return "uint16";
-    case OIIO::TypeDesc::INT16: return "int16";
-    case OIIO::TypeDesc::UINT32: return "uint32";
-    case OIIO::TypeDesc::INT32: return "int32";
-    case OIIO::TypeDesc::HALF: return "half";
-    case OIIO::TypeDesc::FLOAT: return "float";
-    case OIIO::TypeDesc::DOUBLE: return "double";
-    default: return type.c_str();
+    case OIIO::TypeDesc::UINT8:
+      return "uint8";
+    case OIIO::TypeDesc::INT8:
+      return "int8";
+    case OIIO::TypeDesc::UINT16:
+      return "uint16";
+    case OIIO::TypeDesc::INT16:
+      return "int16";
+    case OIIO::TypeDesc::UINT32:
+      return "uint32";
+    case OIIO::TypeDesc::INT32:
+      return "int32";
+    case OIIO::TypeDesc::HALF:
+      return "half";
+    case OIIO::TypeDesc::FLOAT:
+      return "float";
+    case OIIO::TypeDesc::DOUBLE:
+      return "double";
+    default:
+      return type.c_str();
   }
 }
 
@@ -151,8 +161,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   const OIIO::ImageSpec config = readConfig();
   auto input = OIIO::ImageInput::open(path, &config);
   if (!input) {
-    return makeError(ErrorCode::kInvalidInput,
-                     path + ": not a readable image (" + oneLine(OIIO::geterror()) + ")");
+    return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + oneLine(OIIO::geterror()) + ")");
   }
   if (options.part < 0) {
     return makeError(ErrorCode::kBadArgument, "part must be >= 0, got " + std::to_string(options.part));
@@ -175,17 +184,17 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
     return makeError(ErrorCode::kUnsupported, path + ": deep images are not supported");
   }
   if (width <= 0 || height <= 0 || spec.depth > 1) {
-    return makeError(ErrorCode::kInvalidInput, path + ": invalid image size " + std::to_string(width) + "x" +
-                                                   std::to_string(height));
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": invalid image size " + std::to_string(width) + "x" + std::to_string(height));
   }
   if (width > options.max_size || height > options.max_size) {
-    return makeError(ErrorCode::kInvalidInput, path + ": size " + std::to_string(width) + "x" +
-                                                   std::to_string(height) + " exceeds the limit of " +
-                                                   std::to_string(options.max_size) +
+    return makeError(ErrorCode::kInvalidInput, path + ": size " + std::to_string(width) + "x" + std::to_string(height) +
+                                                   " exceeds the limit of " + std::to_string(options.max_size) +
                                                    " texels per side (raise it with --max-size)");
   }
   if (options.height ? channels < 1 : !(channels >= 2 && channels <= 4)) {
-    std::string expected = options.height ? "at least 1" : "2 (XY), 3 (RGB) or 4 (RGBA); 1-channel height fields need --height";
+    std::string expected =
+        options.height ? "at least 1" : "2 (XY), 3 (RGB) or 4 (RGBA); 1-channel height fields need --height";
     return makeError(ErrorCode::kInvalidInput,
                      path + ": unsupported channel count " + std::to_string(channels) + " (expected " + expected + ")");
   }
@@ -201,11 +210,13 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
                                               std::to_string(height) + " image");
   }
   if (!input->read_image(options.part, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    return makeError(ErrorCode::kInvalidInput, path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
   }
   // Some readers report problems only through the error queue.
   if (input->has_error()) {
-    return makeError(ErrorCode::kInvalidInput, path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
   }
   input->close();
 
@@ -218,14 +229,15 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   if (options.height) {
     // Non-finite heights would spread into their neighbours' normals; count them here, replace
     // them by 0 when asked, and make their own normal (0,0,1) as for normal maps.
-    int64_t bad = 0;
-    size_t first = 0;
+    std::vector<size_t> bad_texels;
     for (size_t i = 0; i < texels; ++i) {
       if (!std::isfinite(pixels[i])) {
-        if (bad++ == 0) first = i;
+        bad_texels.push_back(i);
         pixels[i] = 0.0f;
       }
     }
+    const int64_t bad = int64_t(bad_texels.size());
+    const size_t first = bad_texels.empty() ? 0 : bad_texels.front();
     if (bad > 0 && !options.fix_nonfinite) {
       r->nonfinite = bad;
       r->texels = int64_t(texels);
@@ -235,6 +247,11 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
                            " (--fix-nonfinite replaces them)");
     }
     heightsToNormals(pixels, options.height_scale, &map);
+    for (size_t i : bad_texels) {
+      map.normals[i * 3 + 0] = 0.0f;
+      map.normals[i * 3 + 1] = 0.0f;
+      map.normals[i * 3 + 2] = 1.0f;
+    }
     r->encoding_used = Encoding::kUnorm;
     Status status = normaliseNormals(&map, options, r);
     if (!status) return makeError(status.error().code, path + ": " + status.error().message);
@@ -244,8 +261,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
     Encoding encoding = options.encoding;
     if (encoding == Encoding::kAuto) {
       if (spec.format.is_floating_point()) {
-        const bool any_negative =
-            std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
+        const bool any_negative = std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
         encoding = any_negative ? Encoding::kSnorm : Encoding::kUnorm;
       } else {
         // OIIO already maps signed integer types to [-1, 1].

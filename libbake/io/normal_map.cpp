@@ -15,17 +15,22 @@ namespace glintbake::bake {
 
 const char* encodingString(Encoding e) {
   switch (e) {
-    case Encoding::kAuto: return "auto";
-    case Encoding::kUnorm: return "unorm";
-    case Encoding::kSnorm: return "snorm";
+    case Encoding::kAuto:
+      return "auto";
+    case Encoding::kUnorm:
+      return "unorm";
+    case Encoding::kSnorm:
+      return "snorm";
   }
   return "auto";
 }
 
 const char* wrapString(Wrap w) {
   switch (w) {
-    case Wrap::kRepeat: return "repeat";
-    case Wrap::kClamp: return "clamp";
+    case Wrap::kRepeat:
+      return "repeat";
+    case Wrap::kClamp:
+      return "clamp";
   }
   return "repeat";
 }
@@ -170,8 +175,8 @@ Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const
   try {
     map.normals.resize(size_t(width) * size_t(height) * 3);
   } catch (const std::bad_alloc&) {
-    return makeError(ErrorCode::kRuntime, "out of memory for a " + std::to_string(width) + "x" +
-                                              std::to_string(height) + " map");
+    return makeError(ErrorCode::kRuntime,
+                     "out of memory for a " + std::to_string(width) + "x" + std::to_string(height) + " map");
   }
   const size_t texels = size_t(width) * size_t(height);
   const float sign_y = options.flip_green ? -1.0f : 1.0f;

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace glintbake::bake::ltc {
 
@@ -236,11 +235,9 @@ double fitCell(const CellObjective& objective, FitMethod method, bool isotropic,
     return objective(trial);
   };
   const Params start{ltc->m11, ltc->m22, ltc->m13};
-  Params best = start;
-  double best_value = std::numeric_limits<double>::infinity();
-
   // The published fit: Nelder-Mead from the warm start.
-  best_value = nelderMead(f, start, 0.05, 1e-5, 100, &best);
+  Params best;
+  double best_value = nelderMead(f, start, 0.05, 1e-5, 100, &best);
   if (method == FitMethod::kRefined) {
     // Continue from the best point with a fresh, smaller simplex (a restart escapes the collapsed
     // simplex the first run may have stopped with), then polish with Levenberg-Marquardt.

@@ -11,6 +11,8 @@ namespace glintbake::bake::ltc {
 
 namespace {
 
+constexpr double kUnitLengthSlack = 1e-6;
+
 struct NormalLevel {
   int width = 0, height = 0;
   std::vector<double> b;  // 3 per texel, unnormalised averages
@@ -50,7 +52,9 @@ RoughnessLevel toRoughness(const NormalLevel& level, const RoughnessOptions& opt
   out.mean_length.resize(n);
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
     const double* b = &level.b[i * 3];
-    const double length = std::min(1.0, std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]));
+    double length = std::min(1.0, std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]));
+    // Unit normals stored as float are unit only to within a few ulps; do not read that as roughness.
+    if (length > 1.0 - kUnitLengthSlack) length = 1.0;
     const double alpha_meso = options.exact_meso ? alphaMesoExact(length) : options.meso.eval(length);
     out.mean_length[i] = float(length);
     out.alpha[i] = float(options.combine.eval(options.alpha_micro, alpha_meso));

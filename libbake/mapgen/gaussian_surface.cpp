@@ -7,7 +7,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace glintbake::bake::mapgen {
@@ -60,8 +62,8 @@ inline int wrapIndex(int i, int n) {
 
 }  // namespace
 
-NormalMap gaussianSurface(int size, uint64_t seed, double kernel_sigma_x, double kernel_sigma_y,
-                          double slope_std_x, double slope_std_y) {
+NormalMap gaussianSurface(int size, uint64_t seed, double kernel_sigma_x, double kernel_sigma_y, double slope_std_x,
+                          double slope_std_y) {
   const int n = size;
   const size_t texels = size_t(n) * size_t(n);
   const PeriodicKernel kx = makeKernel(kernel_sigma_x, n);

@@ -9,8 +9,8 @@
 namespace glintbake::bake::mapgen {
 
 // Gaussian random surface with per-axis kernel std (texels) and per-axis slope std; see mapgen.h.
-NormalMap gaussianSurface(int size, uint64_t seed, double kernel_sigma_x, double kernel_sigma_y,
-                          double slope_std_x, double slope_std_y);
+NormalMap gaussianSurface(int size, uint64_t seed, double kernel_sigma_x, double kernel_sigma_y, double slope_std_x,
+                          double slope_std_y);
 NormalMap scratches(const MapParams& params);
 NormalMap flakes(const MapParams& params, double cell);
 

@@ -29,19 +29,24 @@ std::string number(double v) {
 Status checkRange(const char* name, double v, double lo, double hi, bool open_low) {
   const bool ok = (open_low ? v > lo : v >= lo) && v <= hi;
   if (ok) return okStatus();
-  return makeError(ErrorCode::kBadArgument, std::string(name) + " must be in " + (open_low ? "(" : "[") +
-                                                number(lo) + ", " + number(hi) + "], got " + number(v));
+  return makeError(ErrorCode::kBadArgument, std::string(name) + " must be in " + (open_low ? "(" : "[") + number(lo) +
+                                                ", " + number(hi) + "], got " + number(v));
 }
 
 }  // namespace
 
 const char* mapKindString(MapKind kind) {
   switch (kind) {
-    case MapKind::kFlat: return "flat";
-    case MapKind::kBeckmann: return "beckmann";
-    case MapKind::kBrushed: return "brushed";
-    case MapKind::kScratches: return "scratches";
-    case MapKind::kFlakes: return "flakes";
+    case MapKind::kFlat:
+      return "flat";
+    case MapKind::kBeckmann:
+      return "beckmann";
+    case MapKind::kBrushed:
+      return "brushed";
+    case MapKind::kScratches:
+      return "scratches";
+    case MapKind::kFlakes:
+      return "flakes";
   }
   return "flat";
 }
@@ -79,7 +84,8 @@ Status validateMapParams(MapKind kind, const MapParams& params) {
   const double cell = effectiveCell(kind, params);
   Status status = okStatus();
   switch (kind) {
-    case MapKind::kFlat: break;
+    case MapKind::kFlat:
+      break;
     case MapKind::kBeckmann:
       status = checkRange("alpha", params.alpha, 0.0, 4.0, true);
       if (status) status = checkRange("cell", cell, 0.0, size / 2.0, true);
@@ -117,9 +123,12 @@ NormalMap generateMap(MapKind kind, const MapParams& params) {
       return mapgen::gaussianSurface(params.size, params.seed, along, cell, params.alpha_x * kSqrtHalf,
                                      params.alpha_y * kSqrtHalf);
     }
-    case MapKind::kScratches: return mapgen::scratches(params);
-    case MapKind::kFlakes: return mapgen::flakes(params, cell);
-    case MapKind::kFlat: break;
+    case MapKind::kScratches:
+      return mapgen::scratches(params);
+    case MapKind::kFlakes:
+      return mapgen::flakes(params, cell);
+    case MapKind::kFlat:
+      break;
   }
   NormalMap map;
   map.width = params.size;

@@ -18,8 +18,8 @@ constexpr int kSubSamples = 4;  // per texel side
 constexpr double kMinLengthFraction = 0.1, kMaxLengthFraction = 0.5;
 
 struct Segment {
-  double cx, cy;      // centre, texels (image coordinates: x right, y down)
-  double dx, dy;      // unit direction along the scratch
+  double cx, cy;  // centre, texels (image coordinates: x right, y down)
+  double dx, dy;  // unit direction along the scratch
   double half_length;
 };
 

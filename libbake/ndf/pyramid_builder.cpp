@@ -18,13 +18,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr int kConvergenceSamplesPerAxis = 4;
+constexpr int kSplitParts = 16;          // row sets of a split footprint
+constexpr double kSplitFlakes = 1 << 18; // split footprints with more flakes than this
 
 double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 // Relative MSE of image a against b: sum (a - b)^2 / sum b^2 (0 when both vanish).
-double relativeMse(const float* a, const float* b, size_t n) {
+double relativeMse(const float* a, const double* b, size_t n) {
   double num = 0.0, den = 0.0;
   for (size_t i = 0; i < n; ++i) {
     const double d = double(a[i]) - double(b[i]);
@@ -32,6 +34,63 @@ double relativeMse(const float* a, const float* b, size_t n) {
     den += double(b[i]) * double(b[i]);
   }
   return den > 0.0 ? num / den : (num > 0.0 ? 1.0 : 0.0);
+}
+
+// A convergence sample: one centre of a level and the runtime's prediction of its image from the
+// level below (the bilinear blend of up to 4 centres of that level, as NdfPyramid blends them).
+struct Sample {
+  int centre = 0;                  // index j * grid_width + i on its own level
+  int below[4] = {-1, -1, -1, -1}; // centres of the level below
+  double weight[4] = {0, 0, 0, 0};
+  std::vector<double> prediction;  // R * R, accumulated while the level below is written
+};
+
+// Bilinear neighbours along one axis, with the runtime's wrap rules (ndf_pyramid.h).
+void axisNeighbours(double pos, double size, double stride, int n, Wrap wrap, int* i0, int* i1, double* f) {
+  const double g = (pos - 0.5 * stride) / stride;
+  if (wrap == Wrap::kRepeat) {
+    const double fl = std::floor(g);
+    *f = g - fl;
+    *i0 = ((int(fl) % n) + n) % n;
+    *i1 = (*i0 + 1) % n;
+  } else if (!(g > 0.0)) {
+    *i0 = *i1 = 0;
+    *f = 0.0;
+  } else if (g >= double(n - 1)) {
+    *i0 = *i1 = n - 1;
+    *f = 0.0;
+  } else {
+    *i0 = int(std::floor(g));
+    *i1 = *i0 + 1;
+    *f = g - std::floor(g);
+  }
+  (void)size;
+}
+
+// Up to kConvergenceSamplesPerAxis^2 evenly spread centres of level `geo`, with their neighbours
+// on the level below (`below`).
+std::vector<Sample> planSamples(const LevelGeometry& geo, const LevelGeometry& below, Wrap wrap, size_t image_floats) {
+  const int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
+  const int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
+  std::vector<Sample> samples(size_t(nsx) * size_t(nsy));
+  for (int k = 0; k < nsx * nsy; ++k) {
+    Sample& s = samples[size_t(k)];
+    const int i = int((k % nsx + 0.5) * geo.grid_width / nsx);
+    const int j = int((k / nsx + 0.5) * geo.grid_height / nsy);
+    s.centre = j * geo.grid_width + i;
+    int x0, x1, y0, y1;
+    double fx, fy;
+    axisNeighbours((i + 0.5) * geo.stride_x, 0, below.stride_x, below.grid_width, wrap, &x0, &x1, &fx);
+    axisNeighbours((j + 0.5) * geo.stride_y, 0, below.stride_y, below.grid_height, wrap, &y0, &y1, &fy);
+    const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+    const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    for (int q = 0; q < 4; ++q) {
+      s.below[q] = ys[q] * below.grid_width + xs[q];
+      s.weight[q] = ws[q];
+    }
+    s.prediction.assign(image_floats, 0.0);
+  }
+  return samples;
 }
 
 }  // namespace
@@ -98,36 +157,11 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
     return makeError(ErrorCode::kRuntime, "out of memory allocating chunk buffers");
   }
 
+  std::vector<std::vector<double>> part_acc(static_cast<size_t>(kSplitParts), std::vector<double>(image_floats));
   const int max_levels = options.levels > 0 ? options.levels : kMaxPyramidLevels;
+  std::vector<Sample> next_samples;  // level-0 has no level below
   for (int level = 0; level < max_levels; ++level) {
     const LevelGeometry geo = levelGeometry(map.width, map.height, options, level);
-    double mse_prev = -1.0;
-    if (level > 0 && options.levels == 0) {
-      // Sampled comparison of this level's footprint with the level below, at this level's centres.
-      const LevelGeometry below = levelGeometry(map.width, map.height, options, level - 1);
-      const int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
-      const int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
-      const int ns = nsx * nsy;
-      std::vector<float> a(size_t(ns) * image_floats), b(size_t(ns) * image_floats);
-      std::vector<double> mse(static_cast<size_t>(ns));
-      tbb::parallel_for(0, ns, [&](int k) {
-        const int i = int((k % nsx + 0.5) * geo.grid_width / nsx);
-        const int j = int((k / nsx + 0.5) * geo.grid_height / nsy);
-        const double x = (i + 0.5) * geo.stride_x, y = (j + 0.5) * geo.stride_y;
-        Splatter& sp = splatters.local();
-        sp.image(x, y, geo.sigma, &a[size_t(k) * image_floats]);
-        sp.image(x, y, below.sigma, &b[size_t(k) * image_floats]);
-        mse[size_t(k)] = relativeMse(&a[size_t(k) * image_floats], &b[size_t(k) * image_floats], image_floats);
-      });
-      double sum = 0.0;
-      for (double m : mse) sum += m;  // fixed order: deterministic
-      mse_prev = sum / ns;
-      if (mse_prev < options.converge_mse) {
-        rep.stop_reason = "converged";
-        rep.next_level_mse = mse_prev;
-        return okStatus();
-      }
-    }
     if (cancelled()) return cancelError();
 
     const auto t_level = Clock::now();
@@ -135,7 +169,13 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
     PyramidLevelReport lrep;
     lrep.level = level;
     lrep.geometry = geo;
-    lrep.mse_vs_previous = mse_prev;
+
+    // Convergence bookkeeping. Samples of THIS level: compare its images with the prediction the
+    // runtime makes from the level below (bilinear blend of that level's images, collected while it
+    // was written). Samples of the NEXT level: collect the prediction from this level's images.
+    std::vector<Sample> samples = std::move(next_samples);
+    next_samples = planSamples(levelGeometry(map.width, map.height, options, level + 1), geo, map.wrap, image_floats);
+    double mse_sum = 0.0;
 
     runtime::NdfLevelRecord rec;
     rec.level = uint32_t(level);
@@ -172,10 +212,31 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
       *cw = std::min(options.region_size, geo.grid_width - *cx0);
       *ch = std::min(options.region_size, geo.grid_height - *cy0);
     };
+    // Footprints with very many flakes (the top levels: few images, each costing up to several
+    // map's worth of flakes) are split over kSplitParts interleaved row sets computed in parallel
+    // and summed in a fixed order; the split depends only on the level, never on the thread count.
+    const bool split = splatters.local().flakesPerImage(geo.sigma) > kSplitFlakes;
     auto computeRegion = [&](int r, int slot) {
       int cx0, cy0, cw, ch;
       regionExtent(r, &cx0, &cy0, &cw, &ch);
       float* images = buffers[slot].data() + 8;
+      if (split) {
+        for (int k = 0; k < cw * ch; ++k) {
+          if (cancelled()) return;
+          const int i = cx0 + k % cw, j = cy0 + k / cw;
+          tbb::parallel_for(0, kSplitParts, [&](int part) {
+            std::vector<double>& acc = part_acc[size_t(part)];
+            std::fill(acc.begin(), acc.end(), 0.0);
+            splatters.local().accumulate((i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, geo.sigma, part,
+                                         kSplitParts, acc.data());
+          });
+          for (int part = 1; part < kSplitParts; ++part) {
+            for (size_t b = 0; b < image_floats; ++b) part_acc[0][b] += part_acc[size_t(part)][b];
+          }
+          splatters.local().finish(part_acc[0].data(), images + size_t(k) * image_floats);
+        }
+        return;
+      }
       tbb::parallel_for(tbb::blocked_range<int>(0, cw * ch, 1), [&](const tbb::blocked_range<int>& range) {
         Splatter& sp = splatters.local();
         for (int k = range.begin(); k != range.end(); ++k) {
@@ -208,15 +269,33 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
       if (st != format::Status::kOk) {
         return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
       }
+      for (int k = 0; k < cw * ch; ++k) {
+        const int centre = (cy0 + k / cw) * geo.grid_width + (cx0 + k % cw);
+        const float* img = buf.data() + 8 + size_t(k) * image_floats;
+        for (Sample& smp : samples) {
+          if (smp.centre == centre) mse_sum += relativeMse(img, smp.prediction.data(), image_floats);
+        }
+        for (Sample& smp : next_samples) {
+          for (int q = 0; q < 4; ++q) {
+            if (smp.below[q] != centre || smp.weight[q] == 0.0) continue;
+            for (size_t b = 0; b < image_floats; ++b) smp.prediction[b] += smp.weight[q] * double(img[b]);
+          }
+        }
+      }
       lrep.raw_bytes += bytes;
       lrep.images += uint64_t(cw * ch);
       done += uint64_t(cw * ch);
       if (progress) progress(level, done, level_images);
     }
+    if (!samples.empty()) lrep.mse_vs_previous = mse_sum / double(samples.size());
     lrep.stored_bytes = writer.bytesWritten() - bytes_before;
     lrep.seconds = secondsSince(t_level);
     rep.levels.push_back(lrep);
 
+    if (options.levels == 0 && lrep.mse_vs_previous >= 0.0 && lrep.mse_vs_previous < options.converge_mse) {
+      rep.stop_reason = "converged";
+      return okStatus();
+    }
     if (options.levels == 0 && geo.grid_width == 1 && geo.grid_height == 1) {
       rep.stop_reason = "grid-1x1";
       return okStatus();

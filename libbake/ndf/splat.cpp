@@ -163,8 +163,26 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
 }
 
 int64_t Splatter::image(double x, double y, double sigma, float* out) {
-  const int res = params_.ndf_res;
   std::fill(acc_.begin(), acc_.end(), 0.0);
+  const int64_t used = accumulate(x, y, sigma, 0, 1, acc_.data());
+  finish(acc_.data(), out);
+  return used;
+}
+
+double Splatter::flakesPerImage(double sigma) const {
+  const double r = params_.footprint_truncation * std::sqrt(flakes_.sigma_h * flakes_.sigma_h + sigma * sigma);
+  return kPi * r * r / (flakes_.step * flakes_.step);
+}
+
+void Splatter::finish(const double* acc, float* out) const {
+  const int res = params_.ndf_res;
+  const double inv_bin_area = double(res) * double(res) / 4.0;
+  const size_t n = size_t(res) * size_t(res);
+  for (size_t i = 0; i < n; ++i) out[i] = inside_disk_[i] ? float(acc[i] * inv_bin_area) : 0.0f;
+}
+
+int64_t Splatter::accumulate(double x, double y, double sigma, int part, int parts, double* acc) const {
+  const int res = params_.ndf_res;
   const FlakeSet& f = flakes_;
   const double sh2 = f.sigma_h * f.sigma_h;
   const double sp2 = sigma * sigma;
@@ -186,7 +204,7 @@ int64_t Splatter::image(double x, double y, double sigma, float* out) {
   const int64_t gy1 = int64_t(std::ceil((y + radius) / f.step - 0.5));
   const bool repeat = f.wrap == Wrap::kRepeat;
   int64_t used = 0;
-  for (int64_t gy = gy0; gy <= gy1; ++gy) {
+  for (int64_t gy = gy0 + part; gy <= gy1; gy += parts) {
     int64_t wy = gy;
     if (repeat) {
       wy %= f.grid_height;
@@ -218,14 +236,10 @@ int64_t Splatter::image(double x, double y, double sigma, float* out) {
       const double cxy = kc * (j00 * j10 + j01 * j11);
       const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
       const double mass = spatial_norm * std::exp(-d2 * inv_2s2);
-      splatLobe(acc_.data(), res, mx, my, cxx, cxy, cyy, mass, trunc);
+      splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, trunc);
       ++used;
     }
   }
-
-  const double inv_bin_area = double(res) * double(res) / 4.0;
-  const size_t n = size_t(res) * size_t(res);
-  for (size_t i = 0; i < n; ++i) out[i] = inside_disk_[i] ? float(acc_[i] * inv_bin_area) : 0.0f;
   return used;
 }
 

@@ -41,8 +41,9 @@ Status validateCpOptions(const CpOptions& o) {
   if (o.max_iters < 1) return bad("max-iters must be >= 1");
   if (!(o.tol >= 0.0) || !std::isfinite(o.tol)) return bad("tol must be a finite number >= 0");
   if (!(o.ridge >= 0.0 && o.ridge < 1.0)) return bad("ridge must be in [0, 1)");
-  if (o.compressed_basis < 1 || o.compressed_basis > 4096) return bad("compressed basis must be in [1, 4096]");
+  if (o.compressed_basis < 0 || o.compressed_basis > 4096) return bad("compressed basis must be in [0, 4096]");
   if (o.refine_sweeps < 0) return bad("refine sweeps must be >= 0");
+  if (o.core_starts < 1 || o.core_starts > 64) return bad("core starts must be in [1, 64]");
   return okStatus();
 }
 
@@ -177,10 +178,11 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
 
   int sweeps = 0, core_sweeps = 0;
   double err_sq = std::numeric_limits<double>::infinity();
+  const int basis = options.compressed_basis > 0 ? options.compressed_basis : std::max(64, 2 * rank);
   if (options.method == CpMethod::kAlsPlain) {
     randomStart(bins, blocks, rank, options.seed, s);
     err_sq = runSweeps(engine, s, err_sq, settings, &sweeps);
-  } else if (options.nonneg || options.method == CpMethod::kAls || blocks <= options.compressed_basis) {
+  } else if (options.nonneg || options.method == CpMethod::kAls || blocks <= basis) {
     hosvdStart(x, bins, blocks, rank, options.seed, options.nonneg, s);
     if (options.nonneg) s.c = MatF::Constant(blocks, rank, 1.0f);  // HALS refines C from a positive start
     err_sq = engine.solveC(s, options.ridge, options.nonneg);
@@ -188,15 +190,30 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
   } else {
     // Mode-3 compression: T ~ core x_3 Q with Q (K x L) orthonormal; ALS on the B x B x L core,
     // then C = Q C_core and a few full sweeps.
-    const int basis = options.compressed_basis;
     const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed);
     Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
     MatF core_t(xt.rows(), basis);
     core_t.noalias() = xt * q;  // column l = core block l
     CpEngine core(core_t.data(), bins, basis, rank);
-    hosvdStart(core_t.data(), bins, basis, rank, options.seed, false, s);
-    double core_err = core.solveC(s, options.ridge, false);
-    runSweeps(core, s, core_err, settings, &core_sweeps);
+    // Local minima are real (random starts change the error by a few percent) and core sweeps
+    // are cheap: start from the HOSVD and from `core_starts - 1` seeded random points, keep the
+    // best core fit.
+    double best_err = std::numeric_limits<double>::infinity();
+    for (int start = 0; start < std::max(1, options.core_starts); ++start) {
+      CpState candidate;
+      double err = std::numeric_limits<double>::infinity();
+      if (start == 0) {
+        hosvdStart(core_t.data(), bins, basis, rank, options.seed, false, candidate);
+        err = core.solveC(candidate, options.ridge, false);
+      } else {
+        randomStart(bins, basis, rank, options.seed + 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(start), candidate);
+      }
+      err = runSweeps(core, candidate, err, settings, &core_sweeps);
+      if (err < best_err) {
+        best_err = err;
+        s = std::move(candidate);
+      }
+    }
     s.c = q * s.c;
     SweepSettings refine = settings;
     refine.max_sweeps = options.refine_sweeps;

@@ -135,7 +135,8 @@ double CpEngine::alsSweep(CpState& s, double ridge) {
 namespace {
 
 // One pass of HALS column updates on F (rows x R) for the problem min |M - F G|, F >= 0:
-// f_r <- max(0, f_r + (m_r - F g_r) / g_rr), columns in order (Cichocki & Phan 2009, eq. 14).
+// f_r <- max(0, f_r + (m_r - F g_r) / g_rr), columns in order (Cichocki & Phan 2009). A column
+// that reaches zero stays zero (the model loses that rank-1 term).
 void halsUpdate(MatF& f, const MatD& m, const MatD& g) {
   MatD fd = f.cast<double>();
   for (Eigen::Index r = 0; r < fd.cols(); ++r) {

@@ -30,7 +30,8 @@ std::string lowerExtension(const std::string& path) {
 Json parametersJson(bake::MapKind kind, const bake::MapParams& p) {
   Json j = Json::object();
   switch (kind) {
-    case bake::MapKind::kFlat: break;
+    case bake::MapKind::kFlat:
+      break;
     case bake::MapKind::kBeckmann:
       j["alpha"] = p.alpha;
       j["cell"] = bake::effectiveCell(kind, p);
@@ -82,8 +83,7 @@ int main(int argc, char** argv) {
   app.add_option("--alpha-x", params.alpha_x, "brushed: roughness along x, the brushing direction (0, 4]")
       ->capture_default_str();
   app.add_option("--alpha-y", params.alpha_y, "brushed: roughness along y (0, 4]")->capture_default_str();
-  app.add_option("--density", params.density, "scratches: scratches per 1000 texel^2 [0, 1000]")
-      ->capture_default_str();
+  app.add_option("--density", params.density, "scratches: scratches per 1000 texel^2 [0, 1000]")->capture_default_str();
   app.add_option("--width", params.width, "scratches: groove width in texels (0, min(256, size/4)]")
       ->capture_default_str();
   app.add_option("--slope", params.scratch_slope, "scratches: groove wall slope (0, 10]")->capture_default_str();

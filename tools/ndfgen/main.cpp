@@ -174,7 +174,6 @@ int main(int argc, char** argv) {
       }
       doc["levels"] = levels;
       doc["stop_reason"] = report.stop_reason;
-      doc["next_level_mse"] = report.next_level_mse < 0 ? Json(nullptr) : Json(report.next_level_mse);
       doc["flakes"] = report.flakes;
       doc["images"] = images;
       doc["raw_bytes"] = raw;

@@ -91,6 +91,22 @@ TEST(ImageIo, PngQuantisesWithClampAndRounding) {
   }
 }
 
+TEST(ImageIo, FourChannelsAreStoredAsGiven) {
+  ScratchDir dir;
+  std::vector<float> px(4 * 4 * 4);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = (i % 4 == 3) ? 0.5f : 0.2f;
+  for (const char* name : {"rgba.png", "rgba.exr"}) {
+    ASSERT_TRUE(writeImage(dir.file(name), 4, 4, 4, px.data()).ok());
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(dir.file(name), &config);
+    ASSERT_TRUE(in);
+    std::vector<float> back(px.size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, back.data()));
+    for (size_t i = 0; i < px.size(); ++i) EXPECT_NEAR(back[i], px[i], 1e-4) << name << " " << i;
+  }
+}
+
 TEST(ImageIo, IdenticalInputsGiveIdenticalBytes) {
   ScratchDir dir;
   std::vector<float> px = ramp(32, 16, 3);

@@ -146,6 +146,19 @@ TEST(Ingest, Tiff16Bit) {
   expectMatchesReference(map.value(), 4e-5);
 }
 
+TEST(Ingest, JpegWhereAvailable) {
+  const std::string formats = OIIO::get_string_attribute("extension_list");
+  if (formats.find("jpg") == std::string::npos) GTEST_SKIP() << "OIIO built without JPEG";
+  ScratchDir dir;
+  const std::string path = dir.file("n.jpg");
+  writeFloats(path, kW, kH, 3, OIIO::TypeDesc::UINT8, referencePixels(3, true));
+  IngestReport report;
+  auto map = load(path, &report);
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  EXPECT_EQ(report.file_format, "jpeg");
+  expectMatchesReference(map.value(), 0.1);  // lossy: a loose bound that still catches decoding errors
+}
+
 TEST(Ingest, FlipGreenNegatesY) {
   ScratchDir dir;
   const std::string path = dir.file("dx.png");
@@ -338,11 +351,35 @@ TEST(Ingest, NonFiniteIsAnErrorUnlessFixed) {
   EXPECT_EQ(fixed.value().at(2, 7)[2], 1.0f);
 }
 
+TEST(Ingest, NonFiniteHeights) {
+  ScratchDir dir;
+  const std::string path = dir.file("h.exr");
+  std::vector<float> h(size_t(kW) * kH);
+  for (int r = 0; r < kH; ++r)
+    for (int c = 0; c < kW; ++c) h[size_t(r) * kW + size_t(c)] = float(0.1 * c);
+  h[size_t(4) * kW + 6] = std::numeric_limits<float>::quiet_NaN();
+  writeFloats(path, kW, kH, 1, OIIO::TypeDesc::FLOAT, h);
+  IngestOptions options;
+  options.height = true;
+  auto failed = load(path, nullptr, options);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().code, ErrorCode::kInvalidInput);
+  EXPECT_NE(failed.error().message.find("column 6, row 4"), std::string::npos) << failed.error().message;
+
+  options.fix_nonfinite = true;
+  IngestReport report;
+  auto fixed = load(path, &report, options);
+  ASSERT_TRUE(fixed.ok()) << fixed.error().message;
+  EXPECT_EQ(report.nonfinite, 1);
+  EXPECT_EQ(fixed.value().at(6, 4)[2], 1.0f);
+  for (float v : fixed.value().normals) EXPECT_TRUE(std::isfinite(v));
+}
+
 TEST(Ingest, NonPositiveZRepairedAndCounted) {
-  const float px[4 * 3] = {0.6f, 0.8f, -0.5f,   // below: kept azimuth, on the horizon
-                           0.0f, 0.0f, -1.0f,   // straight down: no azimuth, becomes up
+  const float px[4 * 3] = {0.6f,  0.8f, -0.5f,  // below: kept azimuth, on the horizon
+                           0.0f,  0.0f, -1.0f,  // straight down: no azimuth, becomes up
                            -3.0f, 4.0f, 0.0f,   // on the horizon, long: normalised
-                           0.0f, 0.0f, 1.0f};
+                           0.0f,  0.0f, 1.0f};
   IngestReport report;
   auto map = normalMapFromPixels(2, 2, 3, px, IngestOptions{}, &report);
   ASSERT_TRUE(map.ok()) << map.error().message;
@@ -412,8 +449,8 @@ TEST(Ingest, TruncatedFileIsInvalid) {
   ScratchDir dir;
   for (const char* name : {"cut.png", "cut.exr"}) {
     const std::string path = dir.file(name);
-    writeFloats(path, 64, 64, 3, std::string(name).find(".png") != std::string::npos ? OIIO::TypeDesc::UINT16
-                                                                                  : OIIO::TypeDesc::FLOAT,
+    writeFloats(path, 64, 64, 3,
+                std::string(name).find(".png") != std::string::npos ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::FLOAT,
                 std::vector<float>(64 * 64 * 3, 0.5f));
     const std::string bytes = test::readBytes(path);
     test::writeBytes(path, bytes.substr(0, bytes.size() / 2));

@@ -44,14 +44,13 @@ TEST(IngestOptions, ParsesEveryOption) {
 }
 
 TEST(IngestOptions, RejectsBadValues) {
-  for (const std::vector<std::string>& args :
-       std::vector<std::vector<std::string>>{{"--encoding", "srgb"},
-                                             {"--wrap", "mirror"},
-                                             {"--height-scale", "0"},
-                                             {"--height-scale", "-1"},
-                                             {"--part", "-1"},
-                                             {"--max-size", "0"},
-                                             {"--max-size", "2000000"}}) {
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{{"--encoding", "srgb"},
+                                                                                    {"--wrap", "mirror"},
+                                                                                    {"--height-scale", "0"},
+                                                                                    {"--height-scale", "-1"},
+                                                                                    {"--part", "-1"},
+                                                                                    {"--max-size", "0"},
+                                                                                    {"--max-size", "2000000"}}) {
     bake::IngestOptions o;
     EXPECT_FALSE(parse(args, &o)) << args[0] << " " << args[1];
   }

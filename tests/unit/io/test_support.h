@@ -46,6 +46,10 @@ inline void writeRaw(const std::string& path, int width, int height, int channel
   ASSERT_TRUE(out) << OIIO::geterror();
   OIIO::ImageSpec spec(width, height, channels, stored);
   spec.attribute("oiio:UnassociatedAlpha", 1);  // store alpha as given, RGB untouched
+  if (path.size() > 4 && path.substr(path.size() - 4) == ".jpg") {
+    spec.attribute("compression", "jpeg:100");  // near-lossless, full chroma resolution
+    spec.attribute("jpeg:subsampling", "4:4:4");
+  }
   if (tiled) {
     spec.tile_width = 16;
     spec.tile_height = 16;

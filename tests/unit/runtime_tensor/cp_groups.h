@@ -6,9 +6,10 @@
 #include <glintbake/bake/tensor/prefix_sums.h>
 #include <glintbake/runtime/cp_block.h>
 
-#include "ndf_like_tensors.h"
+#include <glintbake/bake/tensor/synthetic_groups.h>
 
 #include <memory>
+#include <random>
 
 namespace glintbake::runtime::testing {
 
@@ -19,7 +20,7 @@ struct OwnedGroup {
 };
 
 inline std::unique_ptr<OwnedGroup> makeGroup(uint64_t seed, bool nonneg, int rank = 16, int blocks = 64) {
-  const bake::tensor::GroupTensor t = bake::tensor::testing::makeNdfLikeTensor(32, blocks, seed);
+  const bake::tensor::GroupTensor t = bake::tensor::makeNdfLikeGroup(32, blocks, seed);
   bake::tensor::CpOptions o;
   o.rank = rank;
   o.nonneg = nonneg;
@@ -50,10 +51,10 @@ inline CpMix makeBlend(const OwnedGroup& g0, const OwnedGroup& g1, int first_blo
 class Uniforms {
  public:
   explicit Uniforms(uint64_t seed) : rng_(seed) {}
-  double next() { return rng_.uniform(); }
+  double next() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }  // [0, 1)
 
  private:
-  bake::tensor::testing::TestRng rng_;
+  std::mt19937_64 rng_;
 };
 
 }  // namespace glintbake::runtime::testing

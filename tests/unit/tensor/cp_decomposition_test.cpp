@@ -2,19 +2,18 @@
 // against 500 plain sweeps, non-negativity and the error-target rank search.
 #include <glintbake/bake/tensor/cp_decomposition.h>
 
-#include "ndf_like_tensors.h"
+#include <glintbake/bake/tensor/synthetic_groups.h>
 
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
 namespace glintbake::bake::tensor {
 namespace {
 
-using testing::makeLowRankTensor;
-using testing::makeNdfLikeTensor;
 
 CpFactors decompose(const GroupTensor& t, const CpOptions& o) {
   Result<CpFactors> r = decomposeCp(t, o);
@@ -30,7 +29,7 @@ bool sameBytes(const CpFactors& x, const CpFactors& y) {
 }
 
 TEST(CpDecomposition, RecoversExactLowRankTensorWithEveryMethod) {
-  const GroupTensor t = makeLowRankTensor(16, 200, 5, 11);
+  const GroupTensor t = makeLowRankGroup(16, 200, 5, 11);
   for (CpMethod method : {CpMethod::kCompressed, CpMethod::kAls, CpMethod::kAlsPlain}) {
     CpOptions o;
     o.rank = 5;
@@ -44,7 +43,7 @@ TEST(CpDecomposition, RecoversExactLowRankTensorWithEveryMethod) {
 }
 
 TEST(CpDecomposition, GramErrorEqualsExplicitError) {
-  const GroupTensor t = makeNdfLikeTensor(32, 96, 3);
+  const GroupTensor t = makeNdfLikeGroup(32, 96, 3);
   for (bool nonneg : {false, true}) {
     CpOptions o;
     o.rank = 12;
@@ -57,7 +56,7 @@ TEST(CpDecomposition, GramErrorEqualsExplicitError) {
 }
 
 TEST(CpDecomposition, ErrorFallsWithRank) {
-  const GroupTensor t = makeNdfLikeTensor(32, 256, 5);
+  const GroupTensor t = makeNdfLikeGroup(32, 256, 5);
   double previous = 1.0;
   for (int rank : {8, 16, 32}) {
     CpOptions o;
@@ -72,7 +71,7 @@ TEST(CpDecomposition, ErrorFallsWithRank) {
 
 TEST(CpDecomposition, DeterministicAcrossRunsAndThreadCounts) {
   std::vector<GroupTensor> tensors;
-  for (uint64_t seed = 20; seed < 24; ++seed) tensors.push_back(makeNdfLikeTensor(16, 128, seed));
+  for (uint64_t seed = 20; seed < 24; ++seed) tensors.push_back(makeNdfLikeGroup(16, 128, seed));
   for (CpMethod method : {CpMethod::kCompressed, CpMethod::kAlsPlain}) {
     CpOptions o;
     o.rank = 8;
@@ -92,12 +91,22 @@ TEST(CpDecomposition, DeterministicAcrossRunsAndThreadCounts) {
     }
     EXPECT_TRUE(sameBytes(serial[0].value(), once));
   }
+  // Error-target mode in a batch: ranks and bytes independent of the thread count.
+  CpOptions o;
+  o.rank = 8;
+  o.compressed_basis = 32;
+  const auto serial = decomposeCpBatch(tensors, o, 1, 0.45);
+  const auto parallel = decomposeCpBatch(tensors, o, 2, 0.45);
+  for (size_t n = 0; n < tensors.size(); ++n) {
+    ASSERT_TRUE(serial[n].ok() && parallel[n].ok());
+    EXPECT_TRUE(sameBytes(serial[n].value(), parallel[n].value())) << "tensor " << n;
+  }
 }
 
 // The default method must stay within 1% of the error of 500 plain sweeps (algorithms.md sec. 2).
 TEST(CpDecomposition, DefaultWithinOnePercentOfFiveHundredPlainSweeps) {
   for (uint64_t seed : {31u, 32u}) {
-    const GroupTensor t = makeNdfLikeTensor(32, 512, seed);
+    const GroupTensor t = makeNdfLikeGroup(32, 512, seed);
     CpOptions plain;
     plain.method = CpMethod::kAlsPlain;
     plain.tol = 0.0;
@@ -117,7 +126,7 @@ TEST(CpDecomposition, DefaultWithinOnePercentOfFiveHundredPlainSweeps) {
 }
 
 TEST(CpDecomposition, NonnegativeFactorsAndErrorCost) {
-  const GroupTensor t = makeNdfLikeTensor(32, 256, 41);
+  const GroupTensor t = makeNdfLikeGroup(32, 256, 41);
   CpOptions o;
   o.nonneg = true;
   const CpFactors nn = decompose(t, o);
@@ -132,7 +141,7 @@ TEST(CpDecomposition, NonnegativeFactorsAndErrorCost) {
 }
 
 TEST(CpDecomposition, ErrorTargetPicksSmallestSufficientRank) {
-  const GroupTensor t = makeNdfLikeTensor(16, 96, 51);
+  const GroupTensor t = makeNdfLikeGroup(16, 96, 51);
   CpOptions o;
   o.rank = 16;
   o.compressed_basis = 32;
@@ -156,7 +165,7 @@ TEST(CpDecomposition, ErrorTargetPicksSmallestSufficientRank) {
 }
 
 TEST(CpDecomposition, RejectsBadOptionsAndInputs) {
-  const GroupTensor t = makeLowRankTensor(8, 4, 2, 1);
+  const GroupTensor t = makeLowRankGroup(8, 4, 2, 1);
   for (int rank : {0, kMaxCpRank + 1}) {
     CpOptions o;
     o.rank = rank;
@@ -183,6 +192,62 @@ TEST(CpDecomposition, ZeroTensorGivesZeroModel) {
   const CpFactors f = decompose(t, CpOptions{});
   EXPECT_EQ(f.relative_error, 0.0);
   for (float v : f.c) EXPECT_EQ(v, 0.0f);
+}
+
+}  // namespace
+}  // namespace glintbake::bake::tensor
+
+namespace glintbake::bake::tensor {
+namespace {
+
+// Survey of the speed/error trade-off of the method variants (run by hand with
+// --gtest_also_run_disabled_tests; prints one line per variant, relative to 500 plain sweeps).
+TEST(CpDecompositionSurvey, DISABLED_MethodVariants) {
+  using Clock = std::chrono::steady_clock;
+  for (uint64_t seed : {61u, 62u, 2026u}) {
+    const GroupTensor t = makeNdfLikeGroup(32, 1024, seed);
+    auto run = [&t](const CpOptions& o, double* ms) {
+      const auto t0 = Clock::now();
+      CpFactors f = decomposeCp(t, o).value();
+      *ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      return f;
+    };
+    CpOptions plain;
+    plain.method = CpMethod::kAlsPlain;
+    plain.tol = 0.0;
+    double plain_ms = 0.0;
+    const double reference = run(plain, &plain_ms).relative_error;
+    std::printf("seed %d: als-plain x500 error %.5f, %.0f ms\n", static_cast<int>(seed), reference, plain_ms);
+    struct Variant { const char* name; CpMethod method; int basis, refine; bool extrapolate; double tol; int starts = 1; };
+    const Variant variants[] = {
+        {"als-plain (tol 1e-5)", CpMethod::kAlsPlain, 0, 0, false, 1e-5},
+        {"als hosvd", CpMethod::kAls, 0, 0, false, 1e-5},
+        {"als hosvd+extrapolation", CpMethod::kAls, 0, 0, true, 1e-5},
+        {"compressed L32 r10", CpMethod::kCompressed, 32, 10, true, 1e-5},
+        {"compressed L64 r5", CpMethod::kCompressed, 64, 5, true, 1e-5},
+        {"compressed L64 r10", CpMethod::kCompressed, 64, 10, true, 1e-5},
+        {"compressed L64 r10 no-extrap", CpMethod::kCompressed, 64, 10, false, 1e-5},
+        {"compressed L96 r10", CpMethod::kCompressed, 96, 10, true, 1e-5},
+        {"compressed L64 r20", CpMethod::kCompressed, 64, 20, true, 1e-5},
+        {"compressed L64 r10 tol 1e-6", CpMethod::kCompressed, 64, 10, true, 1e-6},
+        {"compressed L64 r10 2 starts", CpMethod::kCompressed, 64, 10, true, 1e-5, 2},
+        {"compressed L64 r10 3 starts", CpMethod::kCompressed, 64, 10, true, 1e-5, 3},
+        {"compressed L32 r10 3 starts", CpMethod::kCompressed, 32, 10, true, 1e-5, 3},
+    };
+    for (const Variant& v : variants) {
+      CpOptions o;
+      o.method = v.method;
+      o.compressed_basis = v.basis > 0 ? v.basis : o.compressed_basis;
+      o.refine_sweeps = v.refine;
+      o.extrapolate = v.extrapolate;
+      o.tol = v.tol;
+      o.core_starts = v.starts;
+      double ms = 0.0;
+      const CpFactors f = run(o, &ms);
+      std::printf("  %-30s error %.5f (%+.2f%%) %6.0f ms (x%.1f faster), %d+%d sweeps\n", v.name, f.relative_error,
+                  100.0 * (f.relative_error / reference - 1.0), ms, plain_ms / ms, f.core_sweeps, f.sweeps);
+    }
+  }
 }
 
 }  // namespace

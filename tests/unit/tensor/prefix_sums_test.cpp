@@ -2,18 +2,22 @@
 // range sums of rank-1 terms factorise.
 #include <glintbake/bake/tensor/prefix_sums.h>
 
-#include "ndf_like_tensors.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
 
 namespace glintbake::bake::tensor {
 namespace {
 
+double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
 TEST(PrefixSums, EntriesAreRoundedExactPartialSums) {
-  testing::TestRng rng(7);
+  std::mt19937_64 rng(7);
   const int rows = 32, rank = 5;
   std::vector<float> f(rows * rank);
-  for (float& v : f) v = static_cast<float>(rng.uniform() * 2.0 - 0.5);
+  for (float& v : f) v = static_cast<float>(uniform(rng) * 2.0 - 0.5);
   const std::vector<float> p = buildPrefixSums(f, rows, rank);
   ASSERT_EQ(p.size(), static_cast<size_t>((rows + 1) * rank));
   for (int r = 0; r < rank; ++r) {
@@ -27,11 +31,11 @@ TEST(PrefixSums, EntriesAreRoundedExactPartialSums) {
 }
 
 TEST(PrefixSums, RectangleSumOfRankOneTermFactorises) {
-  testing::TestRng rng(8);
+  std::mt19937_64 rng(8);
   const int rows = 16;
   std::vector<float> a(rows), b(rows);
-  for (float& v : a) v = static_cast<float>(rng.uniform());
-  for (float& v : b) v = static_cast<float>(rng.uniform());
+  for (float& v : a) v = static_cast<float>(uniform(rng));
+  for (float& v : b) v = static_cast<float>(uniform(rng));
   const std::vector<float> pa = buildPrefixSums(a, rows, 1), pb = buildPrefixSums(b, rows, 1);
   for (int i0 = 0; i0 < rows; i0 += 3) {
     for (int i1 = i0; i1 < rows; i1 += 5) {

@@ -23,8 +23,7 @@ void addIngestOptions(CLI::App& app, bake::IngestOptions& options) {
   app.add_flag("--height", options.height,
                "The input is a height field (first channel); normals by central differences")
       ->group(group);
-  app.add_option("--height-scale", options.height_scale,
-                 "Height-field scale K: slope = K * dh/dtexel (> 0)")
+  app.add_option("--height-scale", options.height_scale, "Height-field scale K: slope = K * dh/dtexel (> 0)")
       ->check(CLI::PositiveNumber)
       ->group(group);
   app.add_option("--wrap", options.wrap, "How the map continues beyond its edges: repeat or clamp")
@@ -81,8 +80,7 @@ bake::NormalMap loadNormalMapForTool(Tool& tool, const std::string& path, const 
     tool.warning(name + ": replaced " + std::to_string(r->nonfinite) + " non-finite texel(s) by (0,0,1)");
   }
   if (r->nz_nonpositive > 0) {
-    tool.warning(name + ": moved " + std::to_string(r->nz_nonpositive) +
-                 " texel(s) with n_z <= 0 onto the horizon");
+    tool.warning(name + ": moved " + std::to_string(r->nz_nonpositive) + " texel(s) with n_z <= 0 onto the horizon");
   }
   if (r->far_from_unit > 0) {
     tool.warning(name + ": renormalised " + std::to_string(r->far_from_unit) + " of " + std::to_string(r->texels) +

@@ -30,8 +30,10 @@ enum class FitMethod : uint32_t {
   // The published fitter's settings: Nelder-Mead, simplex offset 0.05, tolerance 1e-5,
   // 100 iterations per cell.
   kPublished = 0,
-  // The published start, then Nelder-Mead continued with restarts and a Ceres Levenberg-Marquardt
-  // polish on the square-rooted objective terms; keeps the best parameters seen. Default.
+  // The published run, then a Nelder-Mead restart from its best point (simplex offset 0.01,
+  // tolerance 1e-7, 100 iterations) and a Ceres Levenberg-Marquardt polish on the square-rooted
+  // objective terms; keeps the best parameters seen, so each cell's objective is never above the
+  // published run's from the same start. Default.
   kRefined = 1,
 };
 const char* fitMethodString(FitMethod method);  // "published", "refined"

@@ -12,7 +12,7 @@
 //               (default 3; the height autocorrelation is then Gaussian with standard deviation
 //               cell * sqrt(2)). Slopes are the exact derivatives of that smooth surface, scaled
 //               so that each slope (dh/dx, dh/dy) ~ N(0, alpha^2 / 2): the Beckmann distribution
-//               of roughness alpha (Walter et al. 2007, eq. 25). n = normalize(-dh/dx, -dh/dy, 1).
+//               of roughness alpha (Walter et al. 2007, section 5.1). n = normalize(-dh/dx, -dh/dy, 1).
 //  - brushed:   the same with an anisotropic kernel: standard deviation `cell` across the brushing
 //               direction (y) and cell * alpha_y / alpha_x along it (x), capped at size / 4, and
 //               slopes scaled to N(0, alpha_x^2 / 2) and N(0, alpha_y^2 / 2). With alpha_x < alpha_y
@@ -74,7 +74,7 @@ Status validateMapParams(MapKind kind, const MapParams& params);
 // Generates the map (wrap mode repeat, unit normals, n_z > 0). The parameters must pass
 // validateMapParams (checked: violating it aborts). Multithreaded with TBB; the result is
 // identical for every thread count. Cost: O(size^2 * cell) for the Gaussian kinds, O(size^2) for
-// flakes, O(scratch area) for scratches; memory about 5 floats per texel.
+// flakes, O(scratch area) for scratches; peak memory at most 7 floats per texel.
 NormalMap generateMap(MapKind kind, const MapParams& params);
 
 // Statistics of a map of unit normals with n_z > 0 (texels with n_z <= 1e-6 are skipped for the

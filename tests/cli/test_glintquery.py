@@ -1,0 +1,103 @@
+"""glintquery: point, image and batch queries on an ndf-pyramid through the runtime."""
+
+import json
+import math
+import os
+import tempfile
+
+import clitest
+from clitest import ToolTestCase, run
+
+
+class GlintQuery(ToolTestCase):
+    @classmethod
+    def setUpClass(cls):
+        # One asset shared by every test (each tool start costs about half a second).
+        cls._assets = tempfile.TemporaryDirectory(prefix="glintbake-query-")
+        m = os.path.join(cls._assets.name, "m.png")
+        cls.asset = os.path.join(cls._assets.name, "m.gbk")
+        for args in (("mapgen", "beckmann", "-o", m, "--size", "32", "--seed", "5", "--quiet"),
+                     ("ndfgen", m, "-o", cls.asset, "--ndf-res", "32", "--stride", "8", "--sigma0", "4",
+                      "--levels", "3", "--quiet")):
+            code, _, err = run(*args)
+            if code != 0:
+                raise RuntimeError(f"{args[0]} failed: {err}")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls._assets.cleanup()
+
+    def test_point(self):
+        doc = self.run_json("glintquery", "point", self.asset, "--at", "12,20", "--sigma", "5", "--s", "0.02,-0.01",
+                            schema="glintquery-point.schema.json")
+        self.assertGreater(doc["value"], 0.0)
+        out, _ = self.run_ok("glintquery", "point", self.asset, "--at", "12,20", "--sigma", "5", "--s", "0.02,-0.01")
+        self.assertAlmostEqual(float(out), doc["value"], delta=1e-6 * doc["value"])
+        # Outside the s-plane square: zero.
+        doc = self.run_json("glintquery", "point", self.asset, "--at", "1,1", "--sigma", "4", "--s", "1.5,0",
+                            schema="glintquery-point.schema.json")
+        self.assertEqual(doc["value"], 0.0)
+
+    def test_image(self):
+        for name in ("ndf.exr", "ndf.png"):
+            out = self.path(name)
+            doc = self.run_json("glintquery", "image", self.asset, "--at", "16,16", "--sigma", "8", "-o", out,
+                                schema="glintquery-image.schema.json")
+            self.assertTrue(os.path.exists(out))
+            self.assertEqual(doc["resolution"], 32)
+            self.assertAlmostEqual(doc["mass"], 1.0, delta=2e-3)
+
+    def test_batch(self):
+        queries = [
+            {"op": "point", "x": 3.0, "y": 4.0, "sigma": 6.0, "s": [0.0, 0.0], "id": 1},
+            {"op": "range", "x": 3.0, "y": 4.0, "sigma": 6.0, "rect": [-1, -1, 1, 1]},
+            {"op": "sample", "x": 3.0, "y": 4.0, "sigma": 6.0, "u": [0.25, 0.75]},
+            {"op": "pdf", "x": 3.0, "y": 4.0, "sigma": 6.0, "s": [0.01, 0.02]},
+        ]
+        code, out, err = run("glintquery", "batch", self.asset, stdin="\n".join(json.dumps(q) for q in queries) + "\n")
+        self.assertEqual(code, 0, err)
+        lines = [json.loads(l) for l in out.splitlines()]
+        self.assertEqual(len(lines), 4)
+        for l in lines:
+            clitest.validate(l, "glintquery-batch.schema.json")
+        self.assertEqual(lines[0]["id"], 1)
+        # The whole-plane average is the mass / 4.
+        self.assertAlmostEqual(lines[1]["value"] * 4.0, 1.0, delta=2e-3)
+        # The sample's pdf equals the pdf query at the sampled point.
+        s = lines[2]["s"]
+        code, out, err = run("glintquery", "batch", self.asset,
+                             stdin=json.dumps({"op": "pdf", "x": 3.0, "y": 4.0, "sigma": 6.0, "s": s}) + "\n")
+        self.assertEqual(code, 0, err)
+        self.assertAlmostEqual(json.loads(out)["value"], lines[2]["pdf"], delta=1e-9 * lines[2]["pdf"])
+
+    def test_batch_bad_lines(self):
+        code, out, err = run("glintquery", "batch", self.asset,
+                             stdin='{"op":"point","x":1,"y":1,"sigma":2,"s":[0,0]}\nnot json\n{"op":"warp"}\n')
+        self.assertEqual(code, clitest.INVALID)
+        lines = [json.loads(l) for l in out.splitlines()]
+        self.assertEqual(len(lines), 3)
+        self.assertIn("value", lines[0])
+        self.assertIn("error", lines[1])
+        self.assertIn("error", lines[2])
+        self.assertEqual(len([l for l in err.splitlines() if l.strip()]), 1)
+
+    def test_errors(self):
+        self.assert_fails(clitest.IO, "glintquery", "point", self.path("none.gbk"), "--at", "1,1", "--sigma", "1",
+                          "--s", "0,0")
+        bad = self.path("bad.gbk")
+        with open(bad, "wb") as f:
+            f.write(b"not a container at all" * 10)
+        self.assert_fails(clitest.INVALID, "glintquery", "point", bad, "--at", "1,1", "--sigma", "1", "--s", "0,0")
+        self.assert_fails(clitest.BAD_ARGS, "glintquery", "point", self.asset, "--at", "1", "--sigma", "1",
+                          "--s", "0,0")
+        self.assert_fails(clitest.BAD_ARGS, "glintquery", "point", self.asset, "--at", "1,1", "--sigma", "-1",
+                          "--s", "0,0")
+        self.assert_fails(clitest.BAD_ARGS, "glintquery")
+        out = self.path("x.png")
+        self.assert_fails(clitest.IO, "glintquery", "image", self.asset, "--at", "1,1", "--sigma", "1",
+                          "-o", self.path("no/dir/x.png"))
+        self.assertFalse(os.path.exists(out))
+
+
+if __name__ == "__main__":
+    clitest.main()

@@ -1,0 +1,345 @@
+// NdfPyramid on hand-made containers: exact centre values, trilinear weights, range averages,
+// sampling (pdf consistency and a chi-square test), the C API, and malformed assets.
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/glintbake_c.h>
+#include <glintbake/runtime/ndf_pyramid.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace glintbake::runtime {
+namespace {
+
+constexpr int kRes = 16;
+constexpr int kMap = 64;
+
+// Deterministic positive test image of centre (i, j) of level l: a smooth bump whose position
+// depends on the centre, plus a floor, normalised to unit mass. Zero outside the unit disk.
+std::vector<float> testImage(int l, int i, int j) {
+  std::vector<float> img(size_t(kRes) * kRes);
+  const double h = 2.0 / kRes;
+  const double cx = -0.5 + 0.13 * i + 0.05 * l, cy = 0.4 - 0.11 * j;
+  double sum = 0.0;
+  for (int y = 0; y < kRes; ++y) {
+    for (int x = 0; x < kRes; ++x) {
+      const double sx = -1 + (x + 0.5) * h, sy = 1 - (y + 0.5) * h;
+      double v = 0.0;
+      if (sx * sx + sy * sy <= 1.0) v = 0.05 + std::exp(-((sx - cx) * (sx - cx) + (sy - cy) * (sy - cy)) / 0.08);
+      img[size_t(y) * kRes + x] = float(v);
+      sum += v;
+    }
+  }
+  for (float& v : img) v = float(v / (sum * h * h));
+  return img;
+}
+
+struct LevelSpec {
+  int grid;
+  double sigma;
+};
+
+// Writes a pyramid container over a kMap^2 map with the given levels and region size.
+std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int region, uint32_t wrap = 0,
+                                 const std::string& path = "") {
+  const std::string file = path.empty() ? std::string(::testing::TempDir()) + "/rt_pyramid.gbk" : path;
+  format::Writer w;
+  EXPECT_EQ(w.open(file, format::AssetKind::kNdfPyramid, 1), format::Status::kOk);
+  for (size_t l = 0; l < levels.size(); ++l) {
+    NdfLevelRecord rec;
+    rec.level = uint32_t(l);
+    rec.ndf_res = kRes;
+    rec.grid_width = rec.grid_height = uint32_t(levels[l].grid);
+    rec.region_size = uint32_t(region);
+    rec.regions_x = rec.regions_y = uint32_t((levels[l].grid + region - 1) / region);
+    rec.wrap = wrap;
+    rec.map_width = rec.map_height = kMap;
+    rec.stride_x = rec.stride_y = double(kMap) / levels[l].grid;
+    rec.origin_x = rec.origin_y = 0.5 * rec.stride_x;
+    rec.sigma_texels = levels[l].sigma;
+    rec.sigma_r = 0.005;
+    EXPECT_EQ(w.addSection(format::kSectionNdfLevel, l, &rec, sizeof(rec)), format::Status::kOk);
+    for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
+      for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
+        const int cw = std::min(region, levels[l].grid - int(rx) * region);
+        const int ch = std::min(region, levels[l].grid - int(ry) * region);
+        format::ImageSectionHeader hdr;
+        hdr.width = hdr.height = kRes;
+        hdr.channels = 1;
+        hdr.layers = uint32_t(cw * ch);
+        std::vector<uint8_t> bytes(sizeof(hdr));
+        std::memcpy(bytes.data(), &hdr, sizeof(hdr));
+        for (int k = 0; k < cw * ch; ++k) {
+          const std::vector<float> img = testImage(int(l), int(rx) * region + k % cw, int(ry) * region + k / cw);
+          const uint8_t* p = reinterpret_cast<const uint8_t*>(img.data());
+          bytes.insert(bytes.end(), p, p + img.size() * 4);
+        }
+        EXPECT_EQ(w.addSection(format::kSectionNdfChunk, (uint64_t(l) << 32) | (ry * rec.regions_x + rx), bytes.data(),
+                               bytes.size()),
+                  format::Status::kOk);
+      }
+    }
+  }
+  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
+  EXPECT_EQ(w.finish(), format::Status::kOk);
+  std::ifstream f(file, std::ios::binary);
+  return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+const std::vector<LevelSpec> kLevels = {{8, 2.0}, {4, 4.0}, {2, 8.0}};
+
+class NdfPyramidTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    bytes_ = makePyramid(kLevels, 3);
+    ASSERT_EQ(pyr_.openMemory(bytes_.data(), bytes_.size()), Status::kOk);
+  }
+  std::vector<uint8_t> bytes_;
+  NdfPyramid pyr_;
+};
+
+Footprint fp(double x, double y, double sigma) {
+  Footprint f;
+  f.x = x;
+  f.y = y;
+  f.sigma = sigma;
+  return f;
+}
+
+TEST_F(NdfPyramidTest, CentreQueriesReturnTheStoredImagesExactly) {
+  ASSERT_EQ(pyr_.levelCount(), 3);
+  ASSERT_EQ(pyr_.resolution(), kRes);
+  std::vector<float> out(kRes * kRes);
+  for (int l = 0; l < 3; ++l) {
+    const NdfLevelRecord* rec = pyr_.level(l);
+    for (int j = 0; j < kLevels[l].grid; ++j) {
+      for (int i = 0; i < kLevels[l].grid; ++i) {
+        const double x = rec->origin_x + i * rec->stride_x, y = rec->origin_y + j * rec->stride_y;
+        ASSERT_EQ(pyr_.image(fp(x, y, kLevels[l].sigma), out.data(), out.size()), Status::kOk);
+        EXPECT_EQ(out, testImage(l, i, j)) << "level " << l << " centre " << i << "," << j;
+        // Point queries at bin centres too.
+        double v = 0.0;
+        ASSERT_EQ(pyr_.eval(fp(x, y, kLevels[l].sigma), SPoint{-1 + 9.5 * 2.0 / kRes, 1 - 6.5 * 2.0 / kRes}, &v),
+                  Status::kOk);
+        EXPECT_EQ(float(v), testImage(l, i, j)[6 * kRes + 9]);
+      }
+    }
+  }
+}
+
+TEST_F(NdfPyramidTest, TrilinearBlendOfTheBracketingLevels) {
+  // sigma 2.828 = 2^1.5: halfway (in log2) between levels 0 and 1. Position between centres.
+  const double x = 4.0 + 8.0 * 2 + 2.0, y = 4.0 + 8.0 * 5 + 6.0;  // level 0: i = 2 + 0.25, j = 5 + 0.75
+  const double sigma = std::sqrt(8.0);
+  const SPoint s{-1 + 7.5 * 2.0 / kRes, 1 - 8.5 * 2.0 / kRes};
+  const int bin = 8 * kRes + 7;
+  auto at = [&](int l, int i, int j) { return double(testImage(l, i, j)[bin]); };
+  const double l0 = 0.75 * 0.25 * at(0, 2, 5) + 0.25 * 0.25 * at(0, 3, 5) + 0.75 * 0.75 * at(0, 2, 6) +
+                    0.25 * 0.75 * at(0, 3, 6);
+  // level 1: stride 16, origin 8: gx = (22 - 8) / 16 = 0.875, gy = (50 - 8) / 16 = 2.625
+  const double l1 = 0.125 * 0.375 * at(1, 0, 2) + 0.875 * 0.375 * at(1, 1, 2) + 0.125 * 0.625 * at(1, 0, 3) +
+                    0.875 * 0.625 * at(1, 1, 3);
+  double v = 0.0;
+  ASSERT_EQ(pyr_.eval(fp(x, y, sigma), s, &v), Status::kOk);
+  EXPECT_NEAR(v, 0.5 * l0 + 0.5 * l1, 1e-9 * std::fabs(v));
+  // Below level 0 and above the top clamp.
+  double below = 0.0, at0 = 0.0, above = 0.0, top = 0.0;
+  ASSERT_EQ(pyr_.eval(fp(x, y, 0.1), s, &below), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 2.0), s, &at0), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 1000.0), s, &above), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 8.0), s, &top), Status::kOk);
+  EXPECT_EQ(below, at0);
+  EXPECT_EQ(above, top);
+  // Repeat wrap: a query one map period away is identical; the grid wraps between the last and
+  // first centres.
+  double shifted = 0.0;
+  ASSERT_EQ(pyr_.eval(fp(x + kMap, y - 2 * kMap, sigma), s, &shifted), Status::kOk);
+  EXPECT_NEAR(shifted, v, 1e-12 * v);
+  double seam = 0.0;
+  ASSERT_EQ(pyr_.eval(fp(kMap, 4.0, 2.0), s, &seam), Status::kOk);  // midway between centres 7 and 0
+  EXPECT_NEAR(seam, 0.5 * (at(0, 7, 0) + at(0, 0, 0)), 1e-6 * seam);
+}
+
+TEST_F(NdfPyramidTest, RangeAveragesAreExactForPiecewiseConstantImages) {
+  const Footprint f = fp(20.0, 33.0, 3.0);
+  std::vector<float> img(kRes * kRes);
+  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), Status::kOk);
+  const double h = 2.0 / kRes;
+  // Bin-aligned rectangle: mean of its bins.
+  SRect r;
+  r.x0 = -1 + 3 * h;
+  r.x1 = -1 + 7 * h;
+  r.y1 = 1 - 2 * h;
+  r.y0 = 1 - 5 * h;
+  double expect = 0.0;
+  for (int j = 2; j < 5; ++j)
+    for (int i = 3; i < 7; ++i) expect += img[size_t(j) * kRes + i];
+  expect /= 12.0;
+  double v = 0.0;
+  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  EXPECT_NEAR(v, expect, 1e-6 * expect);
+  // Inside one bin: the bin value. Whole plane: mass / 4.
+  r.x0 = -1 + 3.2 * h;
+  r.x1 = -1 + 3.7 * h;
+  r.y0 = 1 - 2.9 * h;
+  r.y1 = 1 - 2.1 * h;
+  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  EXPECT_NEAR(v, img[2 * kRes + 3], 1e-6 * v);
+  double m = 0.0;
+  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  EXPECT_NEAR(m, 1.0, 1e-5);
+  r = SRect();
+  r.x0 = -2;
+  r.x1 = 2;
+  r.y0 = -2;
+  r.y1 = 2;
+  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  EXPECT_NEAR(v, m / 16.0, 1e-6);
+}
+
+TEST_F(NdfPyramidTest, SamplePdfEqualsPdfAndEval) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Footprint f = fp(37.0, 11.0, 5.0);
+  double m = 0.0;
+  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  for (int k = 0; k < 2000; ++k) {
+    NdfSample smp;
+    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), Status::kOk);
+    double p = 0.0, e = 0.0;
+    ASSERT_EQ(pyr_.pdf(f, smp.s, &p), Status::kOk);
+    ASSERT_EQ(pyr_.eval(f, smp.s, &e), Status::kOk);
+    ASSERT_GT(smp.pdf, 0.0);
+    EXPECT_DOUBLE_EQ(smp.pdf, p);
+    EXPECT_NEAR(p, e / m, 1e-12 * p);
+  }
+  NdfSample smp;
+  EXPECT_EQ(pyr_.sample(f, 1.0, 0.5, &smp), Status::kInvalidArgument);
+  EXPECT_EQ(pyr_.sample(f, std::nan(""), 0.5, &smp), Status::kInvalidArgument);
+}
+
+TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {
+  // Histogram of samples over the bins against the blended image's bin masses.
+  const Footprint f = fp(29.0, 45.0, 3.3);
+  std::vector<float> img(kRes * kRes);
+  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), Status::kOk);
+  double m = 0.0;
+  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  const int n = 200000;
+  std::vector<double> counts(kRes * kRes, 0.0);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double h = 2.0 / kRes;
+  for (int k = 0; k < n; ++k) {
+    NdfSample smp;
+    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), Status::kOk);
+    const int i = std::min(kRes - 1, int((smp.s.x + 1) / h)), j = std::min(kRes - 1, int((1 - smp.s.y) / h));
+    counts[size_t(j) * kRes + i] += 1.0;
+  }
+  double chi2 = 0.0;
+  int dof = -1;
+  for (int b = 0; b < kRes * kRes; ++b) {
+    const double expected = n * img[size_t(b)] * h * h / m;
+    if (expected == 0.0) {
+      EXPECT_EQ(counts[size_t(b)], 0.0) << "sample in an empty bin";
+      continue;
+    }
+    chi2 += (counts[size_t(b)] - expected) * (counts[size_t(b)] - expected) / expected;
+    ++dof;
+  }
+  // Accept below the 1e-4 upper quantile (Wilson-Hilferty: about dof + 3.72 sqrt(2 dof) + 8).
+  const double limit = dof + 3.72 * std::sqrt(2.0 * dof) + 8.0;
+  std::printf("[ measured ] chi-square %.1f with %d degrees of freedom (limit %.1f)\n", chi2, dof, limit);
+  EXPECT_LT(chi2, limit);
+}
+
+TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {
+  const std::vector<uint8_t> bytes = makePyramid({{4, 4.0}}, 2, 1);
+  NdfPyramid p;
+  ASSERT_EQ(p.openMemory(bytes.data(), bytes.size()), Status::kOk);
+  std::vector<float> a(kRes * kRes);
+  ASSERT_EQ(p.image(fp(-30.0, 200.0, 4.0), a.data(), a.size()), Status::kOk);
+  EXPECT_EQ(a, testImage(0, 0, 3));
+}
+
+TEST(NdfPyramidC, CApiMatchesTheClass) {
+  const std::string path = std::string(::testing::TempDir()) + "/rt_pyramid_c.gbk";
+  makePyramid(kLevels, 4, 0, path);
+  gb_ndf_pyramid* p = nullptr;
+  ASSERT_EQ(gb_ndf_pyramid_open(path.c_str(), &p), GB_OK);
+  int32_t res = 0, levels = 0;
+  ASSERT_EQ(gb_ndf_pyramid_info(p, &res, &levels), GB_OK);
+  EXPECT_EQ(res, kRes);
+  EXPECT_EQ(levels, 3);
+  NdfPyramid cls;
+  ASSERT_EQ(cls.open(path.c_str()), Status::kOk);
+  double a = 0.0, b = 0.0, sx = 0.0, sy = 0.0, pdf = 0.0, pdf2 = 0.0;
+  ASSERT_EQ(gb_ndf_pyramid_eval(p, 13.0, 50.0, 3.0, 0.1, -0.2, &a), GB_OK);
+  ASSERT_EQ(cls.eval(fp(13.0, 50.0, 3.0), SPoint{0.1, -0.2}, &b), Status::kOk);
+  EXPECT_EQ(a, b);
+  ASSERT_EQ(gb_ndf_pyramid_sample(p, 13.0, 50.0, 3.0, 0.3, 0.6, &sx, &sy, &pdf), GB_OK);
+  ASSERT_EQ(gb_ndf_pyramid_pdf(p, 13.0, 50.0, 3.0, sx, sy, &pdf2), GB_OK);
+  EXPECT_EQ(pdf, pdf2);
+  ASSERT_EQ(gb_ndf_pyramid_average(p, 13.0, 50.0, 3.0, -0.5, -0.5, 0.5, 0.5, &a), GB_OK);
+  EXPECT_GT(a, 0.0);
+  std::vector<float> img(kRes * kRes);
+  EXPECT_EQ(gb_ndf_pyramid_image(p, 1.0, 2.0, 3.0, img.data(), img.size() - 1), GB_INVALID_ARGUMENT);
+  EXPECT_EQ(gb_ndf_pyramid_image(p, 1.0, 2.0, 3.0, img.data(), img.size()), GB_OK);
+  gb_ndf_pyramid_close(p);
+  gb_ndf_pyramid* bad = nullptr;
+  EXPECT_EQ(gb_ndf_pyramid_open("/nonexistent/none.gbk", &bad), GB_IO_ERROR);
+  EXPECT_EQ(bad, nullptr);
+  EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(Status::kWrongKind));
+  std::remove(path.c_str());
+}
+
+TEST(NdfPyramidInvalid, MalformedAssetsAreRejected) {
+  const std::vector<uint8_t> good = makePyramid(kLevels, 3);
+  NdfPyramid p;
+  // Every truncation fails cleanly.
+  for (size_t cut : {size_t(0), size_t(10), good.size() / 2, good.size() - 1}) {
+    EXPECT_NE(p.openMemory(good.data(), cut), Status::kOk) << cut;
+    EXPECT_FALSE(p.isOpen());
+  }
+  // Single flipped bytes anywhere: either rejected or (if the byte is unused) a valid pyramid.
+  std::mt19937 rng(3);
+  for (int k = 0; k < 200; ++k) {
+    std::vector<uint8_t> bad = good;
+    bad[rng() % bad.size()] ^= uint8_t(1 + rng() % 255);
+    const Status s = p.openMemory(bad.data(), bad.size());
+    if (s == Status::kOk) {
+      double v = 0.0;
+      EXPECT_EQ(p.eval(fp(1, 2, 3), SPoint{0, 0}, &v), Status::kOk);
+    }
+  }
+  // Wrong asset kind.
+  const std::string path = std::string(::testing::TempDir()) + "/rt_wrong_kind.gbk";
+  {
+    format::Writer w;
+    ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::Status::kOk);
+    ASSERT_EQ(w.addMetadata("{}"), format::Status::kOk);
+    ASSERT_EQ(w.finish(), format::Status::kOk);
+  }
+  EXPECT_EQ(p.open(path.c_str()), Status::kWrongKind);
+  std::remove(path.c_str());
+  // Queries on a closed pyramid and bad arguments.
+  double v = 0.0;
+  EXPECT_EQ(p.eval(fp(0, 0, 1), SPoint{0, 0}, &v), Status::kInvalidArgument);
+  NdfPyramid ok;
+  ASSERT_EQ(ok.openMemory(good.data(), good.size()), Status::kOk);
+  EXPECT_EQ(ok.eval(fp(std::nan(""), 0, 1), SPoint{0, 0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(ok.eval(fp(0, 0, -1), SPoint{0, 0}, &v), Status::kInvalidArgument);
+  ASSERT_EQ(ok.eval(fp(0, 0, 1), SPoint{3, 0}, &v), Status::kOk);
+  EXPECT_EQ(v, 0.0);
+}
+
+}  // namespace
+}  // namespace glintbake::runtime
