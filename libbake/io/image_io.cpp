@@ -27,14 +27,6 @@ std::string oneLine(std::string text) {
   return text.empty() ? std::string("unknown error") : text;
 }
 
-std::string lowerExtension(const std::string& path) {
-  const size_t slash = path.find_last_of("/\\");
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 // Formats whose OIIO writers only take 8-bit integers.
 bool eightBitOnly(const std::string& ext) {
@@ -66,8 +58,17 @@ std::vector<T> quantise(const float* pixels, size_t count, int bits) {
 
 }  // namespace
 
+std::string imageExtension(const std::string& path) {
+  const size_t slash = path.find_last_of("/\\");
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
 bool isFloatImagePath(const std::string& path) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = imageExtension(path);
   return ext == "exr" || ext == "hdr" || ext == "pfm";
 }
 
@@ -88,7 +89,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
                      path + ": no image writer for this file extension (" + oneLine(OIIO::geterror()) + ")");
   }
 
-  const std::string ext = lowerExtension(path);
+  const std::string ext = imageExtension(path);
   const bool is_float = isFloatImagePath(path);
   const int bits = eightBitOnly(ext) ? 8 : options.png_bits;
   OIIO::TypeDesc stored = is_float ? (options.half_float ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT)

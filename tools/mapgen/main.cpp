@@ -17,15 +17,6 @@ namespace cli = glintbake::cli;
 
 constexpr int kDefaultMaxSize = 16384;
 
-std::string lowerExtension(const std::string& path) {
-  const size_t slash = path.find_last_of("/\\");
-  const size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 // The parameters the kind uses, in canonical form.
 Json parametersJson(bake::MapKind kind, const bake::MapParams& p) {
   Json j = Json::object();
@@ -110,7 +101,7 @@ int main(int argc, char** argv) {
                                               std::to_string(params.size) +
                                               (params.size > max_size ? " (raise the limit with --max-size)" : ""));
     }
-    const std::string ext = lowerExtension(output);
+    const std::string ext = bake::imageExtension(output);
     if (ext != "exr" && ext != "png" && ext != "tif" && ext != "tiff") {
       throw Error(cli::kExitBadArguments, "output " + output + " must end in .exr, .png or .tif");
     }

@@ -45,4 +45,7 @@ Status writeNormalMap(const std::string& path, const NormalMap& map, const Image
 // True when writeImage stores float values for this path's extension (.exr, .hdr, .pfm).
 bool isFloatImagePath(const std::string& path);
 
+// The file extension of path in lower case, without the dot ("" when there is none).
+std::string imageExtension(const std::string& path);
+
 }  // namespace glintbake::bake
