@@ -79,5 +79,30 @@ class DepfileWithMake(ToolTestCase):
         self.assertEqual(os.path.getmtime(self.path("b.gbk")), mtime_b)
 
 
+class Interrupt(ToolTestCase):
+    """SIGINT or SIGTERM during a bake leaves neither the output nor a temporary file."""
+
+    def test_interrupted_bake_leaves_nothing(self):
+        if "ndfgen" not in TOOLS:
+            self.skipTest("ndfgen not built")
+        import signal
+        import time
+        src = self.mapgen("scratches", "in.exr", "--size", "256", "--seed", "3")
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            out = self.path("out.gbk")
+            proc = subprocess.Popen([clitest.tool_path("ndfgen"), src, "-o", out, "--quiet", "--stride", "2",
+                                     "--sigma0", "2", "--levels", "6", "-j", "1"],
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            # Wait until the temporary container exists, then interrupt.
+            deadline = time.time() + 30
+            while time.time() < deadline and not any(".tmp" in f for f in os.listdir(self.tmp)):
+                time.sleep(0.05)
+            self.assertTrue(any(".tmp" in f for f in os.listdir(self.tmp)), "no temporary file appeared")
+            proc.send_signal(sig)
+            code = proc.wait(timeout=30)
+            self.assertNotEqual(code, 0)
+            self.assertEqual(sorted(os.listdir(self.tmp)), ["in.exr"])
+
+
 if __name__ == "__main__":
     clitest.main()

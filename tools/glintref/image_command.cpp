@@ -65,6 +65,7 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
 
   if (tool.common().json) {
     cli::Json doc;
+    doc["tool"] = "glintref";
     doc["command"] = "image";
     doc.update(queryJson(options.query, query, lobes));
     doc["res"] = res;

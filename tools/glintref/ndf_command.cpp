@@ -25,6 +25,7 @@ int runNdf(cli::Tool& tool, NdfOptions& options) {
 
   if (tool.common().json) {
     cli::Json doc;
+    doc["tool"] = "glintref";
     doc["command"] = "ndf";
     doc.update(queryJson(options.query, query, lobes));
     doc["s"] = {sx, sy};

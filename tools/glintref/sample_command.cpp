@@ -80,6 +80,7 @@ int runSample(cli::Tool& tool, SampleOptions& options) {
 
   if (json) {
     cli::Json doc;
+    doc["tool"] = "glintref";
     doc["command"] = "sample";
     doc.update(queryJson(options.query, query, sampler.lobeCount()));
     doc["count"] = options.count;

@@ -5,6 +5,7 @@
 #include <glintbake/bake/ltc/ltc.h>
 #include <glintbake/bake/ltc/table.h>
 #include <glintbake/bake/result.h>
+#include <glintbake/cli/container_output.h>
 #include <glintbake/cli/tool.h>
 
 #include <string>
@@ -54,22 +55,5 @@ T unwrap(bake::Result<T> result) {
 inline void check(const bake::Status& status) {
   if (!status.ok()) throw cli::Error(int(status.error().code), status.error().message);
 }
-
-// Writes an image section (format::ImageSectionHeader + floats) to a container writer.
-void addImageSection(class ContainerOutput& out, uint32_t type, uint64_t key, int width, int height, int channels,
-                     const float* data);
-
-// A container output that is removed unless finish() succeeds.
-class ContainerOutput {
- public:
-  ContainerOutput(cli::Tool& tool, const std::string& path, uint32_t asset_kind);
-  ~ContainerOutput();
-  void addSection(uint32_t type, uint64_t key, const void* data, size_t size);
-  void finish(const cli::Json& metadata);
-
- private:
-  struct Impl;
-  Impl* impl_;
-};
 
 }  // namespace glintbake::ltcfit

@@ -10,61 +10,6 @@
 
 namespace glintbake::ltcfit {
 
-struct ContainerOutput::Impl {
-  format::Writer writer;
-  std::string path;
-  bool finished = false;
-};
-
-ContainerOutput::ContainerOutput(cli::Tool& tool, const std::string& path, uint32_t asset_kind) : impl_(new Impl) {
-  impl_->path = path;
-  const format::Status status = impl_->writer.open(path, format::AssetKind(asset_kind));
-  if (status != format::Status::kOk) {
-    delete impl_;
-    throw cli::Error(cli::kExitIo, "cannot write " + path + ": " + format::statusString(status));
-  }
-  cli::registerTemporary(impl_->writer.temporaryPath());
-  tool.addOutput(path);
-}
-
-ContainerOutput::~ContainerOutput() {
-  if (!impl_->finished) {
-    cli::unregisterTemporary(impl_->writer.temporaryPath());
-    impl_->writer.abort();
-  }
-  delete impl_;
-}
-
-void ContainerOutput::addSection(uint32_t type, uint64_t key, const void* data, size_t size) {
-  const format::Status status = impl_->writer.addSection(type, key, data, size);
-  if (status != format::Status::kOk)
-    throw cli::Error(cli::kExitIo, "cannot write " + impl_->path + ": " + format::statusString(status));
-}
-
-void ContainerOutput::finish(const cli::Json& metadata) {
-  const std::string tmp = impl_->writer.temporaryPath();
-  format::Status status = impl_->writer.addMetadata(metadata.dump());
-  if (status == format::Status::kOk) status = impl_->writer.finish();
-  if (status != format::Status::kOk)
-    throw cli::Error(cli::kExitIo, "cannot write " + impl_->path + ": " + format::statusString(status));
-  cli::unregisterTemporary(tmp);
-  impl_->finished = true;
-}
-
-void addImageSection(ContainerOutput& out, uint32_t type, uint64_t key, int width, int height, int channels,
-                     const float* data) {
-  format::ImageSectionHeader header;
-  header.width = uint32_t(width);
-  header.height = uint32_t(height);
-  header.channels = uint32_t(channels);
-  header.layers = 1;
-  const size_t values = size_t(width) * size_t(height) * size_t(channels);
-  std::vector<uint8_t> bytes(sizeof(header) + values * sizeof(float));
-  std::memcpy(bytes.data(), &header, sizeof(header));
-  std::memcpy(bytes.data() + sizeof(header), data, values * sizeof(float));
-  out.addSection(type, key, bytes.data(), bytes.size());
-}
-
 }  // namespace glintbake::ltcfit
 
 int main(int argc, char** argv) {

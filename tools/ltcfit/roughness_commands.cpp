@@ -68,9 +68,9 @@ int runRoughness(cli::Tool& tool, const RoughnessArgs& args) {
                          {"alpha_micro", args.alpha_micro},
                          {"quantity", "overall GGX alpha per texel (Tao et al. 2021)"},
                          {"section", {{"type", format::kSectionRoughness}, {"key", "mip level"}}}};
-    ContainerOutput out(tool, args.container, uint32_t(format::AssetKind::kRoughness));
+    cli::ContainerOutput out(tool, args.container, format::AssetKind::kRoughness);
     for (size_t i = 0; i < levels.size(); ++i)
-      addImageSection(out, format::kSectionRoughness, i, levels[i].width, levels[i].height, 1, levels[i].alpha.data());
+      out.addImageSection(format::kSectionRoughness, i, levels[i].width, levels[i].height, 1, levels[i].alpha.data());
     out.finish(metadata);
   }
   const bake::Status status = bake::ltc::writeRoughnessExr(levels, args.output);

@@ -64,9 +64,9 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
                                      {"ltc_2", {{"type", format::kSectionLtcTable}, {"key", 1}}}}}};
 
   {
-    ContainerOutput out(tool, args.output, uint32_t(format::AssetKind::kLtcTable));
-    addImageSection(out, format::kSectionLtcTable, 0, args.size, args.size, 4, published.ltc1.data());
-    addImageSection(out, format::kSectionLtcTable, 1, args.size, args.size, 4, published.ltc2.data());
+    cli::ContainerOutput out(tool, args.output, format::AssetKind::kLtcTable);
+    out.addImageSection(format::kSectionLtcTable, 0, args.size, args.size, 4, published.ltc1.data());
+    out.addImageSection(format::kSectionLtcTable, 1, args.size, args.size, 4, published.ltc2.data());
     out.finish(metadata);
   }
   cli::Json files = cli::Json::array();

@@ -1,6 +1,7 @@
 // ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
 // ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md).
 #include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/cli/container_output.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
@@ -84,22 +85,14 @@ int main(int argc, char** argv) {
                                               std::to_string(map.width) + "x" + std::to_string(map.height) + ")");
     }
 
-    format::Writer writer;
-    if (format::Status s = writer.open(output, format::AssetKind::kNdfPyramid, zstd_level); s != format::Status::kOk) {
-      throw Error(cli::kExitIo, "cannot create " + output + ": " + format::statusString(s));
-    }
-    cli::registerTemporary(writer.temporaryPath());
-    struct Unregister {
-      std::string path;
-      ~Unregister() { cli::unregisterTemporary(path); }
-    } unregister{writer.temporaryPath()};
+    cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
 
     std::unique_ptr<cli::Progress> bar;
     int bar_level = -1;
     uint64_t bar_done = 0;
     bake::ndf::PyramidReport report;
     bake::Status built = bake::ndf::buildNdfPyramid(
-        map, opt, writer, &report, [&](int level, uint64_t done, uint64_t total) {
+        map, opt, out.writer(), &report, [&](int level, uint64_t done, uint64_t total) {
           if (level != bar_level) {
             if (bar) bar->finish();
             bar = t.progress("level " + std::to_string(level), total);
@@ -111,7 +104,6 @@ int main(int argc, char** argv) {
         });
     if (bar) bar->finish();
     if (!built) {
-      writer.abort();
       throw Error(exitCodeOf(built.error().code), built.error().message);
     }
 
@@ -139,13 +131,7 @@ int main(int argc, char** argv) {
     for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
     asset["stop_reason"] = report.stop_reason;
     meta["asset"] = asset;
-    if (format::Status s = writer.addMetadata(meta.dump()); s != format::Status::kOk) {
-      throw Error(cli::kExitIo, "cannot write " + output + ": " + format::statusString(s));
-    }
-    if (format::Status s = writer.finish(); s != format::Status::kOk) {
-      throw Error(cli::kExitIo, "cannot write " + output + ": " + format::statusString(s));
-    }
-    t.addOutput(output);
+    out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     uint64_t raw = 0, stored = 0, images = 0;
@@ -177,12 +163,12 @@ int main(int argc, char** argv) {
       doc["flakes"] = report.flakes;
       doc["images"] = images;
       doc["raw_bytes"] = raw;
-      doc["file_bytes"] = writer.bytesWritten();
+      doc["file_bytes"] = out.bytesWritten();
       doc["seconds"] = seconds;
       t.printJson(doc);
     } else {
       t.info("wrote " + output + ": " + std::to_string(report.levels.size()) + " levels, " + std::to_string(images) +
-             " images, " + std::to_string(writer.bytesWritten()) + " bytes (" + std::to_string(raw) +
+             " images, " + std::to_string(out.bytesWritten()) + " bytes (" + std::to_string(raw) +
              " raw) in " + std::to_string(seconds) + " s");
     }
     return cli::kExitOk;

@@ -1,0 +1,50 @@
+#include <glintbake/cli/container_output.h>
+
+#include <cstring>
+#include <vector>
+
+namespace glintbake::cli {
+
+ContainerOutput::ContainerOutput(Tool& tool, const std::string& path, format::AssetKind kind, int zstd_level)
+    : path_(path) {
+  const format::Status status = writer_.open(path, kind, zstd_level);
+  if (status != format::Status::kOk) {
+    throw Error(kExitIo, "cannot create " + path + ": " + format::statusString(status));
+  }
+  temporary_ = writer_.temporaryPath();
+  registerTemporary(temporary_);
+  tool.addOutput(path);
+}
+
+ContainerOutput::~ContainerOutput() {
+  if (!finished_) writer_.abort();
+  unregisterTemporary(temporary_);
+}
+
+void ContainerOutput::addSection(uint32_t type, uint64_t key, const void* data, size_t size) {
+  const format::Status status = writer_.addSection(type, key, data, size);
+  if (status != format::Status::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+}
+
+void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, int height, int channels,
+                                      const float* data, int layers) {
+  format::ImageSectionHeader header;
+  header.width = uint32_t(width);
+  header.height = uint32_t(height);
+  header.channels = uint32_t(channels);
+  header.layers = uint32_t(layers);
+  const size_t values = size_t(width) * size_t(height) * size_t(channels) * size_t(layers);
+  std::vector<uint8_t> bytes(sizeof(header) + values * sizeof(float));
+  std::memcpy(bytes.data(), &header, sizeof(header));
+  std::memcpy(bytes.data() + sizeof(header), data, values * sizeof(float));
+  addSection(type, key, bytes.data(), bytes.size());
+}
+
+void ContainerOutput::finish(const Json& metadata) {
+  format::Status status = writer_.addMetadata(metadata.dump());
+  if (status == format::Status::kOk) status = writer_.finish();
+  if (status != format::Status::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+  finished_ = true;
+}
+
+}  // namespace glintbake::cli
