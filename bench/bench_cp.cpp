@@ -13,8 +13,8 @@
 #include <benchmark/benchmark.h>
 
 #include <map>
-#include <random>
 #include <memory>
+#include <random>
 
 namespace {
 

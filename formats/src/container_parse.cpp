@@ -95,9 +95,8 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
     return check.status();
   }
   if (hi.version_minor > kFormatVersionMinor) {
-    check.warn(2014, "container format 1." + std::to_string(hi.version_minor) +
-                         " is newer than this reader (1." + std::to_string(kFormatVersionMinor) +
-                         "); sections of unknown types are skipped");
+    check.warn(2014, "container format 1." + std::to_string(hi.version_minor) + " is newer than this reader (1." +
+                         std::to_string(kFormatVersionMinor) + "); sections of unknown types are skipped");
   }
 
   hi.asset_kind = load32(h + kOffAssetKind);
@@ -141,9 +140,9 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
     return check.status();
   }
   if (actual_size < hi.file_size) {
-    check.fail(Status::kTruncated, 2011,
-               "file is truncated: " + std::to_string(actual_size) + " bytes, header says " +
-                   std::to_string(hi.file_size));
+    check.fail(
+        Status::kTruncated, 2011,
+        "file is truncated: " + std::to_string(actual_size) + " bytes, header says " + std::to_string(hi.file_size));
     return check.status();
   }
   if (actual_size > hi.file_size) {
@@ -189,7 +188,8 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
 
     const std::string name = "section " + std::to_string(i);
     if (s.offset % kSectionAlignment != 0) {
-      if (check.fail(Status::kCorruptIndex, 3002, name + ": offset " + std::to_string(s.offset) + " is not a multiple of 64"))
+      if (check.fail(Status::kCorruptIndex, 3002,
+                     name + ": offset " + std::to_string(s.offset) + " is not a multiple of 64"))
         return;
     }
     if (s.offset < kHeaderSize || s.offset > hi.index_offset || s.stored_size > hi.index_offset - s.offset) {
@@ -214,8 +214,8 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
       const size_t bound = s.raw_size <= uint64_t(SIZE_MAX / 2) ? ZSTD_compressBound(size_t(s.raw_size)) : 0;
       if (s.stored_size == 0 || bound == 0 || ZSTD_isError(bound) || s.stored_size > bound) {
         if (check.fail(Status::kCorruptIndex, 3007,
-                       name + ": zstd stored_size " + std::to_string(s.stored_size) +
-                           " is impossible for raw_size " + std::to_string(s.raw_size)))
+                       name + ": zstd stored_size " + std::to_string(s.stored_size) + " is impossible for raw_size " +
+                           std::to_string(s.raw_size)))
           return;
       }
     } else {

@@ -7,18 +7,30 @@ namespace glintbake::format {
 
 const char* statusString(Status status) {
   switch (status) {
-    case Status::kOk: return "ok";
-    case Status::kIoError: return "i/o error";
-    case Status::kBadMagic: return "not a glintbake container";
-    case Status::kUnsupportedVersion: return "unsupported container version";
-    case Status::kCorruptHeader: return "corrupt header";
-    case Status::kCorruptIndex: return "corrupt section index";
-    case Status::kChecksumMismatch: return "checksum mismatch";
-    case Status::kDecompressFailed: return "section does not decode";
-    case Status::kTooLarge: return "exceeds a reader limit";
-    case Status::kNotFound: return "section not found";
-    case Status::kInvalidArgument: return "invalid argument";
-    case Status::kTruncated: return "file is truncated";
+    case Status::kOk:
+      return "ok";
+    case Status::kIoError:
+      return "i/o error";
+    case Status::kBadMagic:
+      return "not a glintbake container";
+    case Status::kUnsupportedVersion:
+      return "unsupported container version";
+    case Status::kCorruptHeader:
+      return "corrupt header";
+    case Status::kCorruptIndex:
+      return "corrupt section index";
+    case Status::kChecksumMismatch:
+      return "checksum mismatch";
+    case Status::kDecompressFailed:
+      return "section does not decode";
+    case Status::kTooLarge:
+      return "exceeds a reader limit";
+    case Status::kNotFound:
+      return "section not found";
+    case Status::kInvalidArgument:
+      return "invalid argument";
+    case Status::kTruncated:
+      return "file is truncated";
   }
   return "unknown status";
 }
@@ -58,8 +70,10 @@ bool assetKindFromString(const std::string& name, AssetKind* kind) {
 
 const char* codecString(Codec codec) {
   switch (codec) {
-    case Codec::kRaw: return "raw";
-    case Codec::kZstd: return "zstd";
+    case Codec::kRaw:
+      return "raw";
+    case Codec::kZstd:
+      return "zstd";
   }
   return "unknown";
 }
@@ -72,8 +86,9 @@ struct TypeName {
 };
 
 constexpr TypeName kTypeNames[] = {
-    {kSectionMetadata, "metadata"},       {kSectionNdfLevel, "ndf-level"}, {kSectionNdfChunk, "ndf-chunk"},
-    {kSectionTensorIndex, "tensor-index"}, {kSectionLtcTable, "ltc-table"}, {kSectionRoughness, "roughness"},
+    {kSectionMetadata, "metadata"},  {kSectionNdfLevel, "ndf-level"},
+    {kSectionNdfChunk, "ndf-chunk"}, {kSectionTensorIndex, "tensor-index"},
+    {kSectionLtcTable, "ltc-table"}, {kSectionRoughness, "roughness"},
     {kSectionImage, "image"},
 };
 
@@ -101,10 +116,14 @@ bool sectionTypeFromString(const std::string& name, uint32_t* type) {
   for (size_t i = start; i < name.size(); ++i) {
     const char c = name[i];
     int digit;
-    if (c >= '0' && c <= '9') digit = c - '0';
-    else if (hex && c >= 'a' && c <= 'f') digit = c - 'a' + 10;
-    else if (hex && c >= 'A' && c <= 'F') digit = c - 'A' + 10;
-    else return false;
+    if (c >= '0' && c <= '9')
+      digit = c - '0';
+    else if (hex && c >= 'a' && c <= 'f')
+      digit = c - 'a' + 10;
+    else if (hex && c >= 'A' && c <= 'F')
+      digit = c - 'A' + 10;
+    else
+      return false;
     value = value * (hex ? 16 : 10) + uint64_t(digit);
     if (value > UINT32_MAX) return false;
   }

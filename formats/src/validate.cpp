@@ -27,9 +27,7 @@ class Collector final : public detail::Diagnostics {
  public:
   explicit Collector(std::vector<ValidationMessage>* messages) : messages_(messages) {}
   void error(int id, const std::string& message) override { messages_->push_back({id, Severity::kError, message}); }
-  void warning(int id, const std::string& message) override {
-    messages_->push_back({id, Severity::kWarning, message});
-  }
+  void warning(int id, const std::string& message) override { messages_->push_back({id, Severity::kWarning, message}); }
 
  private:
   std::vector<ValidationMessage>* messages_;
@@ -52,16 +50,30 @@ bool isRegisteredType(uint32_t type) {
 // The range of section types owned by an asset kind, if it has one.
 bool kindTypeRange(AssetKind kind, uint32_t* first, uint32_t* last) {
   switch (kind) {
-    case AssetKind::kNdfPyramid: *first = kSectionNdfLevel; *last = kSectionNdfChunk; return true;
-    case AssetKind::kTensorNdf: *first = kSectionTensorIndex; *last = kSectionTensorIndex + 15; return true;
-    case AssetKind::kLtcTable: *first = kSectionLtcTable; *last = kSectionLtcTable + 15; return true;
-    case AssetKind::kRoughness: *first = kSectionRoughness; *last = kSectionRoughness + 15; return true;
-    default: return false;
+    case AssetKind::kNdfPyramid:
+      *first = kSectionNdfLevel;
+      *last = kSectionNdfChunk;
+      return true;
+    case AssetKind::kTensorNdf:
+      *first = kSectionTensorIndex;
+      *last = kSectionTensorIndex + 15;
+      return true;
+    case AssetKind::kLtcTable:
+      *first = kSectionLtcTable;
+      *last = kSectionLtcTable + 15;
+      return true;
+    case AssetKind::kRoughness:
+      *first = kSectionRoughness;
+      *last = kSectionRoughness + 15;
+      return true;
+    default:
+      return false;
   }
 }
 
 std::string describe(size_t index, const SectionInfo& s) {
-  return "section " + std::to_string(index) + " (type " + std::to_string(s.type) + ", key " + std::to_string(s.key) + ")";
+  return "section " + std::to_string(index) + " (type " + std::to_string(s.type) + ", key " + std::to_string(s.key) +
+         ")";
 }
 
 void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
@@ -75,8 +87,8 @@ void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uin
   ImageSectionHeader header;
   if (!parseImageSection(raw.data(), raw.size(), &header)) {
     addError(messages, 4005,
-             describe(index, s) + ": image header dimensions do not match the section's " +
-                 std::to_string(raw.size()) + " bytes");
+             describe(index, s) + ": image header dimensions do not match the section's " + std::to_string(raw.size()) +
+                 " bytes");
     return;
   }
   if (header.flags != 0 || header.reserved != 0) {
@@ -101,9 +113,12 @@ int jsonDepth(const std::string& text) {
   bool in_string = false, escaped = false;
   for (char c : text) {
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '{' || c == '[') {
@@ -116,10 +131,10 @@ int jsonDepth(const std::string& text) {
 }
 
 bool looksLikeAbsolutePath(const std::string& s) {
-  if (s.size() >= 2 && s[0] == '/' && s[1] != ' ') return true;  // POSIX
+  if (s.size() >= 2 && s[0] == '/' && s[1] != ' ') return true;    // POSIX
   if (s.size() >= 2 && s[0] == '\\' && s[1] == '\\') return true;  // UNC
   if (s.size() >= 3 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':' && (s[2] == '\\' || s[2] == '/'))
-    return true;  // drive letter
+    return true;                                                 // drive letter
   if (s.size() >= 2 && s[0] == '~' && s[1] == '/') return true;  // home-relative
   return false;
 }
@@ -248,7 +263,8 @@ void validateMetadata(const std::string& text, AssetKind kind, std::vector<Valid
     stack.pop_back();
     if (node->is_string()) {
       if (looksLikeAbsolutePath(node->get_ref<const std::string&>())) {
-        addError(messages, 5014, "metadata " + (where.empty() ? std::string("value") : where) + " holds an absolute path");
+        addError(messages, 5014,
+                 "metadata " + (where.empty() ? std::string("value") : where) + " holds an absolute path");
       }
     } else if (node->is_object()) {
       for (auto it = node->begin(); it != node->end(); ++it) stack.emplace_back(&*it, where + "/" + it.key());
@@ -268,10 +284,9 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   detail::ParsedContainer parsed;
   report.status = detail::parseContainer(source, reader_options, &parsed, &collector);
   // Header errors, or an index that fails its checksum, leave nothing trustworthy to look at.
-  const bool structure_unusable =
-      std::any_of(report.messages.begin(), report.messages.end(), [](const ValidationMessage& m) {
-        return m.severity == Severity::kError && (m.id < 3000 || m.id == 3001);
-      });
+  const bool structure_unusable = std::any_of(
+      report.messages.begin(), report.messages.end(),
+      [](const ValidationMessage& m) { return m.severity == Severity::kError && (m.id < 3000 || m.id == 3001); });
   if (structure_unusable || parsed.sections.size() != parsed.header.section_count) return report;
 
   auto noteStatus = [&](Status status) {
@@ -345,12 +360,13 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
 
   // 6xxx: kind-specific.
   if (std::strcmp(assetKindString(kind), "unknown") == 0) {
-    addWarning(&report.messages, 6001, "asset kind " + std::to_string(parsed.header.asset_kind) + " is not known to this version");
+    addWarning(&report.messages, 6001,
+               "asset kind " + std::to_string(parsed.header.asset_kind) + " is not known to this version");
   }
   uint32_t first = 0, last = 0;
-  if (kindTypeRange(kind, &first, &last) &&
-      std::none_of(sections.begin(), sections.end(),
-                   [&](const SectionInfo& s) { return s.type >= first && s.type <= last; })) {
+  if (kindTypeRange(kind, &first, &last) && std::none_of(sections.begin(), sections.end(), [&](const SectionInfo& s) {
+        return s.type >= first && s.type <= last;
+      })) {
     addWarning(&report.messages, 6002,
                std::string("a ") + assetKindString(kind) + " asset holds no section of types " + std::to_string(first) +
                    "-" + std::to_string(last));

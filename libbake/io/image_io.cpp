@@ -27,7 +27,6 @@ std::string oneLine(std::string text) {
   return text.empty() ? std::string("unknown error") : text;
 }
 
-
 // Formats whose OIIO writers only take 8-bit integers.
 bool eightBitOnly(const std::string& ext) {
   return ext == "jpg" || ext == "jpeg" || ext == "webp" || ext == "bmp" || ext == "gif" || ext == "tga";

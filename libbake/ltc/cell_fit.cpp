@@ -36,8 +36,7 @@ CellMoments computeMoments(BrdfKind brdf, Vec3 v, double alpha, int samples) {
   return moments;
 }
 
-CellObjective::CellObjective(BrdfKind brdf, Vec3 v, double alpha, int samples)
-    : brdf_(brdf), v_(v), alpha_(alpha) {
+CellObjective::CellObjective(BrdfKind brdf, Vec3 v, double alpha, int samples) : brdf_(brdf), v_(v), alpha_(alpha) {
   const size_t n = size_t(samples) * size_t(samples);
   cosine_.reserve(n);
   brdf_dirs_.reserve(n);

@@ -7,10 +7,10 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 
+#include <unistd.h>
 #include <atomic>
 #include <cstdio>
 #include <exception>
-#include <unistd.h>
 
 namespace glintbake::bake::ltc {
 
@@ -42,9 +42,8 @@ Status writeExr(const std::string& path, const std::vector<std::string>& channel
     Imf::FrameBuffer frame;
     for (size_t c = 0; c < channels; ++c) {
       header.channels().insert(channel_names[c], Imf::Channel(Imf::FLOAT));
-      frame.insert(channel_names[c],
-                   Imf::Slice(Imf::FLOAT, (char*)(image.pixels + c), sizeof(float) * channels,
-                              sizeof(float) * channels * size_t(image.width)));
+      frame.insert(channel_names[c], Imf::Slice(Imf::FLOAT, (char*)(image.pixels + c), sizeof(float) * channels,
+                                                sizeof(float) * channels * size_t(image.width)));
     }
     Imf::OutputFile file(tmp.c_str(), header);
     file.setFrameBuffer(frame);
@@ -56,7 +55,8 @@ Status writeExr(const std::string& path, const std::vector<std::string>& channel
   return commit(tmp, path);
 }
 
-Status writeMipmappedExr(const std::string& path, const std::string& channel_name, const std::vector<ExrLevel>& levels) {
+Status writeMipmappedExr(const std::string& path, const std::string& channel_name,
+                         const std::vector<ExrLevel>& levels) {
   if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no image levels to write");
   const std::string tmp = temporaryName(path);
   try {
@@ -71,8 +71,8 @@ Status writeMipmappedExr(const std::string& path, const std::string& channel_nam
       if (file.levelWidth(l) != level.width || file.levelHeight(l) != level.height)
         throw std::runtime_error("mip level size mismatch");
       Imf::FrameBuffer frame;
-      frame.insert(channel_name, Imf::Slice(Imf::FLOAT, (char*)level.pixels, sizeof(float),
-                                            sizeof(float) * size_t(level.width)));
+      frame.insert(channel_name,
+                   Imf::Slice(Imf::FLOAT, (char*)level.pixels, sizeof(float), sizeof(float) * size_t(level.width)));
       file.setFrameBuffer(frame);
       file.writeTiles(0, file.numXTiles(l) - 1, 0, file.numYTiles(l) - 1, l);
     }

@@ -24,8 +24,10 @@ Vec3 cellView(int t, int size) {
 
 const char* fitMethodString(FitMethod method) {
   switch (method) {
-    case FitMethod::kPublished: return "published";
-    case FitMethod::kRefined: return "refined";
+    case FitMethod::kPublished:
+      return "published";
+    case FitMethod::kRefined:
+      return "refined";
   }
   return "unknown";
 }

@@ -36,8 +36,10 @@ Mat3 inverse(const Mat3& a) {
 
 const char* brdfKindString(BrdfKind kind) {
   switch (kind) {
-    case BrdfKind::kGgx: return "ggx";
-    case BrdfKind::kBeckmann: return "beckmann";
+    case BrdfKind::kGgx:
+      return "ggx";
+    case BrdfKind::kBeckmann:
+      return "beckmann";
   }
   return "unknown";
 }
@@ -103,8 +105,8 @@ double evalBrdf(BrdfKind kind, Vec3 v, Vec3 l, double alpha, double* pdf) {
 
 Vec3 sampleBrdf(BrdfKind kind, Vec3 v, double alpha, double u1, double u2) {
   const double phi = 2.0 * kPi * u1;
-  const double r = kind == BrdfKind::kGgx ? alpha * std::sqrt(u2 / (1.0 - u2))
-                                          : std::sqrt(-alpha * alpha * std::log(1.0 - u2));
+  const double r =
+      kind == BrdfKind::kGgx ? alpha * std::sqrt(u2 / (1.0 - u2)) : std::sqrt(-alpha * alpha * std::log(1.0 - u2));
   const Vec3 n = normalize(Vec3{r * std::cos(phi), r * std::sin(phi), 1.0});
   return 2.0 * dot(n, v) * n - v;
 }

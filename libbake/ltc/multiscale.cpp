@@ -16,7 +16,7 @@ namespace {
 // Results of fitMultiscale() at its defaults (256 meso points, 9 x 9 combine grid); the unit tests
 // refit and check them.
 constexpr std::array<double, 5> kMesoFitCoefficients = {0.444866589, 5.452478761, 0.9965650275, 6.451670751,
-                                                         -7.375820039};
+                                                        -7.375820039};
 constexpr std::array<double, 3> kCombineFitCoefficients = {-0.9643196139, 0.107777481, 0.1073185619};
 
 // Composite Simpson rule of |b|'s integrand: accurate where the closed form cancels (alpha ~ 1).
@@ -221,8 +221,10 @@ CombineFit defaultCombineFit() {
 }
 
 Result<MultiscaleFit> fitMultiscale(int meso_points, int combine_grid) {
-  if (meso_points < 8 || meso_points > 100000) return makeError(ErrorCode::kBadArgument, "meso points must be in [8, 100000]");
-  if (combine_grid < 3 || combine_grid > 64) return makeError(ErrorCode::kBadArgument, "combine grid must be in [3, 64]");
+  if (meso_points < 8 || meso_points > 100000)
+    return makeError(ErrorCode::kBadArgument, "meso points must be in [8, 100000]");
+  if (combine_grid < 3 || combine_grid > 64)
+    return makeError(ErrorCode::kBadArgument, "combine grid must be in [3, 64]");
   MultiscaleFit fit;
   fit.meso_points = meso_points;
   fit.combine_grid = combine_grid;
@@ -237,9 +239,9 @@ Result<MultiscaleFit> fitMultiscale(int meso_points, int combine_grid) {
   {
     ceres::Problem problem;
     for (const auto& [length, alpha] : meso)
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<MesoResidual, 1, 5>(
-                                   new MesoResidual{std::sqrt(1.0 - length), alpha}),
-                               nullptr, fit.meso.c.data());
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<MesoResidual, 1, 5>(new MesoResidual{std::sqrt(1.0 - length), alpha}),
+          nullptr, fit.meso.c.data());
     solveQuietly(&problem);
   }
   int count = 0;
@@ -268,8 +270,7 @@ Result<MultiscaleFit> fitMultiscale(int meso_points, int combine_grid) {
     const double a_mi = double(index % g) / (g - 1);
     const double a_me = double(index / g) / (g - 1);
     // Both are compared unclamped-to-truth: the truth itself may exceed 1 for rough inputs.
-    accumulate(&fit.combine_error, combineForm(fit.combine.k.data(), a_mi, a_me) - truth[size_t(index)],
-               &count_ours);
+    accumulate(&fit.combine_error, combineForm(fit.combine.k.data(), a_mi, a_me) - truth[size_t(index)], &count_ours);
     accumulate(&fit.combine_paper_error, combinePaper(a_mi, a_me) - truth[size_t(index)], &count_paper);
   }
   fit.combine_error.rms = std::sqrt(fit.combine_error.rms / count_ours);

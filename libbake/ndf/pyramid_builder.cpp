@@ -18,12 +18,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr int kConvergenceSamplesPerAxis = 4;
-constexpr int kSplitParts = 16;          // row sets of a split footprint
-constexpr double kSplitFlakes = 1 << 18; // split footprints with more flakes than this
+constexpr int kSplitParts = 16;           // row sets of a split footprint
+constexpr double kSplitFlakes = 1 << 18;  // split footprints with more flakes than this
 
-double secondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Relative MSE of image a against b: sum (a - b)^2 / sum b^2 (0 when both vanish).
 double relativeMse(const float* a, const double* b, size_t n) {
@@ -39,8 +37,8 @@ double relativeMse(const float* a, const double* b, size_t n) {
 // A convergence sample: one centre of a level and the runtime's prediction of its image from the
 // level below (the bilinear blend of up to 4 centres of that level, as NdfPyramid blends them).
 struct Sample {
-  int centre = 0;                  // index j * grid_width + i on its own level
-  int below[4] = {-1, -1, -1, -1}; // centres of the level below
+  int centre = 0;                   // index j * grid_width + i on its own level
+  int below[4] = {-1, -1, -1, -1};  // centres of the level below
   double weight[4] = {0, 0, 0, 0};
   std::vector<double> prediction;  // R * R, accumulated while the level below is written
 };
@@ -127,8 +125,7 @@ LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions&
 }
 
 Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
-                       PyramidReport* report, const PyramidProgress& progress,
-                       const std::atomic<bool>* cancel) {
+                       PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
   if (Status s = validatePyramidOptions(options); !s) return s;
   PyramidReport local_report;
   PyramidReport& rep = report ? *report : local_report;

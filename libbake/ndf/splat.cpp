@@ -70,8 +70,7 @@ inline double phiPdf(double z) {
 
 }  // namespace
 
-Splatter::Splatter(const FlakeSet& flakes, const SplatParams& params)
-    : flakes_(flakes), params_(params) {
+Splatter::Splatter(const FlakeSet& flakes, const SplatParams& params) : flakes_(flakes), params_(params) {
   const int r = params_.ndf_res;
   acc_.assign(size_t(r) * size_t(r), 0.0);
   inside_disk_.resize(size_t(r) * size_t(r));
@@ -89,7 +88,7 @@ Splatter::Splatter(const FlakeSet& flakes, const SplatParams& params)
 // He_4, below 2e-4 for sigma >= 1.5 h. The Gaussian is evaluated along each row with the
 // two-multiply recurrence of exp(quadratic), so a bin costs about as much as an addition.
 static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, double caa, double cab, double cbb,
-                   double mass, double truncation) {
+                          double mass, double truncation) {
   const double h = 2.0 / res;
   caa += h * h / 12.0;
   cbb += h * h / 12.0;
@@ -97,8 +96,8 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
   const double pa = cbb / det, pab = -cab / det, pb = caa / det;  // precision matrix
   const double bin_mass = mass * h * h / (2.0 * kPi * std::sqrt(det));
   const double sd_b = std::sqrt(cbb);
-  const double slope = cab / cbb;                         // E[a | b] = mean_a + slope (b - mean_b)
-  const double cond_sd_a = std::sqrt(det / cbb);          // std of a given b
+  const double slope = cab / cbb;                 // E[a | b] = mean_a + slope (b - mean_b)
+  const double cond_sd_a = std::sqrt(det / cbb);  // std of a given b
   const int j0 = std::max(0, int(std::floor((mean_b - truncation * sd_b + 1.0) / h)));
   const int j1 = std::min(res - 1, int(std::floor((mean_b + truncation * sd_b + 1.0) / h)));
   const double g = std::exp(-pa * h * h);
@@ -132,8 +131,8 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
   }
 }
 
-void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, double cxx, double cxy,
-                         double cyy, double mass, double truncation) {
+void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, double cxx, double cxy, double cyy,
+                         double mass, double truncation) {
   {
     // Smallest eigenvalue of the covariance decides between the two integration schemes.
     const double h = 2.0 / res;
@@ -242,8 +241,8 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
   const double radius2 = radius * radius;
   const double spatial_norm = f.area / (2.0 * kPi * s2);
   const double inv_2s2 = 0.5 / s2;
-  const double t = sh2 / s2;          // mean shift factor of mu_k
-  const double kc = sh2 * sp2 / s2;   // J diag(kc) J^T term of C_k
+  const double t = sh2 / s2;         // mean shift factor of mu_k
+  const double kc = sh2 * sp2 / s2;  // J diag(kc) J^T term of C_k
   const double sr2 = params_.sigma_r * params_.sigma_r;
   const double trunc = params_.lobe_truncation;
 

@@ -20,9 +20,12 @@ namespace glintbake::bake::tensor {
 
 const char* cpMethodName(CpMethod method) {
   switch (method) {
-    case CpMethod::kCompressed: return "compressed";
-    case CpMethod::kAls: return "als";
-    case CpMethod::kAlsPlain: return "als-plain";
+    case CpMethod::kCompressed:
+      return "compressed";
+    case CpMethod::kAls:
+      return "als";
+    case CpMethod::kAlsPlain:
+      return "als-plain";
   }
   return "unknown";
 }
@@ -283,8 +286,8 @@ double cpReconstructionError(const GroupTensor& tensor, const CpFactors& f) {
       for (int i = 0; i < tensor.bins; ++i) {
         double model = 0.0;
         for (int r = 0; r < f.rank; ++r) {
-          model += static_cast<double>(f.a[static_cast<size_t>(i) * f.rank + r]) * f.b[static_cast<size_t>(j) * f.rank + r] *
-                   f.c[static_cast<size_t>(k) * f.rank + r];
+          model += static_cast<double>(f.a[static_cast<size_t>(i) * f.rank + r]) *
+                   f.b[static_cast<size_t>(j) * f.rank + r] * f.c[static_cast<size_t>(k) * f.rank + r];
         }
         const double v = tensor.at(k, i, j);
         diff += (v - model) * (v - model);

@@ -86,7 +86,8 @@ void CpEngine::contractModeB(const MatF& a, MatD& out) const {
 
 void CpEngine::contractModeC(const MatF& a, const MatF& b) {
   for (int r = 0; r < rank_; ++r) {
-    for (int j = 0; j < bins_; ++j) kr_.col(r).segment(static_cast<Eigen::Index>(j) * bins_, bins_) = a.col(r) * b(j, r);
+    for (int j = 0; j < bins_; ++j)
+      kr_.col(r).segment(static_cast<Eigen::Index>(j) * bins_, bins_) = a.col(r) * b(j, r);
   }
   mc_.noalias() = xt_.transpose() * kr_;
 }

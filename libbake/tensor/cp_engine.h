@@ -8,7 +8,7 @@
 
 namespace glintbake::bake::tensor {
 
-using MatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;   // column-major
+using MatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;  // column-major
 using MatD = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
 
 // Factor matrices, column-major: a (B x R), b (B x R), c (K x R). After a sweep, a and b have
@@ -43,24 +43,24 @@ class CpEngine {
   double solveC(CpState& s, double ridge, bool nonneg);
 
  private:
-  void contractW(const MatF& c);                         // w_ = X^T C
-  void contractModeA(const MatF& b, MatD& out) const;    // out(i, r) = sum_j W_r(i, j) b(j, r)
-  void contractModeB(const MatF& a, MatD& out) const;    // out(j, r) = sum_i W_r(i, j) a(i, r)
-  void contractModeC(const MatF& a, const MatF& b);      // mc_ = X (B kr A)
+  void contractW(const MatF& c);                       // w_ = X^T C
+  void contractModeA(const MatF& b, MatD& out) const;  // out(i, r) = sum_j W_r(i, j) b(j, r)
+  void contractModeB(const MatF& a, MatD& out) const;  // out(j, r) = sum_i W_r(i, j) a(i, r)
+  void contractModeC(const MatF& a, const MatF& b);    // mc_ = X (B kr A)
   // Squared error of the model (A, B, c); requires contractModeC(A, B) to have run.
   double errorSquared(const MatD& ata, const MatD& btb, const MatF& c) const;
 
   Eigen::Map<const MatF> xt_;  // (B*B) x K
   int bins_, blocks_, rank_;
   double norm_sq_ = 0.0;
-  MatF w_;    // (B*B) x R
-  MatF kr_;   // (B*B) x R
-  MatF mc_;   // K x R
-  MatD m_;    // B x R scratch
+  MatF w_;   // (B*B) x R
+  MatF kr_;  // (B*B) x R
+  MatF mc_;  // K x R
+  MatD m_;   // B x R scratch
 };
 
 // Column-wise helpers shared by the drivers.
-MatD gram(const MatF& m);                                     // m^T m in double
+MatD gram(const MatF& m);  // m^T m in double
 // Scales m's columns to unit norm (zero columns stay zero) and multiplies absorb's columns by the
 // norms (when given). Returns the norms (1 for zero columns).
 Eigen::VectorXd normaliseColumns(MatF& m, MatF* absorb);

@@ -21,7 +21,8 @@ double median(std::vector<double> v) {
 
 CpSweepTiming timeCpSweeps(const GroupTensor& tensor, int rank, int sweeps) {
   CpSweepTiming timing;
-  const size_t expected = static_cast<size_t>(tensor.bins) * tensor.bins * static_cast<size_t>(std::max(tensor.blocks, 0));
+  const size_t expected =
+      static_cast<size_t>(tensor.bins) * tensor.bins * static_cast<size_t>(std::max(tensor.blocks, 0));
   if (sweeps < 1 || rank < 1 || rank > kMaxCpRank || tensor.bins < 1 || tensor.bins > kMaxBlockBins ||
       tensor.blocks < 1 || tensor.values.size() != expected) {
     return timing;

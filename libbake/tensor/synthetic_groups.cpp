@@ -66,7 +66,8 @@ GroupTensor makeLowRankGroup(int bins, int blocks, int rank, uint64_t seed) {
       for (int i = 0; i < bins; ++i) {
         double sum = 0.0;
         for (int r = 0; r < rank; ++r) {
-          sum += a[static_cast<size_t>(i) * rank + r] * b[static_cast<size_t>(j) * rank + r] * c[static_cast<size_t>(k) * rank + r];
+          sum += a[static_cast<size_t>(i) * rank + r] * b[static_cast<size_t>(j) * rank + r] *
+                 c[static_cast<size_t>(k) * rank + r];
         }
         t.values[(static_cast<size_t>(k) * bins + j) * bins + i] = static_cast<float>(sum);
       }

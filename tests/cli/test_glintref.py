@@ -47,6 +47,18 @@ class GlintRef(ToolTestCase):
         out, _ = self.run_ok("glintref", "ndf", self.map, *AT, "--s", "0.05,-0.02")
         self.assertEqual(float(out.strip()), doc["value"])
 
+    def test_schemas_are_strict(self):
+        import jsonschema
+        doc = self.run_json("glintref", "sample", self.map, *AT, "--count", "2", schema="glintref-sample.schema.json")
+        for mutate in (lambda d: d.update(extra=1), lambda d: d.pop("total_weight"),
+                       lambda d: d["ingest"].pop("hash"), lambda d: d["map"].update(wrap="mirror"),
+                       lambda d: d.update(output={"name": "s.csv", "format": "csv"}),
+                       lambda d: d.update(samples=[[0.1]]), lambda d: d["footprint"].update(sigma=0)):
+            bad = json.loads(json.dumps(doc))
+            mutate(bad)
+            with self.assertRaises(jsonschema.ValidationError):
+                clitest.validate(bad, "glintref-sample.schema.json")
+
     def test_flat_map_is_the_intrinsic_gaussian(self):
         # mapgen writes signed float EXR; a flat map has no negative value, so say it is signed.
         flat = self.mapgen("flat", "flat.exr", "--size", "8")

@@ -26,7 +26,9 @@ inline std::string imageMetadata() {
 constexpr uint32_t kImageWidth = 4, kImageHeight = 4, kImageChannels = 1, kImageLayers = 2;
 
 // Value of texel (x, y) of a layer: exact in float32.
-inline float imageValue(uint32_t x, uint32_t y, uint32_t layer) { return float(x) * 0.5f + float(y) * 0.25f + float(layer); }
+inline float imageValue(uint32_t x, uint32_t y, uint32_t layer) {
+  return float(x) * 0.5f + float(y) * 0.25f + float(layer);
+}
 
 // kSectionImage payload: ImageSectionHeader followed by the float32 values, little-endian.
 inline std::vector<uint8_t> imageSection() {

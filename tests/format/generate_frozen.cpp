@@ -18,9 +18,12 @@ int main() {
     if (writer.open("v1_0_image.gbk", AssetKind::kTest, 9) != Status::kOk) return 1;
     if (writer.addMetadata(frozen::imageMetadata()) != Status::kOk) return 1;
     const auto image = frozen::imageSection();
-    if (writer.addSection(kSectionImage, frozen::kImageKey, image.data(), image.size(), Codec::kZstd) != Status::kOk) return 1;
+    if (writer.addSection(kSectionImage, frozen::kImageKey, image.data(), image.size(), Codec::kZstd) != Status::kOk)
+      return 1;
     const auto raw = frozen::privateSection();
-    if (writer.addSection(kSectionFirstPrivate, frozen::kPrivateKey, raw.data(), raw.size(), Codec::kRaw) != Status::kOk) return 1;
+    if (writer.addSection(kSectionFirstPrivate, frozen::kPrivateKey, raw.data(), raw.size(), Codec::kRaw) !=
+        Status::kOk)
+      return 1;
     if (writer.finish() != Status::kOk) return 1;
   }
   std::puts("wrote v1_0_minimal.gbk and v1_0_image.gbk");

@@ -27,8 +27,8 @@ struct ExportOptions {
   std::string file;
   std::string section;  // index ("3") or "type:key" ("ndf-chunk:4294967296", "17:0")
   uint32_t layer = 0;
-  int channel = -1;      // -1: every channel
-  std::string output;    // .exr, .png, .tif, ...
+  int channel = -1;            // -1: every channel
+  std::string output;          // .exr, .png, .tif, ...
   std::string scale = "auto";  // PNG only: divide by this ("auto" = maximum exported value)
 };
 

@@ -10,12 +10,18 @@ namespace glintbake::glintinfo {
 int exitCodeFor(format::Status status) {
   using format::Status;
   switch (status) {
-    case Status::kOk: return cli::kExitOk;
-    case Status::kIoError: return cli::kExitIo;
-    case Status::kUnsupportedVersion: return cli::kExitUnsupported;
-    case Status::kInvalidArgument: return cli::kExitBadArguments;
-    case Status::kNotFound: return cli::kExitBadArguments;
-    default: return cli::kExitInvalidInput;
+    case Status::kOk:
+      return cli::kExitOk;
+    case Status::kIoError:
+      return cli::kExitIo;
+    case Status::kUnsupportedVersion:
+      return cli::kExitUnsupported;
+    case Status::kInvalidArgument:
+      return cli::kExitBadArguments;
+    case Status::kNotFound:
+      return cli::kExitBadArguments;
+    default:
+      return cli::kExitInvalidInput;
   }
 }
 
@@ -45,7 +51,8 @@ std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std:
   std::vector<uint8_t> bytes;
   const format::Status status = reader.readSection(i, &bytes);
   if (status != format::Status::kOk) {
-    throw cli::Error(exitCodeFor(status), path + ": section " + std::to_string(i) + ": " + format::statusString(status));
+    throw cli::Error(exitCodeFor(status),
+                     path + ": section " + std::to_string(i) + ": " + format::statusString(status));
   }
   return bytes;
 }

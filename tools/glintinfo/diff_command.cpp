@@ -66,7 +66,8 @@ CLI::App* addDiffCommand(CLI::App& app, DiffOptions& options) {
   CLI::App* cmd = app.add_subcommand("diff", "Compare two containers section by section (exit 7 if they differ)");
   cmd->add_option("a", options.file_a, "First container")->required();
   cmd->add_option("b", options.file_b, "Second container")->required();
-  cmd->add_option("--rel-tol", options.rel_tol, "Image sections match when their relative L2 difference is at most this")
+  cmd->add_option("--rel-tol", options.rel_tol,
+                  "Image sections match when their relative L2 difference is at most this")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--abs-tol", options.abs_tol, "... or when their largest absolute difference is at most this")
       ->check(CLI::NonNegativeNumber);

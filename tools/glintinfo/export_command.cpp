@@ -114,10 +114,11 @@ int runExport(cli::Tool& tool, const ExportOptions& options) {
   }
   const int out_channels = options.channel >= 0 ? 1 : int(header.channels);
   if (out_channels > 4) {
-    throw cli::Error(cli::kExitBadArguments, "the section has " + std::to_string(header.channels) +
-                                                 " channels; choose one with --channel");
+    throw cli::Error(cli::kExitBadArguments,
+                     "the section has " + std::to_string(header.channels) + " channels; choose one with --channel");
   }
-  if (header.width > uint32_t(std::numeric_limits<int>::max()) || header.height > uint32_t(std::numeric_limits<int>::max())) {
+  if (header.width > uint32_t(std::numeric_limits<int>::max()) ||
+      header.height > uint32_t(std::numeric_limits<int>::max())) {
     throw cli::Error(cli::kExitUnsupported, "image too large to export");
   }
 
@@ -146,7 +147,8 @@ int runExport(cli::Tool& tool, const ExportOptions& options) {
     for (float& v : out) v = std::isfinite(v) ? v * inv : 0.0f;
   }
 
-  const bake::Status status = bake::writeImage(options.output, int(header.width), int(header.height), out_channels, out.data());
+  const bake::Status status =
+      bake::writeImage(options.output, int(header.width), int(header.height), out_channels, out.data());
   if (!status.ok()) throw cli::Error(int(status.error().code), status.error().message);
   tool.addOutput(options.output);
 

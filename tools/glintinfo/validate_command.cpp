@@ -49,8 +49,8 @@ int runValidate(cli::Tool& tool, const ValidateOptions& options) {
     }
   }
   const int code = report.status == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
-                   : report.status == format::Status::kIoError            ? cli::kExitIo
-                                                                         : cli::kExitInvalidInput;
+                   : report.status == format::Status::kIoError          ? cli::kExitIo
+                                                                        : cli::kExitInvalidInput;
   throw cli::Error(code, options.file + " is not valid: error-" + std::to_string(first->id) + ": " + first->message);
 }
 

@@ -85,8 +85,8 @@ Json answer(const rt::NdfPyramid& pyramid, const Json& q) {
   if (op == "point" || op == "pdf") {
     const std::vector<double> s = numbers(q, "s", 2);
     double v = 0.0;
-    const rt::Status st = op == "point" ? pyramid.eval(fp, rt::SPoint{s[0], s[1]}, &v)
-                                        : pyramid.pdf(fp, rt::SPoint{s[0], s[1]}, &v);
+    const rt::Status st =
+        op == "point" ? pyramid.eval(fp, rt::SPoint{s[0], s[1]}, &v) : pyramid.pdf(fp, rt::SPoint{s[0], s[1]}, &v);
     if (st != rt::Status::kOk) fail(st);
     out["value"] = v;
   } else if (op == "range") {
@@ -133,8 +133,9 @@ int main(int argc, char** argv) {
   image->add_option("--at", at_text, "Footprint centre X,Y in texels")->required();
   image->add_option("--sigma", sigma, "Footprint std in texels (>= 0)")->required();
   image->add_option("-o,--output", output, "Output image (.exr, .png, ...)")->required();
-  image->add_option("--scale", png_scale, "Multiply densities by this before writing (default: 1 for float "
-                                          "formats, 1/max for integer formats)");
+  image->add_option("--scale", png_scale,
+                    "Multiply densities by this before writing (default: 1 for float "
+                    "formats, 1/max for integer formats)");
 
   CLI::App* batch = app.add_subcommand("batch", "JSON-lines queries on stdin, one JSON line per answer on stdout");
   batch->add_option("asset", asset, "NDF asset (.gbk)")->required();
@@ -190,8 +191,8 @@ int main(int argc, char** argv) {
         peak = std::max(peak, double(v));
       }
       mass *= 4.0 / (double(res) * res);
-      std::string ext = output.substr(output.find_last_of('.') == std::string::npos ? output.size()
-                                                                                    : output.find_last_of('.'));
+      std::string ext =
+          output.substr(output.find_last_of('.') == std::string::npos ? output.size() : output.find_last_of('.'));
       for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
       const bool float_format = ext == ".exr" || ext == ".hdr" || ext == ".pfm";
       double scale = png_scale > 0.0 ? png_scale : (float_format ? 1.0 : (peak > 0.0 ? 1.0 / peak : 1.0));

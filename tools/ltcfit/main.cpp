@@ -8,9 +8,7 @@
 
 #include <cstring>
 
-namespace glintbake::ltcfit {
-
-}  // namespace glintbake::ltcfit
+namespace glintbake::ltcfit {}  // namespace glintbake::ltcfit
 
 int main(int argc, char** argv) {
   using namespace glintbake;
@@ -23,11 +21,13 @@ int main(int argc, char** argv) {
   table_cmd->fallthrough();
   table_cmd->add_option("--brdf", table.brdf, "BRDF to fit")->check(CLI::IsMember({"ggx", "beckmann"}));
   table_cmd->add_option("--size", table.size, "Table size N (N x N cells)")->check(CLI::Range(2, 256));
-  table_cmd->add_option("--samples", table.samples, "Stratified samples per axis in the fit")->check(CLI::Range(4, 256));
+  table_cmd->add_option("--samples", table.samples, "Stratified samples per axis in the fit")
+      ->check(CLI::Range(4, 256));
   table_cmd->add_option("--method", table.method, "refined (default) or published (100 Nelder-Mead iterations)")
       ->check(CLI::IsMember({"refined", "published"}));
-  table_cmd->add_option("--columns", table.columns,
-                        "Fit only this many roughness columns from the roughest down (0 = all; for quick checks)")
+  table_cmd
+      ->add_option("--columns", table.columns,
+                   "Fit only this many roughness columns from the roughest down (0 = all; for quick checks)")
       ->check(CLI::Range(0, 256));
   table_cmd->add_option("-o,--output", table.output, "Output container (kind ltc-table)")->required();
   table_cmd->add_option("--exr", table.exr_prefix, "Also write PREFIX_1.exr and PREFIX_2.exr (published layout)");
@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
   eval_cmd->add_option("table1", eval.table1, "ltc_1 image (RGBA)")->required();
   eval_cmd->add_option("table2", eval.table2, "ltc_2 image (RGBA)")->required();
   eval_cmd->add_option("--brdf", eval.brdf, "BRDF the table approximates")->check(CLI::IsMember({"ggx", "beckmann"}));
-  eval_cmd->add_option("--samples", eval.samples, "Stratified samples per axis and strategy")->check(CLI::Range(4, 1024));
+  eval_cmd->add_option("--samples", eval.samples, "Stratified samples per axis and strategy")
+      ->check(CLI::Range(4, 1024));
   eval_cmd->add_flag("--per-cell", eval.per_cell, "Include every cell's error in the --json output");
 
   ltcfit::MultiscaleArgs multiscale;
@@ -55,7 +56,9 @@ int main(int argc, char** argv) {
   CLI::App* rough_cmd = app.add_subcommand("roughness", "Bake per-texel roughness mips of a normal map");
   rough_cmd->fallthrough();
   rough_cmd->add_option("map", rough.input, "Normal map")->required();
-  rough_cmd->add_option("--alpha-micro", rough.alpha_micro, "Micro-scale GGX alpha")->required()->check(CLI::Range(0.0, 1.0));
+  rough_cmd->add_option("--alpha-micro", rough.alpha_micro, "Micro-scale GGX alpha")
+      ->required()
+      ->check(CLI::Range(0.0, 1.0));
   rough_cmd->add_option("-o,--output", rough.output, "Mipmapped single-channel EXR")->required();
   rough_cmd->add_option("--container", rough.container, "Also write a container (kind roughness)");
   rough_cmd->add_flag("--exact-meso", rough.exact_meso, "Invert eq. 4 exactly instead of the rational fit");

@@ -18,21 +18,20 @@ cli::Json errorsJson(const bake::ltc::FitErrors& e) { return {{"rms", e.rms}, {"
 
 int runMultiscale(cli::Tool& tool, const MultiscaleArgs& args) {
   const bake::ltc::MultiscaleFit fit = unwrap(bake::ltc::fitMultiscale(args.meso_points, args.grid));
-  cli::Json doc = {
-      {"tool", "ltcfit"},
-      {"command", "multiscale"},
-      {"meso",
-       {{"form", "alpha_me = y (p0 + p1 y + p2 y^2) / (1 + q0 y + q1 y^2), y = sqrt(1 - |b|)"},
-        {"coefficients", fit.meso.c},
-        {"points", fit.meso_points},
-        {"error", errorsJson(fit.meso_error)}}},
-      {"combine",
-       {{"form", "alpha = a_mi + a_me + a_mi a_me (k0 + k1 a_mi + k2 a_me)"},
-        {"coefficients", fit.combine.k},
-        {"grid", fit.combine_grid},
-        {"error", errorsJson(fit.combine_error)},
-        {"paper_form", "alpha = 0.07 a_mi^2 + 0.94 a_mi + a_me - 0.83 a_mi a_me (Tao et al. 2021, eq. 7)"},
-        {"paper_error", errorsJson(fit.combine_paper_error)}}}};
+  cli::Json doc = {{"tool", "ltcfit"},
+                   {"command", "multiscale"},
+                   {"meso",
+                    {{"form", "alpha_me = y (p0 + p1 y + p2 y^2) / (1 + q0 y + q1 y^2), y = sqrt(1 - |b|)"},
+                     {"coefficients", fit.meso.c},
+                     {"points", fit.meso_points},
+                     {"error", errorsJson(fit.meso_error)}}},
+                   {"combine",
+                    {{"form", "alpha = a_mi + a_me + a_mi a_me (k0 + k1 a_mi + k2 a_me)"},
+                     {"coefficients", fit.combine.k},
+                     {"grid", fit.combine_grid},
+                     {"error", errorsJson(fit.combine_error)},
+                     {"paper_form", "alpha = 0.07 a_mi^2 + 0.94 a_mi + a_me - 0.83 a_mi a_me (Tao et al. 2021, eq. 7)"},
+                     {"paper_error", errorsJson(fit.combine_paper_error)}}}};
   {
     cli::AtomicOutput out(args.output);
     {

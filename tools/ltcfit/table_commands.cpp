@@ -3,9 +3,9 @@
 
 #include <glintbake/format/container.h>
 
-#include <cstdio>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <mutex>
 
@@ -52,16 +52,21 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
   for (const auto& cell : fitted.cells)
     if (cell.fitted) objective_sum += std::log10(std::max(cell.objective, 1e-300)), ++fitted_cells;
 
-  cli::Json parameters = {{"brdf", args.brdf},   {"size", args.size},       {"samples", args.samples},
-                          {"method", args.method}, {"columns", args.columns}};
+  cli::Json parameters = {{"brdf", args.brdf},
+                          {"size", args.size},
+                          {"samples", args.samples},
+                          {"method", args.method},
+                          {"columns", args.columns}};
   cli::Json metadata = tool.makeMetadata("ltc-table", parameters);
   metadata["asset"] = {{"layout", "heitz2016"},
                        {"brdf", args.brdf},
                        {"size", args.size},
-                       {"parametrisation", "column a: roughness = a/(N-1), alpha = max(roughness^2, 1e-5); "
-                                           "row t: cos(theta_v) = 1 - (t/(N-1))^2"},
-                       {"sections", {{"ltc_1", {{"type", format::kSectionLtcTable}, {"key", 0}}},
-                                     {"ltc_2", {{"type", format::kSectionLtcTable}, {"key", 1}}}}}};
+                       {"parametrisation",
+                        "column a: roughness = a/(N-1), alpha = max(roughness^2, 1e-5); "
+                        "row t: cos(theta_v) = 1 - (t/(N-1))^2"},
+                       {"sections",
+                        {{"ltc_1", {{"type", format::kSectionLtcTable}, {"key", 0}}},
+                         {"ltc_2", {{"type", format::kSectionLtcTable}, {"key", 1}}}}}};
 
   {
     cli::ContainerOutput out(tool, args.output, format::AssetKind::kLtcTable);
@@ -115,16 +120,17 @@ int runEval(cli::Tool& tool, const EvalArgs& args) {
   const bake::ltc::TableError error = unwrap(bake::ltc::evaluateTable(table, brdf, args.samples));
   const int n = table.size;
   if (tool.common().json) {
-    cli::Json doc = {{"tool", "ltcfit"},
-                     {"command", "eval"},
-                     {"brdf", args.brdf},
-                     {"size", n},
-                     {"samples", args.samples},
-                     {"mean_relative_l1", error.mean_relative_l1},
-                     {"max_relative_l1", error.max_relative_l1},
-                     {"max_relative_l1_cell", {{"a", error.max_relative_l1_cell % n}, {"t", error.max_relative_l1_cell / n}}},
-                     {"mean_objective", error.mean_objective},
-                     {"mean_log10_objective", error.mean_log10_objective}};
+    cli::Json doc = {
+        {"tool", "ltcfit"},
+        {"command", "eval"},
+        {"brdf", args.brdf},
+        {"size", n},
+        {"samples", args.samples},
+        {"mean_relative_l1", error.mean_relative_l1},
+        {"max_relative_l1", error.max_relative_l1},
+        {"max_relative_l1_cell", {{"a", error.max_relative_l1_cell % n}, {"t", error.max_relative_l1_cell / n}}},
+        {"mean_objective", error.mean_objective},
+        {"mean_log10_objective", error.mean_log10_objective}};
     if (args.per_cell) {
       cli::Json l1 = cli::Json::array(), objective = cli::Json::array();
       for (const auto& cell : error.cells) {

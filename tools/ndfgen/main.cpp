@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
     int bar_level = -1;
     uint64_t bar_done = 0;
     bake::ndf::PyramidReport report;
-    bake::Status built = bake::ndf::buildNdfPyramid(
-        map, opt, out.writer(), &report, [&](int level, uint64_t done, uint64_t total) {
+    bake::Status built =
+        bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, [&](int level, uint64_t done, uint64_t total) {
           if (level != bar_level) {
             if (bar) bar->finish();
             bar = t.progress("level " + std::to_string(level), total);
@@ -168,8 +168,8 @@ int main(int argc, char** argv) {
       t.printJson(doc);
     } else {
       t.info("wrote " + output + ": " + std::to_string(report.levels.size()) + " levels, " + std::to_string(images) +
-             " images, " + std::to_string(out.bytesWritten()) + " bytes (" + std::to_string(raw) +
-             " raw) in " + std::to_string(seconds) + " s");
+             " images, " + std::to_string(out.bytesWritten()) + " bytes (" + std::to_string(raw) + " raw) in " +
+             std::to_string(seconds) + " s");
     }
     return cli::kExitOk;
   });

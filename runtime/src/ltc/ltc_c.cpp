@@ -78,8 +78,8 @@ int32_t gb_ltc_integrate_polygon(const gb_ltc* ltc, const float* vertices, int32
                                  float* out) {
   if (!ltc || !vertices || !out || count < 3 || count > glintbake::runtime::kLtcMaxPolygonVertices)
     return int32_t(Status::kInvalidArgument);
-  *out = glintbake::runtime::ltcIntegratePolygon(fromC(*ltc), reinterpret_cast<const float(*)[3]>(vertices),
-                                                 count, two_sided != 0);
+  *out = glintbake::runtime::ltcIntegratePolygon(fromC(*ltc), reinterpret_cast<const float(*)[3]>(vertices), count,
+                                                 two_sided != 0);
   return int32_t(Status::kOk);
 }
 

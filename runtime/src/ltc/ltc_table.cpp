@@ -15,10 +15,14 @@ constexpr uint32_t kLtcTableSection = format::kSectionLtcTable;
 
 Status fromFormat(format::Status status) {
   switch (status) {
-    case format::Status::kOk: return Status::kOk;
-    case format::Status::kIoError: return Status::kIoError;
-    case format::Status::kUnsupportedVersion: return Status::kUnsupportedVersion;
-    default: return Status::kInvalidAsset;
+    case format::Status::kOk:
+      return Status::kOk;
+    case format::Status::kIoError:
+      return Status::kIoError;
+    case format::Status::kUnsupportedVersion:
+      return Status::kUnsupportedVersion;
+    default:
+      return Status::kInvalidAsset;
   }
 }
 
@@ -104,8 +108,7 @@ Status LtcTable::fromArrays(int size, const float* ltc1, const float* ltc2) {
 }
 
 Status LtcTable::lookup(float roughness, float cos_theta_v, LtcCoefficients* out) const {
-  if (size_ == 0 || !out || !std::isfinite(roughness) || !std::isfinite(cos_theta_v))
-    return Status::kInvalidArgument;
+  if (size_ == 0 || !out || !std::isfinite(roughness) || !std::isfinite(cos_theta_v)) return Status::kInvalidArgument;
   const float n1 = float(size_ - 1);
   const Lerp la = lerpAt(std::clamp(roughness, 0.0f, 1.0f) * n1, size_);
   const Lerp lt = lerpAt(std::sqrt(1.0f - std::clamp(cos_theta_v, 0.0f, 1.0f)) * n1, size_);

@@ -30,8 +30,8 @@ struct Array {
 
 struct Level {
   NdfLevelRecord rec;
-  Array<float> images;     // grid_height * grid_width images of R * R, centre-major row-major
-  Array<double> prefix;    // per image R + 1 cumulative row masses
+  Array<float> images;   // grid_height * grid_width images of R * R, centre-major row-major
+  Array<double> prefix;  // per image R + 1 cumulative row masses
 };
 
 // Up to 8 weighted images (2 levels x 4 centres).
@@ -46,10 +46,14 @@ bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
 Status fromFormat(format::Status s) {
   switch (s) {
-    case format::Status::kOk: return Status::kOk;
-    case format::Status::kIoError: return Status::kIoError;
-    case format::Status::kUnsupportedVersion: return Status::kUnsupportedVersion;
-    default: return Status::kInvalidAsset;
+    case format::Status::kOk:
+      return Status::kOk;
+    case format::Status::kIoError:
+      return Status::kIoError;
+    case format::Status::kUnsupportedVersion:
+      return Status::kUnsupportedVersion;
+    default:
+      return Status::kInvalidAsset;
   }
 }
 

@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
   fmt::Writer writer;
   if (writer.open(argv[1], fmt::AssetKind::kTest) != fmt::Status::kOk) return 2;
   if (writer.addMetadata(meta) != fmt::Status::kOk) return 2;
-  if (writer.addSection(fmt::kSectionFirstPrivate, 7, payload.data(), payload.size() * sizeof(float)) != fmt::Status::kOk)
+  if (writer.addSection(fmt::kSectionFirstPrivate, 7, payload.data(), payload.size() * sizeof(float)) !=
+      fmt::Status::kOk)
     return 2;
   if (writer.finish() != fmt::Status::kOk) return 2;
 

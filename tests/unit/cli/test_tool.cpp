@@ -47,9 +47,19 @@ TEST(Tool, ExitCodesFollowErrors) {
 
 TEST(Tool, ThreadsOptionIsApplied) {
   int seen = 0;
-  EXPECT_EQ(runWith({"testtool", "-j", "3"}, [&](Tool& t) { seen = t.threadCount(); return 0; }), 0);
+  EXPECT_EQ(runWith({"testtool", "-j", "3"},
+                    [&](Tool& t) {
+                      seen = t.threadCount();
+                      return 0;
+                    }),
+            0);
   EXPECT_EQ(seen, 3);
-  EXPECT_EQ(runWith({"testtool"}, [&](Tool& t) { seen = t.threadCount(); return 0; }), 0);
+  EXPECT_EQ(runWith({"testtool"},
+                    [&](Tool& t) {
+                      seen = t.threadCount();
+                      return 0;
+                    }),
+            0);
   EXPECT_GE(seen, 1);
 }
 

@@ -100,8 +100,9 @@ TEST_F(Corruption, EveryTruncationIsDetected) {
 }
 
 TEST_F(Corruption, NotAContainer) {
-  const std::string text = "hello, this is not a container at all, but it is long enough to hold a header....."
-                           "..................................................";
+  const std::string text =
+      "hello, this is not a container at all, but it is long enough to hold a header....."
+      "..................................................";
   Reader reader;
   EXPECT_EQ(reader.openMemory(text.data(), text.size()), Status::kBadMagic);
   // The validator says exactly that, and nothing about sections or metadata it cannot see.

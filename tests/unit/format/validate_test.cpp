@@ -70,8 +70,9 @@ TEST(Validate, MetadataSchemaChecks) {
   EXPECT_TRUE(metadataIds(base + R"("inputs":[]})").empty());
   EXPECT_EQ(metadataIds(base + R"("inputs":[]})", AssetKind::kNdfPyramid), std::vector<int>{5007});
   EXPECT_EQ(metadataIds(base + R"("inputs":[{"name":"a.png"}]})"), std::vector<int>{5010});
-  EXPECT_EQ(metadataIds(base + R"("inputs":[{"name":"dir/a.png","hash":"xxh3-128:00000000000000000000000000000000"}]})"),
-            std::vector<int>{5011});
+  EXPECT_EQ(
+      metadataIds(base + R"("inputs":[{"name":"dir/a.png","hash":"xxh3-128:00000000000000000000000000000000"}]})"),
+      std::vector<int>{5011});
   EXPECT_EQ(metadataIds(base + R"("inputs":[{"name":"a.png","hash":"xxh3-128:0000"}]})"), std::vector<int>{5012});
   EXPECT_EQ(metadataIds(base + R"("inputs":[{"name":"a.png","hash":"xxh3-128:0000000000000000000000000000000G"}]})"),
             std::vector<int>{5012});

@@ -136,8 +136,8 @@ std::string writeContainer(const std::string& name, format::AssetKind kind, cons
 TEST(LtcTableRuntime, LoadsContainersAndRefusesMalformedOnes) {
   std::vector<float> l1, l2;
   makeTable(6, &l1, &l2);
-  const std::string good = writeContainer("ltc_good.gbk", format::AssetKind::kLtcTable, imageSection(6, l1),
-                                          imageSection(6, l2));
+  const std::string good =
+      writeContainer("ltc_good.gbk", format::AssetKind::kLtcTable, imageSection(6, l1), imageSection(6, l2));
   LtcTable table;
   ASSERT_EQ(table.open(good.c_str()), Status::kOk);
   EXPECT_EQ(table.size(), 6);

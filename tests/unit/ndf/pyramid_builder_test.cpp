@@ -137,8 +137,8 @@ TEST(PyramidBuilder, IdenticalBytesForEveryThreadCount) {
   EXPECT_FALSE(r1.stop_reason.empty());
   EXPECT_EQ(r1.levels.size(), r2.levels.size());
   EXPECT_EQ(readAll(p1), readAll(p2));
-  std::printf("[ measured ] auto levels: %zu, stop %s, top-level MSE %.3g\n", r1.levels.size(),
-              r1.stop_reason.c_str(), r1.levels.back().mse_vs_previous);
+  std::printf("[ measured ] auto levels: %zu, stop %s, top-level MSE %.3g\n", r1.levels.size(), r1.stop_reason.c_str(),
+              r1.levels.back().mse_vs_previous);
   std::remove(p1.c_str());
   std::remove(p2.c_str());
 }

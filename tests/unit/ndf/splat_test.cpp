@@ -76,7 +76,9 @@ TEST_P(SplatVsReference, MatchesBinAveragedReference) {
 INSTANTIATE_TEST_SUITE_P(AllKinds, SplatVsReference,
                          ::testing::Values(MapKind::kFlat, MapKind::kBeckmann, MapKind::kBrushed, MapKind::kScratches,
                                            MapKind::kFlakes),
-                         [](const ::testing::TestParamInfo<MapKind>& param_info) { return mapKindString(param_info.param); });
+                         [](const ::testing::TestParamInfo<MapKind>& param_info) {
+                           return mapKindString(param_info.param);
+                         });
 
 TEST(Splat, FlatMapIsBinAveragedGaussian) {
   const NormalMap map = makeMap(MapKind::kFlat, 32);
@@ -185,7 +187,7 @@ TEST(Splat, RotatedAndMirroredMapsRotateAndMirrorTheImage) {
     for (int j = 0; j < kRes; ++j) {
       for (int i = 0; i < kRes; ++i) {
         const float v = a[size_t(j) * kRes + i];
-        expect_rot[size_t(kRes - 1 - i) * kRes + j] = v;  // s -> (-s_y, s_x)
+        expect_rot[size_t(kRes - 1 - i) * kRes + j] = v;    // s -> (-s_y, s_x)
         expect_mir[size_t(j) * kRes + (kRes - 1 - i)] = v;  // s -> (-s_x, s_y)
       }
     }

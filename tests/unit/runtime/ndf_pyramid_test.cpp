@@ -142,8 +142,8 @@ TEST_F(NdfPyramidTest, TrilinearBlendOfTheBracketingLevels) {
   const SPoint s{-1 + 7.5 * 2.0 / kRes, 1 - 8.5 * 2.0 / kRes};
   const int bin = 8 * kRes + 7;
   auto at = [&](int l, int i, int j) { return double(testImage(l, i, j)[bin]); };
-  const double l0 = 0.75 * 0.25 * at(0, 2, 5) + 0.25 * 0.25 * at(0, 3, 5) + 0.75 * 0.75 * at(0, 2, 6) +
-                    0.25 * 0.75 * at(0, 3, 6);
+  const double l0 =
+      0.75 * 0.25 * at(0, 2, 5) + 0.25 * 0.25 * at(0, 3, 5) + 0.75 * 0.75 * at(0, 2, 6) + 0.25 * 0.75 * at(0, 3, 6);
   // level 1: stride 16, origin 8: gx = (22 - 8) / 16 = 0.875, gy = (50 - 8) / 16 = 2.625
   const double l1 = 0.125 * 0.375 * at(1, 0, 2) + 0.875 * 0.375 * at(1, 1, 2) + 0.125 * 0.625 * at(1, 0, 3) +
                     0.875 * 0.625 * at(1, 1, 3);

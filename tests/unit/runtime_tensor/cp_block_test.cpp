@@ -22,7 +22,8 @@ double directValue(const CpBlendTerm* terms, int count, int i, int j) {
   for (int t = 0; t < count; ++t) {
     const CpGroupView& v = *terms[t].group;
     for (int r = 0; r < v.rank; ++r)
-      sum += static_cast<double>(terms[t].weight) * v.a[i * v.rank + r] * v.b[j * v.rank + r] * v.c[terms[t].block * v.rank + r];
+      sum += static_cast<double>(terms[t].weight) * v.a[i * v.rank + r] * v.b[j * v.rank + r] *
+             v.c[terms[t].block * v.rank + r];
   }
   return sum;
 }
@@ -126,7 +127,8 @@ TEST(CpBlock, MeasuresSignedModelDepartures) {
       for (int i = 0; i < 32; ++i) gap += std::abs(mix.pdf(i, j) - mix.value(i, j) / clamped_total);
     }
     std::printf("%s CP: negative mass %.4f%% of |values| in %d of 1024 bins; pdf vs value/mass L1 gap %.4f%%\n",
-                nonneg ? "non-negative" : "plain", 100.0 * negative / (negative + positive), negative_bins, 100.0 * gap);
+                nonneg ? "non-negative" : "plain", 100.0 * negative / (negative + positive), negative_bins,
+                100.0 * gap);
     EXPECT_NEAR(pdf_total, 1.0, 1e-9);
     if (nonneg) {
       EXPECT_EQ(negative_bins, 0);

@@ -30,8 +30,8 @@ inline std::unique_ptr<OwnedGroup> makeGroup(uint64_t seed, bool nonneg, int ran
   const auto& f = g->factors;
   g->a_prefix = bake::tensor::buildPrefixSums(f.a, f.bins, f.rank);
   g->b_prefix = bake::tensor::buildPrefixSums(f.b, f.bins, f.rank);
-  g->view = CpGroupView{f.bins, f.rank, f.blocks, f.a.data(), f.b.data(), f.c.data(), g->a_prefix.data(),
-                        g->b_prefix.data()};
+  g->view =
+      CpGroupView{f.bins, f.rank, f.blocks, f.a.data(), f.b.data(), f.c.data(), g->a_prefix.data(), g->b_prefix.data()};
   return g;
 }
 

@@ -14,7 +14,6 @@
 namespace glintbake::bake::tensor {
 namespace {
 
-
 CpFactors decompose(const GroupTensor& t, const CpOptions& o) {
   Result<CpFactors> r = decomposeCp(t, o);
   EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
@@ -62,8 +61,8 @@ TEST(CpDecomposition, ErrorFallsWithRank) {
     CpOptions o;
     o.rank = rank;
     const CpFactors f = decompose(t, o);
-    std::printf("rank %2d: relative error %.4f (%d full sweeps, %d core sweeps)\n", rank, f.relative_error,
-                f.sweeps, f.core_sweeps);
+    std::printf("rank %2d: relative error %.4f (%d full sweeps, %d core sweeps)\n", rank, f.relative_error, f.sweeps,
+                f.core_sweeps);
     EXPECT_LT(f.relative_error, previous) << "rank " << rank;
     previous = f.relative_error;
   }
@@ -218,7 +217,14 @@ TEST(CpDecompositionSurvey, DISABLED_MethodVariants) {
     double plain_ms = 0.0;
     const double reference = run(plain, &plain_ms).relative_error;
     std::printf("seed %d: als-plain x500 error %.5f, %.0f ms\n", static_cast<int>(seed), reference, plain_ms);
-    struct Variant { const char* name; CpMethod method; int basis, refine; bool extrapolate; double tol; int starts = 1; };
+    struct Variant {
+      const char* name;
+      CpMethod method;
+      int basis, refine;
+      bool extrapolate;
+      double tol;
+      int starts = 1;
+    };
     const Variant variants[] = {
         {"als-plain (tol 1e-5)", CpMethod::kAlsPlain, 0, 0, false, 1e-5},
         {"als hosvd", CpMethod::kAls, 0, 0, false, 1e-5},

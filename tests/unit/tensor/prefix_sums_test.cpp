@@ -2,7 +2,6 @@
 // range sums of rank-1 terms factorise.
 #include <glintbake/bake/tensor/prefix_sums.h>
 
-
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -23,7 +23,8 @@ ContainerOutput::~ContainerOutput() {
 
 void ContainerOutput::addSection(uint32_t type, uint64_t key, const void* data, size_t size) {
   const format::Status status = writer_.addSection(type, key, data, size);
-  if (status != format::Status::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+  if (status != format::Status::kOk)
+    throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
 }
 
 void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, int height, int channels,
@@ -43,7 +44,8 @@ void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, in
 void ContainerOutput::finish(const Json& metadata) {
   format::Status status = writer_.addMetadata(metadata.dump());
   if (status == format::Status::kOk) status = writer_.finish();
-  if (status != format::Status::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+  if (status != format::Status::kOk)
+    throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
   finished_ = true;
 }
 

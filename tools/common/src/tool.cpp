@@ -146,8 +146,8 @@ struct Progress::Impl {
     const int width = 30;
     const int filled = int(fraction * width + 0.5);
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "\r%-16s [%.*s%*s] %5.1f%% %6.1fs", label.c_str(), filled,
-                 "##############################", width - filled, "", fraction * 100.0, elapsed);
+    std::fprintf(stderr, "\r%-16s [%.*s%*s] %5.1f%% %6.1fs", label.c_str(), filled, "##############################",
+                 width - filled, "", fraction * 100.0, elapsed);
     if (final_line) std::fputc('\n', stderr);
     std::fflush(stderr);
   }
@@ -202,7 +202,8 @@ Tool::Tool(std::string name, std::string description) : name_(std::move(name)), 
   app_.option_defaults()->always_capture_default();
   app_.add_flag("--json", common_.json, "Print a machine-readable summary on stdout (see schemas/)");
   app_.add_flag("-q,--quiet", common_.quiet, "No progress bar and no informational messages");
-  app_.add_option("-j,--threads", common_.threads, "Worker threads (0 = all cores); output is identical for every value")
+  app_.add_option("-j,--threads", common_.threads,
+                  "Worker threads (0 = all cores); output is identical for every value")
       ->check(CLI::Range(0, 1024));
   app_.add_option("--depfile", common_.depfile, "Write a Make-syntax dependency file listing the inputs");
   app_.footer(
@@ -212,9 +213,7 @@ Tool::Tool(std::string name, std::string description) : name_(std::move(name)), 
 
 Tool::~Tool() = default;
 
-int Tool::threadCount() const {
-  return common_.threads > 0 ? common_.threads : int(tbb::info::default_concurrency());
-}
+int Tool::threadCount() const { return common_.threads > 0 ? common_.threads : int(tbb::info::default_concurrency()); }
 
 int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
   installSignalHandlers();

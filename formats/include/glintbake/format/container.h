@@ -20,9 +20,9 @@ constexpr uint16_t kFormatVersionMajor = 1;
 constexpr uint16_t kFormatVersionMinor = 0;
 
 // Fixed sizes and limits of the layout (see SPEC.md).
-constexpr size_t kHeaderSize = 128;          // bytes of the file header
-constexpr size_t kIndexEntrySize = 64;       // bytes of one section index entry
-constexpr size_t kSectionAlignment = 64;     // every section and the index start at a multiple
+constexpr size_t kHeaderSize = 128;                                // bytes of the file header
+constexpr size_t kIndexEntrySize = 64;                             // bytes of one section index entry
+constexpr size_t kSectionAlignment = 64;                           // every section and the index start at a multiple
 constexpr uint64_t kDefaultMaxRawSectionSize = uint64_t(1) << 32;  // 4 GiB: readers' default cap
 constexpr uint32_t kMaxSectionCount = 1u << 24;                    // readers refuse more
 
@@ -69,13 +69,13 @@ const char* codecString(Codec codec);
 // types they do not know. The 64-bit key distinguishes sections of the same type (e.g. level and
 // region of an NDF chunk); its meaning is defined per type in SPEC.md.
 enum SectionType : uint32_t {
-  kSectionMetadata = 1,      // UTF-8 JSON object, schemas/container-metadata.schema.json. Exactly one.
-  kSectionNdfLevel = 16,     // ndf-pyramid: per-level descriptor (key = level)
-  kSectionNdfChunk = 17,     // ndf-pyramid: NDF images of one spatial region (key = level << 32 | region)
-  kSectionTensorIndex = 32,  // tensor-ndf sections (32-47)
-  kSectionLtcTable = 48,     // ltc-table sections (48-63)
-  kSectionRoughness = 64,    // roughness mips (64-79)
-  kSectionImage = 0x100,     // generic float image (key = user-defined), see ImageSectionHeader
+  kSectionMetadata = 1,            // UTF-8 JSON object, schemas/container-metadata.schema.json. Exactly one.
+  kSectionNdfLevel = 16,           // ndf-pyramid: per-level descriptor (key = level)
+  kSectionNdfChunk = 17,           // ndf-pyramid: NDF images of one spatial region (key = level << 32 | region)
+  kSectionTensorIndex = 32,        // tensor-ndf sections (32-47)
+  kSectionLtcTable = 48,           // ltc-table sections (48-63)
+  kSectionRoughness = 64,          // roughness mips (64-79)
+  kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
   kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
 };
 
@@ -88,13 +88,13 @@ bool sectionTypeFromString(const std::string& name, uint32_t* type);
 // One row of the section index, as stored (little-endian on disk; see SPEC.md).
 struct SectionInfo {
   uint32_t type = 0;
-  uint32_t codec = 0;          // Codec
+  uint32_t codec = 0;  // Codec
   uint64_t key = 0;
-  uint64_t offset = 0;         // from the start of the file, multiple of kSectionAlignment
-  uint64_t stored_size = 0;    // bytes in the file
-  uint64_t raw_size = 0;       // bytes after decoding
-  uint64_t checksum = 0;       // XXH3-64 of the stored bytes
-  uint32_t flags = 0;          // reserved, 0
+  uint64_t offset = 0;       // from the start of the file, multiple of kSectionAlignment
+  uint64_t stored_size = 0;  // bytes in the file
+  uint64_t raw_size = 0;     // bytes after decoding
+  uint64_t checksum = 0;     // XXH3-64 of the stored bytes
+  uint32_t flags = 0;        // reserved, 0
   uint32_t reserved = 0;
 };
 
@@ -205,7 +205,7 @@ struct ImageSectionHeader {
   uint32_t width = 0;
   uint32_t height = 0;
   uint32_t channels = 0;
-  uint32_t layers = 1;          // images stacked one after another
+  uint32_t layers = 1;  // images stacked one after another
   uint32_t flags = 0;
   uint64_t reserved = 0;
 };

@@ -27,7 +27,7 @@ struct Error {
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT: implicit by design
+  Result(T value) : v_(std::move(value)) {}      // NOLINT: implicit by design
   Result(Error error) : v_(std::move(error)) {}  // NOLINT
   bool ok() const { return v_.index() == 0; }
   explicit operator bool() const { return ok(); }
@@ -50,12 +50,12 @@ inline Error makeError(ErrorCode code, std::string message) { return Error{code,
 }  // namespace glintbake::bake
 
 // Aborts with file:line on a violated internal invariant (never on bad input data).
-#define GLINTBAKE_CHECK(cond)                                                            \
-  do {                                                                                   \
-    if (!(cond)) {                                                                       \
+#define GLINTBAKE_CHECK(cond)                                                                \
+  do {                                                                                       \
+    if (!(cond)) {                                                                           \
       std::fprintf(stderr, "%s:%d: internal check failed: %s\n", __FILE__, __LINE__, #cond); \
-      std::abort();                                                                      \
-    }                                                                                    \
+      std::abort();                                                                          \
+    }                                                                                        \
   } while (0)
 #ifndef NDEBUG
 #define GLINTBAKE_DCHECK(cond) GLINTBAKE_CHECK(cond)

@@ -40,19 +40,18 @@ void gb_ndf_pyramid_close(gb_ndf_pyramid* pyramid); /* NULL is allowed */
 int32_t gb_ndf_pyramid_info(const gb_ndf_pyramid* pyramid, int32_t* resolution, int32_t* levels);
 
 /* Trilinearly interpolated P-NDF value at s for the footprint (x, y, sigma). */
-int32_t gb_ndf_pyramid_eval(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx,
-                            double sy, double* value);
+int32_t gb_ndf_pyramid_eval(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx, double sy,
+                            double* value);
 /* Average over the s-rectangle [sx0, sx1] x [sy0, sy1]. */
-int32_t gb_ndf_pyramid_average(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx0,
-                               double sy0, double sx1, double sy1, double* value);
+int32_t gb_ndf_pyramid_average(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx0, double sy0,
+                               double sx1, double sy1, double* value);
 /* Importance sample from two uniforms in [0, 1); *pdf equals gb_ndf_pyramid_pdf at (*sx, *sy). */
-int32_t gb_ndf_pyramid_sample(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double u1,
-                              double u2, double* sx, double* sy, double* pdf);
-int32_t gb_ndf_pyramid_pdf(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx,
-                           double sy, double* pdf);
+int32_t gb_ndf_pyramid_sample(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double u1, double u2,
+                              double* sx, double* sy, double* pdf);
+int32_t gb_ndf_pyramid_pdf(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, double sx, double sy,
+                           double* pdf);
 /* The blended R x R image (row 0 at s_y = +1); out must hold count >= R * R floats. */
-int32_t gb_ndf_pyramid_image(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, float* out,
-                             size_t count);
+int32_t gb_ndf_pyramid_image(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, float* out, size_t count);
 
 #ifdef __cplusplus
 }

@@ -25,31 +25,31 @@ const char* wrapString(Wrap w);          // "repeat", "clamp"
 
 struct IngestOptions {
   Encoding encoding = Encoding::kAuto;
-  bool flip_green = false;     // negate n_y after decoding (DirectX maps)
+  bool flip_green = false;  // negate n_y after decoding (DirectX maps)
   // Height field input (first channel, as read: integer files in [0, 1]): normals by central
   // differences with the wrap mode, n = normalize(-k dh/dx, -k dh/dy, 1), where
   // dh/dx = (h[c+1] - h[c-1]) / 2 and dh/dy = (h[r-1] - h[r+1]) / 2 (y up = towards row 0).
   bool height = false;
-  double height_scale = 1.0;   // k: slope = height_scale * dh/dtexel, > 0
-  Wrap wrap = Wrap::kRepeat;   // how the map continues beyond its edges
-  int part = 0;                // subimage/part of multi-part files (EXR)
-  bool fix_nonfinite = false;  // replace NaN/Inf texels by (0,0,1) instead of failing
-  int max_size = 16384;        // largest accepted width or height
-  double unit_tolerance = 0.1; // |len - 1| above this counts as "far from unit length"
+  double height_scale = 1.0;    // k: slope = height_scale * dh/dtexel, > 0
+  Wrap wrap = Wrap::kRepeat;    // how the map continues beyond its edges
+  int part = 0;                 // subimage/part of multi-part files (EXR)
+  bool fix_nonfinite = false;   // replace NaN/Inf texels by (0,0,1) instead of failing
+  int max_size = 16384;         // largest accepted width or height
+  double unit_tolerance = 0.1;  // |len - 1| above this counts as "far from unit length"
 };
 
 // What ingest found and repaired. Counts are over all texels of the map.
 struct IngestReport {
-  std::string file_format;      // OIIO format name ("png", "openexr", ...)
-  std::string pixel_type;       // "uint8", "uint16", "half", "float", ...
-  int channels_in = 0;          // channels of the file (2: XY map with reconstructed z)
+  std::string file_format;  // OIIO format name ("png", "openexr", ...)
+  std::string pixel_type;   // "uint8", "uint16", "half", "float", ...
+  int channels_in = 0;      // channels of the file (2: XY map with reconstructed z)
   Encoding encoding_used = Encoding::kUnorm;
   int64_t texels = 0;
-  int64_t far_from_unit = 0;    // | |n| - 1 | > unit_tolerance before renormalisation
-  int64_t nz_nonpositive = 0;   // n_z <= 0 before repair
-  int64_t nonfinite = 0;        // NaN or Inf in any channel
-  double mean_length = 0.0;     // mean |n| before renormalisation
-  std::string content_hash;     // "xxh3-128:..." of the file bytes
+  int64_t far_from_unit = 0;   // | |n| - 1 | > unit_tolerance before renormalisation
+  int64_t nz_nonpositive = 0;  // n_z <= 0 before repair
+  int64_t nonfinite = 0;       // NaN or Inf in any channel
+  double mean_length = 0.0;    // mean |n| before renormalisation
+  std::string content_hash;    // "xxh3-128:..." of the file bytes
 };
 
 // A map of unit normals, upper hemisphere (n_z >= 0). Texels with n_z <= 0 keep their projected

@@ -57,11 +57,11 @@ struct FitErrors {
 struct MultiscaleFit {
   MesoFit meso;
   CombineFit combine;
-  FitErrors meso_error;            // of `meso` against alphaMesoExact on the length grid
-  FitErrors combine_error;         // of `combine` against combineNumerical on the grid
-  FitErrors combine_paper_error;   // of combinePaper against the same ground truth
+  FitErrors meso_error;           // of `meso` against alphaMesoExact on the length grid
+  FitErrors combine_error;        // of `combine` against combineNumerical on the grid
+  FitErrors combine_paper_error;  // of combinePaper against the same ground truth
   int meso_points = 0;
-  int combine_grid = 0;            // grid points per axis
+  int combine_grid = 0;  // grid points per axis
 };
 
 // Refits both relations with Ceres: meso on `meso_points` lengths evenly spaced in alpha (0, 1],

@@ -41,8 +41,8 @@ bool fitMethodFromString(const std::string& name, FitMethod* method);
 
 struct TableFitOptions {
   BrdfKind brdf = BrdfKind::kGgx;
-  int size = 64;       // N, 2..256
-  int samples = 32;    // stratified samples per axis for the moments and the objective, 4..256
+  int size = 64;     // N, 2..256
+  int samples = 32;  // stratified samples per axis for the moments and the objective, 4..256
   FitMethod method = FitMethod::kRefined;
   // Fit only the first `max_roughness_columns` columns counted from a = N-1 downwards (0 = all);
   // the remaining cells keep identity matrices. Tests use it to keep run times short.

@@ -28,15 +28,15 @@ constexpr int kFlakeFloats = 6;
 // All flakes of one map, in row-major order of the virtual grid. Immutable after construction;
 // concurrent reads are safe. Memory: 24 bytes per flake (rate^2 flakes per texel).
 struct FlakeSet {
-  int map_width = 0;    // texels
-  int map_height = 0;   // texels
-  int rate = 1;         // sub-samples per texel side
+  int map_width = 0;   // texels
+  int map_height = 0;  // texels
+  int rate = 1;        // sub-samples per texel side
   Wrap wrap = Wrap::kRepeat;
-  int grid_width = 0;   // map_width * rate
-  int grid_height = 0;  // map_height * rate
-  double step = 1.0;    // texels between flakes (1 / rate)
-  double area = 1.0;    // step^2, texel^2
-  double sigma_h = 0.0; // spatial std of a flake, texels
+  int grid_width = 0;       // map_width * rate
+  int grid_height = 0;      // map_height * rate
+  double step = 1.0;        // texels between flakes (1 / rate)
+  double area = 1.0;        // step^2, texel^2
+  double sigma_h = 0.0;     // spatial std of a flake, texels
   std::vector<float> data;  // kFlakeFloats per flake
 
   const float* flake(int gx, int gy) const {

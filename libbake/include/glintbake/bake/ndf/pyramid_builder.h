@@ -42,13 +42,13 @@ namespace glintbake::bake::ndf {
 constexpr int kMaxPyramidLevels = 24;
 
 struct PyramidOptions {
-  SplatParams splat;             // R (ndf_res), sigma_r, truncation radii
-  int rate = 1;                  // flakes per texel side, [1, kMaxFlakeRate]
-  double stride0 = 16.0;         // level-0 stride, texels, > 0
-  double sigma0 = 8.0;           // level-0 footprint std, texels, > 0
-  int levels = 0;                // 0 = automatic, else exactly this many, [1, kMaxPyramidLevels]
-  double converge_mse = 1e-2;    // relative MSE threshold of the automatic level count, > 0
-  int region_size = 16;          // centres per region side, [1, 256]
+  SplatParams splat;           // R (ndf_res), sigma_r, truncation radii
+  int rate = 1;                // flakes per texel side, [1, kMaxFlakeRate]
+  double stride0 = 16.0;       // level-0 stride, texels, > 0
+  double sigma0 = 8.0;         // level-0 footprint std, texels, > 0
+  int levels = 0;              // 0 = automatic, else exactly this many, [1, kMaxPyramidLevels]
+  double converge_mse = 1e-2;  // relative MSE threshold of the automatic level count, > 0
+  int region_size = 16;        // centres per region side, [1, 256]
 };
 
 // Validates the options (kBadArgument with a message naming the option).
@@ -74,7 +74,7 @@ struct PyramidLevelReport {
 
 struct PyramidReport {
   std::vector<PyramidLevelReport> levels;
-  std::string stop_reason;         // "levels", "converged", "grid-1x1", "max-levels"
+  std::string stop_reason;  // "levels", "converged", "grid-1x1", "max-levels"
   uint64_t flakes = 0;
   double flake_seconds = 0.0;
 };

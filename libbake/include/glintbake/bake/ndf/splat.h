@@ -67,8 +67,8 @@ class Splatter {
 
   // Adds the bin masses of a Gaussian lobe N(mean, cov) times `mass` into acc[R * R] (masses, not
   // densities). cov = [[cxx, cxy], [cxy, cyy]] must be positive definite. Exposed for tests.
-  static void splatLobe(double* acc, int res, double mean_x, double mean_y, double cxx, double cxy,
-                        double cyy, double mass, double truncation);
+  static void splatLobe(double* acc, int res, double mean_x, double mean_y, double cxx, double cxy, double cyy,
+                        double mass, double truncation);
 
  private:
   const FlakeSet& flakes_;

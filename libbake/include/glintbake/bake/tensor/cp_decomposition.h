@@ -52,15 +52,15 @@
 
 namespace glintbake::bake::tensor {
 
-constexpr int kMaxCpRank = 64;        // largest supported rank (the runtime's limit too)
-constexpr int kMaxBlockBins = 256;    // largest block side B
+constexpr int kMaxCpRank = 64;      // largest supported rank (the runtime's limit too)
+constexpr int kMaxBlockBins = 256;  // largest block side B
 
 // K blocks of B x B bins: bin (i, j) of block k is values[(k * B + j) * B + i] (row-major images,
 // row j = 0 at the top, like NDF images). Values are NDF densities (any non-negative scale works;
 // negative values are allowed but unusual).
 struct GroupTensor {
-  int bins = 32;   // B, [1, kMaxBlockBins]
-  int blocks = 0;  // K, >= 1
+  int bins = 32;              // B, [1, kMaxBlockBins]
+  int blocks = 0;             // K, >= 1
   std::vector<float> values;  // blocks * bins * bins
 
   float at(int k, int i, int j) const { return values[(static_cast<size_t>(k) * bins + j) * bins + i]; }
@@ -73,17 +73,17 @@ const char* cpMethodName(CpMethod method);
 std::optional<CpMethod> parseCpMethod(std::string_view name);
 
 struct CpOptions {
-  int rank = 16;                      // R, [1, kMaxCpRank]
+  int rank = 16;  // R, [1, kMaxCpRank]
   CpMethod method = CpMethod::kCompressed;
-  bool nonneg = false;                // non-negative factors (HALS)
-  int max_iters = 500;                // sweeps of the main ALS loop, >= 1
-  double tol = 1e-5;                  // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
-  double ridge = 1e-7;                // relative Tikhonov term of the normal equations, [0, 1)
-  int compressed_basis = 0;           // L of kCompressed, [0, 4096]; 0 = max(64, 2 R) (kCompressed runs
-                                      // kAls instead when K <= L)
-  int refine_sweeps = 10;             // full sweeps after expanding the compressed solution, >= 0
-  int core_starts = 3;                // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
-  bool extrapolate = true;            // momentum with restart (kCompressed and kAls)
+  bool nonneg = false;                    // non-negative factors (HALS)
+  int max_iters = 500;                    // sweeps of the main ALS loop, >= 1
+  double tol = 1e-5;                      // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
+  double ridge = 1e-7;                    // relative Tikhonov term of the normal equations, [0, 1)
+  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R) (kCompressed runs
+                                          // kAls instead when K <= L)
+  int refine_sweeps = 10;                 // full sweeps after expanding the compressed solution, >= 0
+  int core_starts = 3;                    // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
+  bool extrapolate = true;                // momentum with restart (kCompressed and kAls)
   uint64_t seed = 0x243F6A8885A308D3ull;  // seeds the range finder and the random start
 };
 

@@ -48,10 +48,10 @@ using Json = nlohmann::ordered_json;
 
 // Options every tool has. Filled by CLI11 during parsing.
 struct CommonOptions {
-  bool json = false;      // --json: machine-readable summary on stdout
-  bool quiet = false;     // --quiet: no progress, no informational messages
-  int threads = 0;        // -j/--threads: 0 = all cores
-  std::string depfile;    // --depfile FILE
+  bool json = false;    // --json: machine-readable summary on stdout
+  bool quiet = false;   // --quiet: no progress, no informational messages
+  int threads = 0;      // -j/--threads: 0 = all cores
+  std::string depfile;  // --depfile FILE
 };
 
 // Shows a progress bar on stderr only when stderr is a terminal and neither --quiet nor --json.
