@@ -101,6 +101,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
   // OIIO's EXR and TIFF writers stamp the current time when no DateTime is given; an explicit empty
   // value keeps the bytes reproducible (EXR then stores an empty capDate, TIFF no date at all).
   spec.attribute("DateTime", "");
+  if (!options.normal_encoding.empty()) spec.attribute(kNormalEncodingAttribute, options.normal_encoding);
 
   const size_t count = size_t(width) * size_t(height) * size_t(channels);
   std::vector<uint8_t> data8;
@@ -146,12 +147,15 @@ Status writeNormalMap(const std::string& path, const NormalMap& map, const Image
   if (map.width <= 0 || map.height <= 0 || map.normals.size() != size_t(map.width) * size_t(map.height) * 3) {
     return makeError(ErrorCode::kBadArgument, path + ": empty or inconsistent normal map");
   }
+  ImageWriteOptions tagged = options;
   if (isFloatImagePath(path)) {
-    return writeImage(path, map.width, map.height, 3, map.normals.data(), options);
+    tagged.normal_encoding = "snorm";
+    return writeImage(path, map.width, map.height, 3, map.normals.data(), tagged);
   }
+  tagged.normal_encoding = "unorm";
   std::vector<float> encoded(map.normals.size());
   for (size_t i = 0; i < encoded.size(); ++i) encoded[i] = 0.5f * map.normals[i] + 0.5f;
-  return writeImage(path, map.width, map.height, 3, encoded.data(), options);
+  return writeImage(path, map.width, map.height, 3, encoded.data(), tagged);
 }
 
 }  // namespace glintbake::bake

@@ -4,6 +4,7 @@
 // either signed ([-1, 1]) or encoded like integers ([0, 1]), told apart by the presence of negative
 // values unless the caller forces an encoding. Height fields become normals by central differences
 // with the map's wrap mode.
+#include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/format/container.h>
 
@@ -259,7 +260,11 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   } else {
     // Decide how stored values map to [-1, 1].
     Encoding encoding = options.encoding;
-    if (encoding == Encoding::kAuto) {
+    const std::string recorded = spec.get_string_attribute(kNormalEncodingAttribute);
+    if (encoding == Encoding::kAuto && (recorded == "snorm" || recorded == "unorm")) {
+      // The writer recorded the encoding (glintbake's own maps do): trust it over the heuristic.
+      encoding = recorded == "snorm" ? Encoding::kSnorm : Encoding::kUnorm;
+    } else if (encoding == Encoding::kAuto) {
       if (spec.format.is_floating_point()) {
         const bool any_negative = std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
         encoding = any_negative ? Encoding::kSnorm : Encoding::kUnorm;

@@ -206,5 +206,24 @@ TEST(ImageIo, NormalMapRoundTripThroughIngest) {
   }
 }
 
+// A signed map without a single negative value (flat, or tilted only towards +x+y) would read back
+// as encoded under --encoding auto; the recorded encoding attribute keeps it signed.
+TEST(ImageIo, FlatSignedMapReadsBackFlat) {
+  ScratchDir dir;
+  NormalMap flat;
+  flat.width = flat.height = 4;
+  flat.normals.assign(4 * 4 * 3, 0.0f);
+  for (size_t i = 2; i < flat.normals.size(); i += 3) flat.normals[i] = 1.0f;
+  for (const char* name : {"flat.exr", "flat.png"}) {
+    const std::string path = dir.file(name);
+    ASSERT_TRUE(writeNormalMap(path, flat).ok()) << name;
+    IngestReport report;
+    auto back = loadNormalMap(path, IngestOptions{}, &report);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    for (size_t i = 0; i < flat.normals.size(); ++i)
+      EXPECT_NEAR(back.value().normals[i], flat.normals[i], 5e-5) << name;
+  }
+}
+
 }  // namespace
 }  // namespace glintbake::bake

@@ -20,7 +20,14 @@ struct ImageWriteOptions {
   // true: rename the temporary file to `path` when complete. false: leave the complete file at
   // temporary_path for the caller to move into place (it is still removed on failure).
   bool rename = true;
+  // When non-empty, stored as the file attribute kNormalEncodingAttribute ("snorm" or "unorm"), so
+  // that --encoding auto reads the map back as written even when no value is negative (a flat
+  // signed map would otherwise look encoded).
+  std::string normal_encoding;
 };
+
+// Name of the image attribute that records how a normal map's values are encoded.
+constexpr const char* kNormalEncodingAttribute = "glintbake:normal_encoding";
 
 // Writes width x height x channels float32 pixels (row-major, top row first) to path; the format
 // follows the extension (.exr, .png, .tif, ...). The file appears only when complete.
