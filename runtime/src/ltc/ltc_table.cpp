@@ -1,4 +1,5 @@
 // Runtime-lite LTC table: loading an ltc-table container and bilinear lookups.
+#include "../format_status.h"
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ltc.h>
 
@@ -13,19 +14,6 @@ namespace {
 constexpr int kMaxTableSize = 1024;
 constexpr uint32_t kLtcTableSection = format::kSectionLtcTable;
 
-Status fromFormat(format::Status status) {
-  switch (status) {
-    case format::Status::kOk:
-      return Status::kOk;
-    case format::Status::kIoError:
-      return Status::kIoError;
-    case format::Status::kUnsupportedVersion:
-      return Status::kUnsupportedVersion;
-    default:
-      return Status::kInvalidAsset;
-  }
-}
-
 // Reads section (48, key) and checks it is an N x N x 4 image; *size is set by the first call and
 // must match in the second.
 Status readImage(const format::Reader& reader, uint64_t key, int* size, std::vector<float>* out) {
@@ -38,7 +26,7 @@ Status readImage(const format::Reader& reader, uint64_t key, int* size, std::vec
   if (info.raw_size > uint64_t(sizeof(header)) + uint64_t(kMaxTableSize) * kMaxTableSize * 16)
     return Status::kInvalidAsset;
   const format::Status read = reader.readSection(size_t(index), &bytes);
-  if (read != format::Status::kOk) return fromFormat(read);
+  if (read != format::Status::kOk) return fromFormatStatus(read);
   // The layout is little-endian; this reader assumes a little-endian host.
   std::memcpy(&header, bytes.data(), sizeof(header));
   if (header.magic != format::ImageSectionHeader{}.magic || header.channels != 4 || header.layers != 1 ||
@@ -84,7 +72,7 @@ Status LtcTable::open(const char* path) {
   if (!path) return Status::kInvalidArgument;
   format::Reader reader;
   const format::Status status = reader.open(path);
-  if (status != format::Status::kOk) return fromFormat(status);
+  if (status != format::Status::kOk) return fromFormatStatus(status);
   return load(reader, this);
 }
 
@@ -92,7 +80,7 @@ Status LtcTable::openMemory(const void* data, size_t size) {
   if (!data) return Status::kInvalidArgument;
   format::Reader reader;
   const format::Status status = reader.openMemory(data, size);
-  if (status != format::Status::kOk) return fromFormat(status);
+  if (status != format::Status::kOk) return fromFormatStatus(status);
   return load(reader, this);
 }
 

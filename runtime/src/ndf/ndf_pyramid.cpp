@@ -1,3 +1,4 @@
+#include "../format_status.h"
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
@@ -44,19 +45,6 @@ struct Blend {
 
 bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
-Status fromFormat(format::Status s) {
-  switch (s) {
-    case format::Status::kOk:
-      return Status::kOk;
-    case format::Status::kIoError:
-      return Status::kIoError;
-    case format::Status::kUnsupportedVersion:
-      return Status::kUnsupportedVersion;
-    default:
-      return Status::kInvalidAsset;
-  }
-}
-
 }  // namespace
 
 struct NdfPyramid::Impl {
@@ -97,7 +85,7 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     if (idx < 0) break;
     if (reader.sections()[size_t(idx)].raw_size != sizeof(NdfLevelRecord)) return Status::kInvalidAsset;
     NdfLevelRecord rec;
-    if (Status s = fromFormat(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
+    if (Status s = fromFormatStatus(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
     // Descriptor sanity: everything the queries index with is checked here.
     if (rec.magic != NdfLevelRecord().magic) return Status::kInvalidAsset;
     if (rec.version != 1) return Status::kUnsupportedVersion;
@@ -135,7 +123,7 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
         if (reader.sections()[size_t(cidx)].raw_size != expected) return Status::kInvalidAsset;
         Array<uint8_t> chunk;
         if (!chunk.allocate(size_t(expected))) return Status::kOutOfMemory;
-        if (Status s = fromFormat(reader.readSectionInto(size_t(cidx), chunk.data, chunk.size)); s != Status::kOk)
+        if (Status s = fromFormatStatus(reader.readSectionInto(size_t(cidx), chunk.data, chunk.size)); s != Status::kOk)
           return s;
         format::ImageSectionHeader header;
         std::memcpy(&header, chunk.data, sizeof(header));
@@ -247,7 +235,7 @@ Status NdfPyramid::open(const char* path) {
   impl_.reset();
   if (!path) return Status::kInvalidArgument;
   format::Reader reader;
-  if (Status s = fromFormat(reader.open(path)); s != Status::kOk) return s;
+  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
   if (!impl) return Status::kOutOfMemory;
   if (Status s = impl->load(reader); s != Status::kOk) return s;
@@ -259,7 +247,7 @@ Status NdfPyramid::openMemory(const void* data, size_t size) {
   impl_.reset();
   if (!data) return Status::kInvalidArgument;
   format::Reader reader;
-  if (Status s = fromFormat(reader.openMemory(data, size)); s != Status::kOk) return s;
+  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
   if (!impl) return Status::kOutOfMemory;
   if (Status s = impl->load(reader); s != Status::kOk) return s;

@@ -72,7 +72,9 @@ enum SectionType : uint32_t {
   kSectionMetadata = 1,            // UTF-8 JSON object, schemas/container-metadata.schema.json. Exactly one.
   kSectionNdfLevel = 16,           // ndf-pyramid: per-level descriptor (key = level)
   kSectionNdfChunk = 17,           // ndf-pyramid: NDF images of one spatial region (key = level << 32 | region)
-  kSectionTensorIndex = 32,        // tensor-ndf sections (32-47)
+  kSectionTensorIndex = 32,        // tensor-ndf: (level, centre, block) -> (group, row) (key = level)
+  kSectionTensorInfo = 33,         // tensor-ndf: asset descriptor (key = 0)
+  kSectionTensorGroup = 34,        // tensor-ndf: CP factors of one group (key = group id)
   kSectionLtcTable = 48,           // ltc-table sections (48-63)
   kSectionRoughness = 64,          // roughness mips (64-79)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
@@ -80,7 +82,7 @@ enum SectionType : uint32_t {
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
-// "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate, "unknown"
+// "tensor-info", "tensor-group", "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate, "unknown"
 // otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);
 bool sectionTypeFromString(const std::string& name, uint32_t* type);

@@ -28,7 +28,7 @@
 // every size is checked against the container and against the descriptor before use.
 #pragma once
 
-#include <glintbake/runtime/runtime.h>
+#include <glintbake/runtime/ndf_source.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -62,18 +62,13 @@ struct NdfLevelRecord {
 };
 static_assert(sizeof(NdfLevelRecord) == 112, "NdfLevelRecord is 112 bytes");
 
-// A rectangle of the s-plane [x0, x1] x [y0, y1] (x0 < x1, y0 < y1).
-struct SRect {
-  double x0 = -1.0, y0 = -1.0, x1 = 1.0, y1 = 1.0;
-};
-
 // Most levels a pyramid may have.
 constexpr int kMaxNdfLevels = 32;
 
-class NdfPyramid {
+class NdfPyramid final : public NdfSource {
  public:
   NdfPyramid();
-  ~NdfPyramid();
+  ~NdfPyramid() override;
   NdfPyramid(const NdfPyramid&) = delete;
   NdfPyramid& operator=(const NdfPyramid&) = delete;
 
@@ -84,7 +79,7 @@ class NdfPyramid {
   Status openMemory(const void* data, size_t size);
   bool isOpen() const;
 
-  int resolution() const;  // R
+  int resolution() const override;  // R
   int levelCount() const;
   // Descriptor of level l in [0, levelCount()), or null.
   const NdfLevelRecord* level(int l) const;
@@ -92,20 +87,20 @@ class NdfPyramid {
   const float* centreImage(int l, int i, int j) const;
 
   // Value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const;
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
   // Exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2 count as 0).
   // Cost grows with the number of bins the rectangle covers.
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const;
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
   // Samples s from the blended P-NDF with two uniforms in [0, 1); sample->pdf == pdf(footprint, s).
   // kInvalidArgument if the blend has no mass.
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const;
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
   // Density of sample(): eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for
   // footprints away from the edges of clamp maps, so pdf == eval there).
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const;
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
   // Total mass of the blend (integral over the s-plane).
-  Status mass(const Footprint& footprint, double* value) const;
+  Status mass(const Footprint& footprint, double* value) const override;
   // The blended image the runtime sees: out must hold R * R floats (out_count >= R * R).
-  Status image(const Footprint& footprint, float* out, size_t out_count) const;
+  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
 
  private:
   struct Impl;

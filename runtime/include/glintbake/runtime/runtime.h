@@ -34,6 +34,11 @@ struct SPoint {
   double y = 0.0;
 };
 
+// A rectangle of the s-plane [x0, x1] x [y0, y1] (x0 < x1, y0 < y1).
+struct SRect {
+  double x0 = -1.0, y0 = -1.0, x1 = 1.0, y1 = 1.0;
+};
+
 // Result of importance sampling the P-NDF: the sampled point and its density (== eval at s).
 struct NdfSample {
   SPoint s;

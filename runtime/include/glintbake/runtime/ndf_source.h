@@ -1,0 +1,48 @@
+// The query interface every NDF asset kind implements (ndf-pyramid, tensor-ndf, and the kinds that
+// follow), so that a renderer or a tool can work with any of them through one pointer.
+//
+// All queries take a Gaussian pixel footprint (texels of the source normal map) and s-plane points
+// or rectangles (runtime.h). Values are densities per unit s-plane area; an NDF of a footprint away
+// from the edges of a clamped map integrates to 1 over [-1, 1]^2.
+//
+// Contract shared by every implementation:
+//  - eval() >= 0 everywhere; 0 outside [-1, 1]^2;
+//  - average() is the exact mean of the asset's piecewise-constant density over the rectangle
+//    (parts outside [-1, 1]^2 count as 0);
+//  - sample() returns a point together with the density with which it was drawn, and pdf() at that
+//    point returns the same number (bit for bit);
+//  - queries are const, thread-safe, never allocate and never throw; an invalid argument (non-finite
+//    or non-positive sigma, non-finite s) returns kInvalidArgument and leaves outputs untouched.
+#pragma once
+
+#include <glintbake/runtime/runtime.h>
+
+#include <cstddef>
+#include <memory>
+
+namespace glintbake::runtime {
+
+class NdfSource {
+ public:
+  virtual ~NdfSource() = default;
+
+  // Bins per side of the NDF images the asset represents.
+  virtual int resolution() const = 0;
+
+  virtual Status eval(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual Status average(const Footprint& footprint, const SRect& rect, double* value) const = 0;
+  // u1, u2 in [0, 1). kInvalidArgument when the footprint's NDF has no mass.
+  virtual Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
+  virtual Status pdf(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  // Integral of eval() over the s-plane.
+  virtual Status mass(const Footprint& footprint, double* value) const = 0;
+  // The R x R image of eval() (bin averages, row 0 at s_y = +1); out_count >= R * R.
+  virtual Status image(const Footprint& footprint, float* out, size_t out_count) const = 0;
+};
+
+// Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf), chosen by the container's
+// asset kind. kIoError, kInvalidAsset, kWrongKind (a container of another kind), kUnsupportedVersion,
+// kOutOfMemory. Safe on untrusted input. On failure *out is reset.
+Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out);
+
+}  // namespace glintbake::runtime
