@@ -124,8 +124,31 @@ LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions&
   return g;
 }
 
+Status WriterPyramidSink::addLevel(const runtime::NdfLevelRecord& record) {
+  if (format::Status st = writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
+      st != format::Status::kOk) {
+    return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
+  }
+  return okStatus();
+}
+
+Status WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
+  const uint64_t key = (uint64_t(chunk.level) << 32) | uint64_t(chunk.region);
+  if (format::Status st = writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
+      st != format::Status::kOk) {
+    return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
+  }
+  return okStatus();
+}
+
 Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
                        PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  WriterPyramidSink sink(writer);
+  return buildNdfPyramid(map, options, sink, report, progress, cancel);
+}
+
+Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport* report,
+                       const PyramidProgress& progress, const std::atomic<bool>* cancel) {
   if (Status s = validatePyramidOptions(options); !s) return s;
   PyramidReport local_report;
   PyramidReport& rep = report ? *report : local_report;
@@ -162,7 +185,7 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
     if (cancelled()) return cancelError();
 
     const auto t_level = Clock::now();
-    const uint64_t bytes_before = writer.bytesWritten();
+    const uint64_t bytes_before = sink.storedBytes();
     PyramidLevelReport lrep;
     lrep.level = level;
     lrep.geometry = geo;
@@ -192,10 +215,7 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
     rec.origin_y = 0.5 * geo.stride_y;
     rec.sigma_texels = geo.sigma;
     rec.sigma_r = options.splat.sigma_r;
-    if (format::Status st = writer.addSection(format::kSectionNdfLevel, uint64_t(level), &rec, sizeof(rec));
-        st != format::Status::kOk) {
-      return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
-    }
+    if (Status s = sink.addLevel(rec); !s) return s;
 
     const int region_count = geo.regions_x * geo.regions_y;
     const uint64_t level_images = uint64_t(geo.grid_width) * uint64_t(geo.grid_height);
@@ -260,12 +280,20 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
       std::vector<float>& buf = buffers[r % 2];
       std::memcpy(buf.data(), &header, sizeof(header));
       const size_t bytes = sizeof(header) + size_t(cw * ch) * image_floats * sizeof(float);
-      const format::Status st =
-          writer.addSection(format::kSectionNdfChunk, (uint64_t(level) << 32) | uint64_t(r), buf.data(), bytes);
+      PyramidChunk chunk;
+      chunk.level = level;
+      chunk.region = r;
+      chunk.x0 = cx0;
+      chunk.y0 = cy0;
+      chunk.width = cw;
+      chunk.height = ch;
+      chunk.ndf_res = res;
+      chunk.images = buf.data() + 8;
+      chunk.section = buf.data();
+      chunk.section_bytes = bytes;
+      Status sunk = sink.addChunk(chunk);
       next.wait();
-      if (st != format::Status::kOk) {
-        return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
-      }
+      if (!sunk) return sunk;
       for (int k = 0; k < cw * ch; ++k) {
         const int centre = (cy0 + k / cw) * geo.grid_width + (cx0 + k % cw);
         const float* img = buf.data() + 8 + size_t(k) * image_floats;
@@ -285,7 +313,8 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
       if (progress) progress(level, done, level_images);
     }
     if (!samples.empty()) lrep.mse_vs_previous = mse_sum / double(samples.size());
-    lrep.stored_bytes = writer.bytesWritten() - bytes_before;
+    if (Status s = sink.endLevel(level); !s) return s;
+    lrep.stored_bytes = sink.storedBytes() - bytes_before;
     lrep.seconds = secondsSince(t_level);
     rep.levels.push_back(lrep);
 

@@ -1,4 +1,4 @@
-"""glintquery: point, image and batch queries on an ndf-pyramid through the runtime."""
+"""glintquery: point, image and batch queries on ndf-pyramid and tensor-ndf assets through the runtime."""
 
 import json
 import math
@@ -69,6 +69,77 @@ class GlintQuery(ToolTestCase):
                              stdin=json.dumps({"op": "pdf", "x": 3.0, "y": 4.0, "sigma": 6.0, "s": s}) + "\n")
         self.assertEqual(code, 0, err)
         self.assertAlmostEqual(json.loads(out)["value"], lines[2]["pdf"], delta=1e-9 * lines[2]["pdf"])
+
+    def test_batch_range_pdf_mass(self):
+        fp = {"x": 10.5, "y": 27.0, "sigma": 7.0}
+        queries = [
+            dict(fp, op="range", s0=[-0.3, -0.2], s1=[0.25, 0.4], id="r"),
+            dict(fp, op="range", rect=[-0.3, -0.2, 0.25, 0.4]),
+            dict(fp, op="mass"),
+            dict(fp, op="sample", u=[0.6, 0.1]),
+            dict(fp, op="range", s0=[0.3, 0.0], s1=[0.1, 0.5]),  # s0 > s1: an error line
+            dict(fp, op="sample", u=[1.0, 0.5]),                 # u outside [0, 1): an error line
+        ]
+        code, out, err = run("glintquery", "batch", self.asset, stdin="\n".join(json.dumps(q) for q in queries) + "\n")
+        self.assertEqual(code, clitest.INVALID)
+        self.assertIn("2 of 6 queries failed", err)
+        lines = [json.loads(l) for l in out.splitlines()]
+        self.assertEqual(len(lines), 6)
+        for l in lines:
+            clitest.validate(l, "glintquery-batch.schema.json")
+        self.assertEqual(lines[0]["id"], "r")
+        self.assertEqual(lines[0]["average"], lines[1]["average"])
+        self.assertGreater(lines[0]["average"], 0.0)
+        self.assertAlmostEqual(lines[2]["mass"], 1.0, delta=2e-3)
+        self.assertIn("error", lines[4])
+        self.assertIn("error", lines[5])
+        # pdf at the sample is the sample's pdf, exactly; with mass ~1 it is the point value too.
+        s = lines[3]["s"]
+        code, out, err = run("glintquery", "batch", self.asset,
+                             stdin=json.dumps(dict(fp, op="pdf", s=s)) + "\n" + json.dumps(dict(fp, op="point", s=s)))
+        self.assertEqual(code, 0, err)
+        pdf, point = [json.loads(l) for l in out.splitlines()]
+        self.assertEqual(pdf["pdf"], lines[3]["pdf"])
+        self.assertAlmostEqual(point["value"], pdf["pdf"] * lines[2]["mass"], delta=1e-9 * point["value"])
+
+    def test_tensor_asset(self):
+        if not os.path.exists(clitest.tool_path("tensorpack")):
+            self.skipTest("tensorpack is not built")
+        tensor = self.path("t.gbk")
+        self.run_ok("tensorpack", self.asset, "-o", tensor, "--rank", "16", "--block", "16", "--nonneg", "--quiet")
+        doc = self.run_json("glintquery", "point", tensor, "--at", "12,20", "--sigma", "5", "--s", "0.02,-0.01",
+                            schema="glintquery-point.schema.json")
+        self.assertEqual(doc["kind"], "tensor-ndf")
+        ref = self.run_json("glintquery", "point", self.asset, "--at", "12,20", "--sigma", "5", "--s", "0.02,-0.01",
+                            schema="glintquery-point.schema.json")
+        self.assertEqual(ref["kind"], "ndf-pyramid")
+        self.assertGreater(doc["value"], 0.0)
+        # Point values of a rank-16 model carry its per-bin error; averages over many bins agree closely.
+        wide = json.dumps({"op": "range", "x": 12, "y": 20, "sigma": 5, "s0": [-0.4, -0.4], "s1": [0.4, 0.4]}) + "\n"
+        averages = []
+        for path in (tensor, self.asset):
+            code, out, err = run("glintquery", "batch", path, stdin=wide)
+            self.assertEqual(code, 0, err)
+            averages.append(json.loads(out)["average"])
+        self.assertAlmostEqual(averages[0], averages[1], delta=0.02 * averages[1])
+        img = self.run_json("glintquery", "image", tensor, "--at", "16,16", "--sigma", "8", "-o", self.path("t.exr"),
+                            schema="glintquery-image.schema.json")
+        self.assertEqual(img["resolution"], 32)
+        self.assertAlmostEqual(img["mass"], 1.0, delta=2e-2)
+        fp = {"x": 3.0, "y": 4.0, "sigma": 6.0}
+        queries = [dict(fp, op="sample", u=[k / 7.0, (k * 3 % 7) / 7.0]) for k in range(7)]
+        queries += [dict(fp, op="range", s0=[-1, -1], s1=[1, 1]), dict(fp, op="mass")]
+        code, out, err = run("glintquery", "batch", tensor, stdin="\n".join(json.dumps(q) for q in queries) + "\n")
+        self.assertEqual(code, 0, err)
+        lines = [json.loads(l) for l in out.splitlines()]
+        for l in lines:
+            clitest.validate(l, "glintquery-batch.schema.json")
+        self.assertAlmostEqual(lines[7]["average"] * 4.0, lines[8]["mass"], delta=1e-4)
+        pdf_queries = [dict(fp, op="pdf", s=l["s"]) for l in lines[:7]]
+        code, out, err = run("glintquery", "batch", tensor, stdin="\n".join(json.dumps(q) for q in pdf_queries) + "\n")
+        self.assertEqual(code, 0, err)
+        for sample, answer in zip(lines[:7], [json.loads(l) for l in out.splitlines()]):
+            self.assertEqual(answer["pdf"], sample["pdf"])
 
     def test_batch_bad_lines(self):
         code, out, err = run("glintquery", "batch", self.asset,

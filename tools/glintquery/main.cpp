@@ -1,11 +1,14 @@
-// glintquery: answers P-NDF queries on a baked NDF asset through the runtime-lite, exactly as a
-// renderer would see them: point values, the blended image of a footprint, and JSON-lines batches.
+// glintquery: answers P-NDF queries on a baked NDF asset (ndf-pyramid or tensor-ndf) through the
+// runtime-lite, exactly as a renderer would see them: point values, the blended image of a
+// footprint, and JSON-lines batches of point, range, sample, pdf and mass queries.
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/cli/tool.h>
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/ndf_source.h>
 
 #include <cmath>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,10 +38,22 @@ void parsePair(const std::string& text, const char* option, double* a, double* b
   if (!ok) throw Error(cli::kExitBadArguments, std::string(option) + " expects two numbers A,B (got '" + text + "')");
 }
 
-void openAsset(rt::NdfPyramid& pyramid, cli::Tool& tool, const std::string& path) {
+// An opened NDF asset of any kind the runtime reads.
+struct Asset {
+  std::unique_ptr<rt::NdfSource> source;
+  std::string kind;  // "ndf-pyramid", "tensor-ndf"
+};
+
+Asset openAsset(cli::Tool& tool, const std::string& path) {
   tool.addInput(path);
-  const rt::Status s = pyramid.open(path.c_str());
-  if (s == rt::Status::kOk) return;
+  Asset asset;
+  const rt::Status s = rt::openNdfAsset(path.c_str(), &asset.source);
+  if (s == rt::Status::kOk) {
+    glintbake::format::Reader reader;  // header and index only: the kind for the JSON summaries
+    asset.kind = reader.open(path) == glintbake::format::Status::kOk ? glintbake::format::assetKindString(reader.kind())
+                                                                     : "unknown";
+    return asset;
+  }
   int code = cli::kExitInvalidInput;
   if (s == rt::Status::kIoError) code = cli::kExitIo;
   if (s == rt::Status::kWrongKind || s == rt::Status::kUnsupportedVersion) code = cli::kExitUnsupported;
@@ -69,7 +84,13 @@ std::vector<double> numbers(const Json& line, const char* key, size_t n) {
 }
 
 // Answers one batch query; throws std::invalid_argument on a malformed query.
-Json answer(const rt::NdfPyramid& pyramid, const Json& q) {
+//   point  "s": [sx, sy]                    -> "value" (density per unit s-plane area)
+//   pdf    "s": [sx, sy]                    -> "pdf" (density of sample(); "value" repeats it)
+//   range  "s0": [x0, y0], "s1": [x1, y1]   -> "average" over the rectangle with corners s0 < s1
+//          (or "rect": [x0, y0, x1, y1];       "value" repeats it)
+//   sample "u": [u1, u2] in [0, 1)          -> "s", "pdf"
+//   mass                                    -> "mass" (integral over the s-plane)
+Json answer(const rt::NdfSource& ndf, const Json& q) {
   if (!q.is_object()) throw std::invalid_argument("a query must be a JSON object");
   auto op_it = q.find("op");
   if (op_it == q.end() || !op_it->is_string()) throw std::invalid_argument("missing string 'op'");
@@ -86,27 +107,48 @@ Json answer(const rt::NdfPyramid& pyramid, const Json& q) {
     const std::vector<double> s = numbers(q, "s", 2);
     double v = 0.0;
     const rt::Status st =
-        op == "point" ? pyramid.eval(fp, rt::SPoint{s[0], s[1]}, &v) : pyramid.pdf(fp, rt::SPoint{s[0], s[1]}, &v);
+        op == "point" ? ndf.eval(fp, rt::SPoint{s[0], s[1]}, &v) : ndf.pdf(fp, rt::SPoint{s[0], s[1]}, &v);
     if (st != rt::Status::kOk) fail(st);
+    if (op == "pdf") out["pdf"] = v;
     out["value"] = v;
   } else if (op == "range") {
-    const std::vector<double> r = numbers(q, "rect", 4);
     rt::SRect rect;
-    rect.x0 = r[0];
-    rect.y0 = r[1];
-    rect.x1 = r[2];
-    rect.y1 = r[3];
+    if (q.contains("rect")) {
+      const std::vector<double> r = numbers(q, "rect", 4);
+      rect.x0 = r[0];
+      rect.y0 = r[1];
+      rect.x1 = r[2];
+      rect.y1 = r[3];
+    } else {
+      const std::vector<double> s0 = numbers(q, "s0", 2), s1 = numbers(q, "s1", 2);
+      rect.x0 = s0[0];
+      rect.y0 = s0[1];
+      rect.x1 = s1[0];
+      rect.y1 = s1[1];
+    }
+    if (!(rect.x1 > rect.x0 && rect.y1 > rect.y0))
+      throw std::invalid_argument("a range needs s0 < s1 in both coordinates");
     double v = 0.0;
-    if (rt::Status st = pyramid.average(fp, rect, &v); st != rt::Status::kOk) fail(st);
+    if (rt::Status st = ndf.average(fp, rect, &v); st != rt::Status::kOk) fail(st);
+    out["average"] = v;
     out["value"] = v;
   } else if (op == "sample") {
     const std::vector<double> u = numbers(q, "u", 2);
+    if (!(u[0] >= 0.0 && u[0] < 1.0 && u[1] >= 0.0 && u[1] < 1.0))
+      throw std::invalid_argument("'u' must hold two numbers in [0, 1)");
     rt::NdfSample smp;
-    if (rt::Status st = pyramid.sample(fp, u[0], u[1], &smp); st != rt::Status::kOk) fail(st);
+    if (rt::Status st = ndf.sample(fp, u[0], u[1], &smp); st != rt::Status::kOk) {
+      if (st == rt::Status::kInvalidArgument) throw std::invalid_argument("the footprint's NDF has no mass to sample");
+      fail(st);
+    }
     out["s"] = {smp.s.x, smp.s.y};
     out["pdf"] = smp.pdf;
+  } else if (op == "mass") {
+    double v = 0.0;
+    if (rt::Status st = ndf.mass(fp, &v); st != rt::Status::kOk) fail(st);
+    out["mass"] = v;
   } else {
-    throw std::invalid_argument("unknown op '" + op + "' (point, range, sample, pdf)");
+    throw std::invalid_argument("unknown op '" + op + "' (point, range, sample, pdf, mass)");
   }
   return out;
 }
@@ -114,7 +156,8 @@ Json answer(const rt::NdfPyramid& pyramid, const Json& q) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  cli::Tool tool("glintquery", "Queries baked NDF assets through the runtime (point, image, batch)");
+  cli::Tool tool("glintquery",
+                 "Queries baked NDF assets (ndf-pyramid, tensor-ndf) through the runtime (point, image, batch)");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
   app.fallthrough();
@@ -137,28 +180,32 @@ int main(int argc, char** argv) {
                     "Multiply densities by this before writing (default: 1 for float "
                     "formats, 1/max for integer formats)");
 
-  CLI::App* batch = app.add_subcommand("batch", "JSON-lines queries on stdin, one JSON line per answer on stdout");
+  CLI::App* batch = app.add_subcommand(
+      "batch",
+      "JSON-lines queries on stdin, one JSON line per answer on stdout. Each query: {\"op\", \"x\", \"y\", "
+      "\"sigma\", optional \"id\"} plus per op: point/pdf \"s\":[sx,sy]; range \"s0\":[x0,y0], \"s1\":[x1,y1]; "
+      "sample \"u\":[u1,u2]; mass (schemas/glintquery-batch.schema.json)");
   batch->add_option("asset", asset, "NDF asset (.gbk)")->required();
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
-    rt::NdfPyramid pyramid;
     if (*point) {
       double x, y, sx, sy;
       parsePair(at_text, "--at", &x, &y);
       parsePair(s_text, "--s", &sx, &sy);
       if (!(sigma >= 0.0) || !std::isfinite(sigma)) throw Error(cli::kExitBadArguments, "--sigma must be >= 0");
-      openAsset(pyramid, t, asset);
+      const Asset ndf = openAsset(t, asset);
       rt::Footprint fp;
       fp.x = x;
       fp.y = y;
       fp.sigma = sigma;
       double v = 0.0;
-      check(pyramid.eval(fp, rt::SPoint{sx, sy}, &v), "point query");
+      check(ndf.source->eval(fp, rt::SPoint{sx, sy}, &v), "point query");
       if (t.common().json) {
         Json doc;
         doc["tool"] = "glintquery";
         doc["op"] = "point";
         doc["asset"] = cli::baseName(asset);
+        doc["kind"] = ndf.kind;
         doc["at"] = {x, y};
         doc["sigma"] = sigma;
         doc["s"] = {sx, sy};
@@ -177,14 +224,14 @@ int main(int argc, char** argv) {
       parsePair(at_text, "--at", &x, &y);
       if (!(sigma >= 0.0) || !std::isfinite(sigma)) throw Error(cli::kExitBadArguments, "--sigma must be >= 0");
       if (!(png_scale >= 0.0) || !std::isfinite(png_scale)) throw Error(cli::kExitBadArguments, "--scale must be >= 0");
-      openAsset(pyramid, t, asset);
+      const Asset ndf = openAsset(t, asset);
       rt::Footprint fp;
       fp.x = x;
       fp.y = y;
       fp.sigma = sigma;
-      const int res = pyramid.resolution();
+      const int res = ndf.source->resolution();
       std::vector<float> pixels(size_t(res) * size_t(res));
-      check(pyramid.image(fp, pixels.data(), pixels.size()), "image query");
+      check(ndf.source->image(fp, pixels.data(), pixels.size()), "image query");
       double mass = 0.0, peak = 0.0;
       for (float v : pixels) {
         mass += v;
@@ -207,6 +254,7 @@ int main(int argc, char** argv) {
         doc["tool"] = "glintquery";
         doc["op"] = "image";
         doc["asset"] = cli::baseName(asset);
+        doc["kind"] = ndf.kind;
         doc["output"] = cli::baseName(output);
         doc["at"] = {x, y};
         doc["sigma"] = sigma;
@@ -222,7 +270,7 @@ int main(int argc, char** argv) {
       return cli::kExitOk;
     }
     // batch
-    openAsset(pyramid, t, asset);
+    const Asset ndf = openAsset(t, asset);
     std::string line;
     uint64_t count = 0, failed = 0;
     std::string first_error;
@@ -231,7 +279,7 @@ int main(int argc, char** argv) {
       ++count;
       Json out;
       try {
-        out = answer(pyramid, Json::parse(line));
+        out = answer(*ndf.source, Json::parse(line));
       } catch (const std::exception& e) {
         ++failed;
         const std::string msg = std::string("query ") + std::to_string(count) + ": " + e.what();

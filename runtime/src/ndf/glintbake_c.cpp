@@ -1,5 +1,9 @@
+#include <glintbake/format/container.h>
 #include <glintbake/runtime/glintbake_c.h>
 #include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/runtime/ndf_source.h>
+
+#include <memory>
 
 #include <new>
 
@@ -12,6 +16,11 @@ using glintbake::runtime::Status;
 
 struct gb_ndf_pyramid {
   NdfPyramid pyramid;
+};
+
+struct gb_ndf_asset {
+  std::unique_ptr<glintbake::runtime::NdfSource> source;
+  int32_t kind = 0;
 };
 
 namespace {
@@ -36,6 +45,33 @@ int32_t openWith(gb_ndf_pyramid** out, OpenFn&& fn) {
   }
   *out = p;
   return GB_OK;
+}
+// Opens any NDF asset kind; `reader` has already been opened on the same bytes and gives the kind.
+template <typename OpenFn>
+int32_t openAsset(gb_ndf_asset** out, const glintbake::format::Reader& reader, OpenFn&& fn) {
+  gb_ndf_asset* a = new (std::nothrow) gb_ndf_asset();
+  if (!a) return GB_OUT_OF_MEMORY;
+  const Status s = fn(&a->source);
+  if (s != Status::kOk) {
+    delete a;
+    return code(s);
+  }
+  a->kind = int32_t(reader.kind());
+  *out = a;
+  return GB_OK;
+}
+
+int32_t fromFormat(glintbake::format::Status s) {
+  switch (s) {
+    case glintbake::format::Status::kOk:
+      return GB_OK;
+    case glintbake::format::Status::kIoError:
+      return GB_IO_ERROR;
+    case glintbake::format::Status::kUnsupportedVersion:
+      return GB_UNSUPPORTED_VERSION;
+    default:
+      return GB_INVALID_ASSET;
+  }
 }
 }  // namespace
 
@@ -101,6 +137,77 @@ int32_t gb_ndf_pyramid_pdf(const gb_ndf_pyramid* p, double x, double y, double s
 int32_t gb_ndf_pyramid_image(const gb_ndf_pyramid* p, double x, double y, double sigma, float* out, size_t count) {
   if (!p) return GB_INVALID_ARGUMENT;
   return code(p->pyramid.image(footprint(x, y, sigma), out, count));
+}
+
+int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {
+  if (!out) return GB_INVALID_ARGUMENT;
+  *out = nullptr;
+  if (!path) return GB_INVALID_ARGUMENT;
+  glintbake::format::Reader reader;
+  if (int32_t st = fromFormat(reader.open(path)); st != GB_OK) return st;
+  return openAsset(out, reader, [&](auto* src) { return glintbake::runtime::openNdfAsset(path, src); });
+}
+
+int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out) {
+  if (!out) return GB_INVALID_ARGUMENT;
+  *out = nullptr;
+  if (!data) return GB_INVALID_ARGUMENT;
+  glintbake::format::Reader reader;
+  if (int32_t st = fromFormat(reader.openMemory(data, size)); st != GB_OK) return st;
+  return openAsset(out, reader, [&](auto* src) { return glintbake::runtime::openNdfAssetMemory(data, size, src); });
+}
+
+void gb_ndf_asset_close(gb_ndf_asset* asset) { delete asset; }
+
+int32_t gb_ndf_asset_info(const gb_ndf_asset* a, int32_t* kind, int32_t* resolution) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  if (kind) *kind = a->kind;
+  if (resolution) *resolution = a->source->resolution();
+  return GB_OK;
+}
+
+int32_t gb_ndf_asset_eval(const gb_ndf_asset* a, double x, double y, double sigma, double sx, double sy,
+                          double* value) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  return code(a->source->eval(footprint(x, y, sigma), SPoint{sx, sy}, value));
+}
+
+int32_t gb_ndf_asset_average(const gb_ndf_asset* a, double x, double y, double sigma, double sx0, double sy0,
+                             double sx1, double sy1, double* value) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  SRect r;
+  r.x0 = sx0;
+  r.y0 = sy0;
+  r.x1 = sx1;
+  r.y1 = sy1;
+  return code(a->source->average(footprint(x, y, sigma), r, value));
+}
+
+int32_t gb_ndf_asset_sample(const gb_ndf_asset* a, double x, double y, double sigma, double u1, double u2, double* sx,
+                            double* sy, double* pdf) {
+  if (!a || !sx || !sy || !pdf) return GB_INVALID_ARGUMENT;
+  NdfSample s;
+  const Status st = a->source->sample(footprint(x, y, sigma), u1, u2, &s);
+  if (st != Status::kOk) return code(st);
+  *sx = s.s.x;
+  *sy = s.s.y;
+  *pdf = s.pdf;
+  return GB_OK;
+}
+
+int32_t gb_ndf_asset_pdf(const gb_ndf_asset* a, double x, double y, double sigma, double sx, double sy, double* pdf) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  return code(a->source->pdf(footprint(x, y, sigma), SPoint{sx, sy}, pdf));
+}
+
+int32_t gb_ndf_asset_mass(const gb_ndf_asset* a, double x, double y, double sigma, double* mass) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  return code(a->source->mass(footprint(x, y, sigma), mass));
+}
+
+int32_t gb_ndf_asset_image(const gb_ndf_asset* a, double x, double y, double sigma, float* out, size_t count) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  return code(a->source->image(footprint(x, y, sigma), out, count));
 }
 
 }  // extern "C"

@@ -1,20 +1,35 @@
-#include "../format_status.h"
+// Opening any NDF asset kind through the NdfSource interface, chosen by the container's kind.
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/tensor_ndf.h>
+#include "../format_status.h"
 
 #include <new>
 
 namespace glintbake::runtime {
 namespace {
 
-template <typename Asset>
-Status openAs(const char* path, std::unique_ptr<NdfSource>* out) {
+template <typename Asset, typename OpenFn>
+Status openAs(std::unique_ptr<NdfSource>* out, OpenFn&& open) {
   std::unique_ptr<Asset> asset(new (std::nothrow) Asset());
   if (!asset) return Status::kOutOfMemory;
-  if (Status st = asset->open(path); st != Status::kOk) return st;
+  if (Status st = open(*asset); st != Status::kOk) return st;
   *out = std::move(asset);
   return Status::kOk;
+}
+
+// Dispatches on the kind of an opened reader; `open` loads the chosen asset class.
+template <typename OpenFn>
+Status openKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out, OpenFn&& open) {
+  switch (reader.kind()) {
+    case format::AssetKind::kNdfPyramid:
+      return openAs<NdfPyramid>(out, open);
+    case format::AssetKind::kTensorNdf:
+      return openAs<TensorNdf>(out, open);
+    default:
+      return Status::kWrongKind;
+  }
 }
 
 }  // namespace
@@ -25,10 +40,16 @@ Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
   if (path == nullptr) return Status::kInvalidArgument;
   format::Reader reader;
   if (format::Status st = reader.open(path); st != format::Status::kOk) return fromFormatStatus(st);
-  switch (reader.kind()) {
-    case format::AssetKind::kNdfPyramid: return openAs<NdfPyramid>(path, out);
-    default: return Status::kWrongKind;
-  }
+  return openKind(reader, out, [&](auto& asset) { return asset.open(path); });
+}
+
+Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out) {
+  if (out == nullptr) return Status::kInvalidArgument;
+  out->reset();
+  if (data == nullptr) return Status::kInvalidArgument;
+  format::Reader reader;
+  if (format::Status st = reader.openMemory(data, size); st != format::Status::kOk) return fromFormatStatus(st);
+  return openKind(reader, out, [&](auto& asset) { return asset.openMemory(data, size); });
 }
 
 }  // namespace glintbake::runtime

@@ -53,6 +53,34 @@ int32_t gb_ndf_pyramid_pdf(const gb_ndf_pyramid* pyramid, double x, double y, do
 /* The blended R x R image (row 0 at s_y = +1); out must hold count >= R * R floats. */
 int32_t gb_ndf_pyramid_image(const gb_ndf_pyramid* pyramid, double x, double y, double sigma, float* out, size_t count);
 
+/* Any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf), behind one handle; the queries
+ * behave as the gb_ndf_pyramid_* ones (ndf_source.h states the shared contract: values >= 0, the
+ * pdf returned by sampling equals gb_ndf_asset_pdf at the sampled point bit for bit). */
+typedef struct gb_ndf_asset gb_ndf_asset;
+
+/* Container asset kinds of NDF assets (formats/SPEC.md section 4). */
+enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2 };
+
+/* GB_WRONG_KIND for containers of other asset kinds. */
+int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out);
+int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out);
+void gb_ndf_asset_close(gb_ndf_asset* asset); /* NULL is allowed */
+
+/* Asset kind (GB_KIND_*) and NDF resolution R (bins per side); either pointer may be NULL. */
+int32_t gb_ndf_asset_info(const gb_ndf_asset* asset, int32_t* kind, int32_t* resolution);
+
+int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
+                          double* value);
+int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0, double sy0,
+                             double sx1, double sy1, double* value);
+int32_t gb_ndf_asset_sample(const gb_ndf_asset* asset, double x, double y, double sigma, double u1, double u2,
+                            double* sx, double* sy, double* pdf);
+int32_t gb_ndf_asset_pdf(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
+                         double* pdf);
+/* Integral of the footprint's NDF over the s-plane (what sampling normalises by). */
+int32_t gb_ndf_asset_mass(const gb_ndf_asset* asset, double x, double y, double sigma, double* mass);
+int32_t gb_ndf_asset_image(const gb_ndf_asset* asset, double x, double y, double sigma, float* out, size_t count);
+
 #ifdef __cplusplus
 }
 #endif

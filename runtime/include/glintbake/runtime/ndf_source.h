@@ -44,5 +44,7 @@ class NdfSource {
 // asset kind. kIoError, kInvalidAsset, kWrongKind (a container of another kind), kUnsupportedVersion,
 // kOutOfMemory. Safe on untrusted input. On failure *out is reset.
 Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out);
+// Same, from a caller buffer (only needed during the call).
+Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out);
 
 }  // namespace glintbake::runtime

@@ -1,5 +1,5 @@
 // Streams a multi-level pyramid of footprint NDF images (Deng et al. 2022, "Constant-Cost
-// Spatially-Varying Glints") into an ndf-pyramid container.
+// Spatially-Varying Glints") into an ndf-pyramid container, or into any PyramidSink.
 //
 // Level l: footprint std sigma_l = sigma0 * 2^l texels; grid_width = max(1, round(map_width /
 // (stride0 * 2^l))) centres per row (likewise per column), actual stride = map size / grid size
@@ -9,12 +9,13 @@
 //
 // Streaming: each level is cut into regions of region_size x region_size centres; the images of one
 // region are computed in parallel (each image independently, by one thread, so results do not
-// depend on the thread count), then written as one kSectionNdfChunk section while the next region
-// is computed. Footprints with more than 2^18 flakes (the top levels: few images, each up to
-// several maps' worth of flakes) are instead split into 16 interleaved row sets computed in
-// parallel and summed in a fixed order (still independent of the thread count). Peak memory: the
-// flakes (24 bytes per flake) plus two chunks (2 * region_size^2 * R^2 * 4 bytes; 32 MiB at the
-// defaults) plus scratch (R^2 * 8 bytes per thread and 16 R^2 * 8 for split footprints).
+// depend on the thread count), then handed to a PyramidSink (for ndf-pyramid assets: written as one
+// kSectionNdfChunk section; tensorpack compresses them instead) while the next region is computed.
+// Footprints with more than 2^18 flakes (the top levels: few images, each up to several maps' worth
+// of flakes) are instead split into 16 interleaved row sets computed in parallel and summed in a
+// fixed order (still independent of the thread count). Peak memory: the flakes (24 bytes per
+// flake) plus two chunks (2 * region_size^2 * R^2 * 4 bytes; 32 MiB at the defaults) plus scratch
+// (R^2 * 8 bytes per thread and 16 R^2 * 8 for split footprints), plus what the sink keeps.
 // Measured: 4096^2 map, 1.15 GB peak RSS in ndfgen (ingest + flakes dominate).
 //
 // Automatic level count (levels = 0): at up to 4 x 4 evenly spread centres of each level l >= 1,
@@ -32,10 +33,15 @@
 #include <glintbake/format/container.h>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
+
+namespace glintbake::runtime {
+struct NdfLevelRecord;  // glintbake/runtime/ndf_pyramid.h: the on-disk level descriptor
+}
 
 namespace glintbake::bake::ndf {
 
@@ -82,11 +88,61 @@ struct PyramidReport {
 // Progress: called from the writing thread after each chunk with (images done, images of level).
 using PyramidProgress = std::function<void(int level, uint64_t done, uint64_t total)>;
 
+// One finished region of one level, as handed to a PyramidSink. The images are laid out as an
+// image section (formats/SPEC.md 3.1): `section` points at a format::ImageSectionHeader (width =
+// height = ndf_res, channels 1, layers = centres) directly followed by `images`, so a sink can
+// store the chunk without a copy. The region's centres are in row-major order within the region:
+// centre k is grid centre (x0 + k % width, y0 + k / width). Pointers are valid during the call only.
+struct PyramidChunk {
+  int level = 0;
+  int region = 0;                 // ry * regions_x + rx
+  int x0 = 0, y0 = 0;             // first centre of the region on the level's grid
+  int width = 0, height = 0;      // centres of the region per row / column
+  int ndf_res = 0;                // R
+  const float* images = nullptr;  // width * height * R * R floats, image after image
+  const void* section = nullptr;  // header + images, section_bytes long
+  size_t section_bytes = 0;
+};
+
+// Receives the pyramid as it is built, from the calling thread of buildNdfPyramid, in this order:
+// for each level, addLevel, then addChunk for every region in region order, then endLevel. A sink
+// may take long in addChunk: the next region is being computed on the TBB pool meanwhile, so a
+// sink that spawns its own TBB tasks keeps every core busy. A failing status stops the build and
+// is returned by buildNdfPyramid.
+class PyramidSink {
+ public:
+  virtual ~PyramidSink() = default;
+  virtual Status addLevel(const runtime::NdfLevelRecord& record) = 0;
+  virtual Status addChunk(const PyramidChunk& chunk) = 0;
+  virtual Status endLevel(int level) { return (void)level, okStatus(); }
+  // Bytes the sink has written so far (for PyramidLevelReport::stored_bytes; 0 if it writes none).
+  virtual uint64_t storedBytes() const { return 0; }
+};
+
+// The sink of ndf-pyramid assets: level records as kSectionNdfLevel, chunks as kSectionNdfChunk
+// sections of an open writer.
+class WriterPyramidSink final : public PyramidSink {
+ public:
+  explicit WriterPyramidSink(format::Writer& writer) : writer_(writer) {}
+  Status addLevel(const runtime::NdfLevelRecord& record) override;
+  Status addChunk(const PyramidChunk& chunk) override;
+  uint64_t storedBytes() const override { return writer_.bytesWritten(); }
+
+ private:
+  format::Writer& writer_;
+};
+
 // Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an
 // open writer (the caller adds metadata and calls finish()). Errors: kBadArgument (options),
 // kRuntime (cancelled, out of memory), kIo (writer failure).
 Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
                        PyramidReport* report, const PyramidProgress& progress = {},
                        const std::atomic<bool>* cancel = nullptr);
+
+// The same, streaming every level and chunk into `sink` instead (the builder's determinism holds:
+// the sink sees identical data whatever the thread count). Errors: those above, plus whatever the
+// sink returns.
+Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport* report,
+                       const PyramidProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace glintbake::bake::ndf

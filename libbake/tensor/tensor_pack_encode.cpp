@@ -1,0 +1,213 @@
+// Compression and encoding of one tensor-ndf group: CP decomposition, column rebalancing, storage
+// rounding, prefix sums of the stored values and the error of the stored model.
+#include "tensor/tensor_pack_internal.h"
+
+#include <glintbake/bake/tensor/prefix_sums.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+namespace glintbake::bake::tensor {
+
+uint16_t floatToHalf(float value) {
+  uint32_t x;
+  std::memcpy(&x, &value, sizeof(x));
+  const uint32_t sign = (x >> 16) & 0x8000u;
+  const uint32_t mag = x & 0x7FFFFFFFu;
+  if (mag >= 0x7F800000u) return uint16_t(sign | (mag > 0x7F800000u ? 0x7E00u : 0x7C00u));  // NaN, infinity
+  if (mag >= 0x477FF000u) return uint16_t(sign | 0x7C00u);  // >= 65520 rounds to infinity
+  if (mag < 0x38800000u) {
+    // Below 2^-14: a subnormal half, an integer multiple of 2^-24. Scaling by 2^24 is exact, and
+    // nearbyint rounds half to even in the default rounding mode.
+    float magnitude;
+    std::memcpy(&magnitude, &mag, sizeof(magnitude));
+    return uint16_t(sign | uint32_t(std::nearbyint(magnitude * 16777216.0f)));
+  }
+  // Normal: rebias the exponent, keep 10 mantissa bits, round the 13 dropped bits to nearest even
+  // (a carry out of the mantissa correctly bumps the exponent).
+  uint32_t h = (((mag >> 23) - 127u + 15u) << 10) | ((mag & 0x7FFFFFu) >> 13);
+  const uint32_t rest = mag & 0x1FFFu;
+  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
+  return uint16_t(sign | h);
+}
+
+float halfToFloat(uint16_t bits) {
+  const uint32_t sign = uint32_t(bits & 0x8000u) << 16;
+  const uint32_t e = (bits >> 10) & 0x1Fu;
+  const uint32_t m = bits & 0x3FFu;
+  uint32_t x;
+  if (e == 0) {
+    const float v = float(m) * (1.0f / 16777216.0f);  // subnormal or zero, exact
+    std::memcpy(&x, &v, sizeof(x));
+    x |= sign;
+  } else if (e == 31) {
+    x = sign | 0x7F800000u | (m << 13);
+  } else {
+    x = sign | ((e - 15u + 127u) << 23) | (m << 13);
+  }
+  float out;
+  std::memcpy(&out, &x, sizeof(out));
+  return out;
+}
+
+namespace detail {
+namespace {
+
+// Scales the columns of the three factors so that column r of A, B and C have the same norm
+// (their product, the rank-1 term, is unchanged). A zero column makes the whole term zero.
+void balanceColumns(CpFactors& f) {
+  const int rank = f.rank;
+  auto columnNorm = [rank](const std::vector<float>& m, int rows, int r) {
+    double s = 0.0;
+    for (int i = 0; i < rows; ++i) s += double(m[size_t(i) * rank + r]) * double(m[size_t(i) * rank + r]);
+    return std::sqrt(s);
+  };
+  auto scaleColumn = [rank](std::vector<float>& m, int rows, int r, double scale) {
+    for (int i = 0; i < rows; ++i) m[size_t(i) * rank + r] = float(double(m[size_t(i) * rank + r]) * scale);
+  };
+  for (int r = 0; r < rank; ++r) {
+    const double na = columnNorm(f.a, f.bins, r), nb = columnNorm(f.b, f.bins, r), nc = columnNorm(f.c, f.blocks, r);
+    if (!(na > 0.0 && nb > 0.0 && nc > 0.0)) {
+      scaleColumn(f.a, f.bins, r, 0.0);
+      scaleColumn(f.b, f.bins, r, 0.0);
+      scaleColumn(f.c, f.blocks, r, 0.0);
+      continue;
+    }
+    const double g = std::cbrt(na * nb * nc);
+    scaleColumn(f.a, f.bins, r, g / na);
+    scaleColumn(f.b, f.bins, r, g / nb);
+    scaleColumn(f.c, f.blocks, r, g / nc);
+  }
+}
+
+// Rounds a factor to the storage precision in place; appends its stored bytes to `out`. Returns
+// false if a stored value is not finite.
+bool storeFactor(std::vector<float>& values, int precision, std::vector<uint8_t>& out) {
+  const size_t at = out.size();
+  if (precision == 1) {
+    out.resize(at + values.size() * 2);
+    for (size_t n = 0; n < values.size(); ++n) {
+      const uint16_t h = floatToHalf(values[n]);
+      values[n] = halfToFloat(h);
+      std::memcpy(out.data() + at + 2 * n, &h, 2);
+      if (!std::isfinite(values[n])) return false;
+    }
+  } else {
+    out.resize(at + values.size() * 4);
+    std::memcpy(out.data() + at, values.data(), values.size() * 4);
+    for (float v : values) {
+      if (!std::isfinite(v)) return false;
+    }
+  }
+  return true;
+}
+
+void appendFloats(const std::vector<float>& values, std::vector<uint8_t>& out) {
+  const size_t at = out.size();
+  out.resize(at + values.size() * 4);
+  std::memcpy(out.data() + at, values.data(), values.size() * 4);
+}
+
+// A column whose rank-1 term vanishes (product of the column norms below 1e-6 of the largest)
+// is wasted rank: the deterministic HOSVD start of kCompressed/kAls leaves such columns when the
+// mode unfoldings of the group have lower rank than R (e.g. groups of a few repeated spike
+// patterns: a flat map's NDF lobes narrower than a bin), and ALS cannot leave that stationary point.
+bool hasDeadColumns(const CpFactors& f) {
+  std::vector<double> products(size_t(f.rank), 1.0);
+  auto accumulate = [&](const std::vector<float>& m, int rows) {
+    for (int r = 0; r < f.rank; ++r) {
+      double s = 0.0;
+      for (int i = 0; i < rows; ++i) s += double(m[size_t(i) * f.rank + r]) * double(m[size_t(i) * f.rank + r]);
+      products[size_t(r)] *= std::sqrt(s);
+    }
+  };
+  accumulate(f.a, f.bins);
+  accumulate(f.b, f.bins);
+  accumulate(f.c, f.blocks);
+  double largest = 0.0;
+  for (double p : products) largest = std::max(largest, p);
+  for (double p : products) {
+    if (p <= 1e-6 * largest) return true;
+  }
+  return false;
+}
+
+// Retries a decomposition stuck with dead columns from the seeded random start of kAlsPlain (same
+// rank, same options otherwise) and keeps whichever fits better. Costs nothing on groups without
+// dead columns; deterministic either way.
+void retryDeadColumns(const GroupTensor& tensor, const CpOptions& options, CpFactors& f) {
+  if (options.method == CpMethod::kAlsPlain || !(f.relative_error > 1e-6) || !hasDeadColumns(f)) return;
+  CpOptions plain = options;
+  plain.method = CpMethod::kAlsPlain;
+  plain.rank = f.rank;
+  Result<CpFactors> retry = decomposeCp(tensor, plain);
+  if (retry && retry.value().relative_error < f.relative_error) f = std::move(retry).value();
+}
+
+}  // namespace
+
+size_t groupSectionBytes(int bins, int rank, int blocks, int precision) {
+  const size_t e = precision == 1 ? 2 : 4;
+  return sizeof(runtime::TensorGroupHeader) + e * size_t(2 * bins + blocks) * size_t(rank) +
+         4 * 2 * size_t(bins + 1) * size_t(rank);
+}
+
+Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<CpFactors> decomposed = options.error_target < 0.0
+                                     ? decomposeCp(tensor, options.cp)
+                                     : decomposeCpToError(tensor, options.cp, options.error_target);
+  if (!decomposed) return decomposed.error();
+  CpFactors& f = decomposed.value();
+  retryDeadColumns(tensor, options.cp, f);
+  balanceColumns(f);
+
+  const int bins = f.bins, rank = f.rank, blocks = f.blocks;
+  EncodedGroup g;
+  g.rank = rank;
+  g.section.reserve(groupSectionBytes(bins, rank, blocks, options.precision));
+  runtime::TensorGroupHeader header;
+  header.bins = uint32_t(bins);
+  header.rank = uint32_t(rank);
+  header.blocks = uint32_t(blocks);
+  header.level = uint32_t(level);
+  header.region = uint32_t(region);
+  header.precision = uint32_t(options.precision);
+  g.section.resize(sizeof(header));
+  std::memcpy(g.section.data(), &header, sizeof(header));
+  if (!storeFactor(f.a, options.precision, g.section) || !storeFactor(f.b, options.precision, g.section) ||
+      !storeFactor(f.c, options.precision, g.section)) {
+    return makeError(ErrorCode::kRuntime, "a CP factor of group " + std::to_string(region) + " of level " +
+                                              std::to_string(level) + " is not finite at the storage precision");
+  }
+  appendFloats(buildPrefixSums(f.a, bins, rank), g.section);
+  appendFloats(buildPrefixSums(f.b, bins, rank), g.section);
+  GLINTBAKE_CHECK(g.section.size() == groupSectionBytes(bins, rank, blocks, options.precision));
+
+  // Error of the stored model, bin by bin (float products summed in double, as the runtime's
+  // range sums are exact to float rounding).
+  std::vector<double> bc(static_cast<size_t>(rank));
+  for (int k = 0; k < blocks; ++k) {
+    for (int j = 0; j < bins; ++j) {
+      for (int r = 0; r < rank; ++r)
+        bc[size_t(r)] = double(f.b[size_t(j) * rank + r]) * double(f.c[size_t(k) * rank + r]);
+      for (int i = 0; i < bins; ++i) {
+        const float* a_row = f.a.data() + size_t(i) * rank;
+        double model = 0.0;
+        for (int r = 0; r < rank; ++r) model += double(a_row[r]) * bc[size_t(r)];
+        const double data = tensor.at(k, i, j);
+        g.error_squared += (data - model) * (data - model);
+        g.norm_squared += data * data;
+        g.absolute_mass += std::abs(model);
+        if (model < 0.0) g.negative_mass -= model;
+      }
+    }
+  }
+  g.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return g;
+}
+
+}  // namespace detail
+}  // namespace glintbake::bake::tensor

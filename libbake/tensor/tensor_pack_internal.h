@@ -1,0 +1,89 @@
+// Private pieces of the tensor-ndf packer (bake/tensor/tensor_pack.h): the compression and
+// encoding of one group, and the streaming sink that cuts regions into groups.
+#pragma once
+
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/bake/tensor/tensor_pack.h>
+#include <glintbake/runtime/tensor_ndf_layout.h>
+
+#include <tbb/task_group.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace glintbake::bake::tensor::detail {
+
+// One group compressed and serialised as a tensor-group section.
+struct EncodedGroup {
+  std::vector<uint8_t> section;  // TensorGroupHeader, factors, prefix sums (SPEC 10.4)
+  int rank = 0;
+  double error_squared = 0.0;  // |T - stored model|_F^2 (the model of the stored, rounded factors)
+  double norm_squared = 0.0;   // |T|_F^2
+  double negative_mass = 0.0;  // sum of max(0, -model) over the group's bins
+  double absolute_mass = 0.0;  // sum of |model|
+  double seconds = 0.0;        // time of decomposition and encoding
+};
+
+// Decomposes `tensor` (fixed rank or error-target mode), rebalances the columns, rounds them to the
+// storage precision, builds the prefix sums of the stored values and measures the error of the
+// stored model. Reentrant; sequential (one TBB task per group).
+Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options);
+
+// Bytes of a tensor-group section.
+size_t groupSectionBytes(int bins, int rank, int blocks, int precision);
+
+// The PyramidSink that turns regions into groups: extracts the non-blank blocks of each chunk,
+// compresses them on the TBB pool, and writes groups, level indexes and the info record in the
+// order tensor_pack.h documents. All methods run on the producer's thread.
+class TensorPackSink final : public ndf::PyramidSink {
+ public:
+  TensorPackSink(format::Writer& writer, const TensorPackOptions& options, TensorPackReport& report,
+                 const std::atomic<bool>* cancel);
+  ~TensorPackSink() override;
+
+  Status addLevel(const runtime::NdfLevelRecord& record) override;
+  Status addChunk(const ndf::PyramidChunk& chunk) override;
+  Status endLevel(int level) override;
+  uint64_t storedBytes() const override { return writer_.bytesWritten(); }
+
+  // Writes the tensor-info record and completes the report. kInvalidInput when no block was kept.
+  Status finish();
+  // Time spent inside this sink (the rest of the producer's time made NDF images).
+  double secondsInside() const { return seconds_inside_; }
+
+ private:
+  struct Pending {
+    GroupTensor tensor;
+    int level = 0, region = 0;
+    std::optional<Result<EncodedGroup>> result;
+    tbb::task_group task;
+  };
+
+  Status writeFront();  // waits for the oldest pending group and writes it
+  Status writeSection(uint32_t type, uint64_t key, const void* data, size_t size);
+
+  format::Writer& writer_;
+  TensorPackOptions options_;
+  TensorPackReport& report_;
+  const std::atomic<bool>* cancel_;
+  size_t max_in_flight_ = 2;
+
+  int ndf_res_ = 0;
+  int blocks_per_side_ = 0;
+  int level_ = -1;
+  int grid_width_ = 0, grid_height_ = 0;
+  uint64_t level_bytes_before_ = 0;
+  std::vector<runtime::TensorIndexEntry> index_;  // of the current level
+  uint32_t next_group_ = 0;
+  std::deque<std::unique_ptr<Pending>> pending_;
+  double seconds_inside_ = 0.0;
+  double absolute_mass_ = 0.0;  // sum of |model| over every kept bin (for the negative-mass fraction)
+  uint64_t bytes_at_start_ = 0;
+};
+
+}  // namespace glintbake::bake::tensor::detail

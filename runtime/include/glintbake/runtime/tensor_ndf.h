@@ -1,0 +1,98 @@
+// Runtime-lite reader of tensor-ndf assets (written by tensorpack): the footprint pyramid of
+// ndf-pyramid assets with every NDF image cut into B x B angular blocks stored as rank-R CP models
+// per group (Deng et al. 2022, "Constant-Cost Spatially-Varying Glints", sec. 4). Layout:
+// formats/SPEC.md section 10.4 and tensor_ndf_layout.h.
+//
+// Geometry and blending are exactly those of NdfPyramid (ndf_pyramid.h): level coordinate
+// t = log2(sigma / sigma_0) between the two bracketing levels, bilinear over the four nearest
+// centres of each level (repeat maps wrap the centre grid, clamp maps clamp to the edge centres).
+// A point, a bin or a block of the s-plane has the same block index in all 8 blended images, so
+// every query blends at most 8 (group, row, weight) terms of one block (CpMix, cp_block.h); blank
+// blocks contribute 0.
+//
+// Queries (Footprint in texels, SPoint/SRect in the s-plane, values per unit s-plane area):
+//  - eval: max(0, blended model value) of the bin containing s; 0 outside [-1, 1]^2. Bins whose
+//    centre lies outside the unit disk hold what the model stores there (tensorpack drops the
+//    blocks entirely outside the disk; partial blocks reconstruct to about 0).
+//  - average: the exact average over the rectangle of the piecewise-constant model, partial bins
+//    weighted by their overlap, parts outside [-1, 1]^2 counting as 0 (NdfPyramid::average
+//    semantics). Per block the rectangle touches, the integral is one rank-R product of continuous
+//    cumulative sums (prefix sum of the whole bins plus the covered fraction of each end bin) and
+//    is clamped at 0. Cost is independent of the rectangle size except for the number of blocks it
+//    spans (at most nb^2).
+//  - sample: picks a block with probability proportional to its blended clamped mass
+//    max(0, sum_t w_t m_t) (raw masses m_t of every (centre, block) are precomputed by open(), so
+//    this costs 8 x nb^2 loads), then descends the block's quadtree (CpMix::sample) and jitters in
+//    the bin. pdf() returns exactly (bit for bit) the density sample() reported for a point, and
+//    mass() is the sum of the clamped block masses that both normalise by.
+// For assets with non-negative factors (TensorInfoRecord flag bit 0) the clamps never bite and
+// eval, average, pdf * mass agree up to float rounding; for signed models they differ where the
+// model dips below 0 (then pdf * mass is not eval, but pdf still matches sample).
+//
+// Memory: every group's factors are loaded by open() (float16 factors are widened to float32),
+// plus 8 bytes of index and 8 bytes of raw mass per (centre, block). Queries never allocate, never
+// throw, are const and thread-safe. open() is safe on untrusted input: every record, index entry,
+// group header and section size is checked (SPEC 10.4 "Readers MUST ...") and every stored value
+// must be finite and of bounded magnitude, so that no query can overflow; anything else is
+// kInvalidAsset.
+#pragma once
+
+#include <glintbake/runtime/cp_block.h>
+#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/tensor_ndf_layout.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace glintbake::runtime {
+
+// Largest magnitude a stored factor or prefix sum may have (keeps every rank-R product of an
+// 8-term blend far below float overflow).
+constexpr float kTensorMaxFactor = 1e9f;
+constexpr float kTensorMaxPrefix = 1e12f;
+
+class TensorNdf final : public NdfSource {
+ public:
+  TensorNdf();
+  ~TensorNdf() override;
+  TensorNdf(const TensorNdf&) = delete;
+  TensorNdf& operator=(const TensorNdf&) = delete;
+
+  // Loads a tensor-ndf container (all groups). kIoError, kInvalidAsset, kWrongKind,
+  // kUnsupportedVersion, kOutOfMemory. Safe on untrusted input.
+  Status open(const char* path);
+  // Same, from a caller buffer (only needed during the call).
+  Status openMemory(const void* data, size_t size);
+  bool isOpen() const;
+
+  int resolution() const override;  // R
+  int levelCount() const;
+  // Descriptor of level l in [0, levelCount()), or null.
+  const NdfLevelRecord* level(int l) const;
+  // The asset descriptor, or null when not open.
+  const TensorInfoRecord* info() const;
+  int groupCount() const;
+  // Runtime view of group g in [0, groupCount()) (float32 factors and prefix sums), or null.
+  const CpGroupView* group(int g) const;
+  // Index entry of block `block` (by * nb + bx) of centre (i, j) of level l, or null out of range.
+  const TensorIndexEntry* indexEntry(int l, int i, int j, int block) const;
+  // Non-blank (centre, block) entries over all levels.
+  uint64_t blocksKept() const;
+  // Bytes held in memory (factors, prefix sums, index, masses).
+  uint64_t memoryBytes() const;
+
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status mass(const Footprint& footprint, double* value) const override;
+  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glintbake::runtime

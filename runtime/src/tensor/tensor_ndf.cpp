@@ -1,0 +1,349 @@
+// Queries of tensor-ndf assets: the NdfPyramid blend over centres and levels, reduced per block to
+// a CpMix (cp_block.h) of at most 8 (group, row, weight) terms.
+#include "tensor_ndf_impl.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace glintbake::runtime {
+namespace {
+
+bool validFootprint(const Footprint& fp) {
+  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
+         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
+}
+
+constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
+
+// s-plane density of a bin from the block's share of the blend's mass and the within-block pdf
+// (per unit bin area). sample() and pdf() both form it here, so they agree bit for bit.
+double combinePdf(double block_mass, double total_mass, double bin_pdf, double bin_area) {
+  return (block_mass / total_mass) * bin_pdf / bin_area;
+}
+
+// The integral of a factor column between x0 and x1 (0 <= x0 <= x1 <= B, bin units) is
+//   P[k1] + f1 F[k1] - P[k0] - f0 F[k0]     (k = floor(x), f = x - k; P the prefix sums),
+// or (x1 - x0) F[k0] when both ends lie in one bin (no prefix-sum cancellation there).
+struct Span {
+  int32_t k0, k1;
+  double f0, f1;
+  bool single;
+  Span(double x0, double x1, int32_t bins) {
+    k0 = std::min(int32_t(x0), bins - 1);
+    k1 = std::min(int32_t(x1), bins - 1);
+    f0 = x0 - k0;
+    f1 = x1 - k1;
+    single = k0 == k1;
+  }
+  double extent(const float* factor, const float* prefix, int32_t rank, int32_t r) const {
+    const float* a0 = factor + size_t(k0) * rank;
+    if (single) return (f1 - f0) * double(a0[r]);
+    const float* a1 = factor + size_t(k1) * rank;
+    return (double(prefix[size_t(k1) * rank + r]) - double(prefix[size_t(k0) * rank + r])) + f1 * double(a1[r]) -
+           f0 * double(a0[r]);
+  }
+};
+
+}  // namespace
+
+int TensorNdf::Impl::binOf(double sx, double sy) const {
+  if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
+  const int i = std::min(res - 1, int((sx + 1.0) / bin));
+  const int j = std::min(res - 1, int((1.0 - sy) / bin));
+  return j * res + i;
+}
+
+// Same centre selection and weights as NdfPyramid::Impl::addLevel (ndf_pyramid.cpp).
+void TensorNdf::Impl::addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const {
+  const TLevel& lv = levels[l];
+  const NdfLevelRecord& r = lv.rec;
+  const int gw = int(r.grid_width), gh = int(r.grid_height);
+  auto axis = [&](double pos, double map_size, double origin, double stride, int n, int* i0, int* i1, double* f) {
+    if (r.wrap == 0) {
+      pos -= std::floor(pos / map_size) * map_size;  // into [0, map size)
+      const double g = (pos - origin) / stride;
+      const double fl = std::floor(g);
+      *f = g - fl;
+      // pos in [0, map size) puts a in [-1, n - 1]: wrap without integer division (the same
+      // indices as ((a % n) + n) % n, which stays as the fallback).
+      const int a = int(fl);
+      *i0 = a >= 0 && a < n ? a : (a == -1 ? n - 1 : ((a % n) + n) % n);
+      *i1 = *i0 + 1 < n ? *i0 + 1 : 0;
+    } else {
+      const double g = (pos - origin) / stride;
+      if (!(g > 0.0)) {
+        *i0 = *i1 = 0;
+        *f = 0.0;
+      } else if (g >= double(n - 1)) {
+        *i0 = *i1 = n - 1;
+        *f = 0.0;
+      } else {
+        const double fl = std::floor(g);
+        *i0 = int(fl);
+        *i1 = *i0 + 1;
+        *f = g - fl;
+      }
+    }
+  };
+  int x0, x1, y0, y1;
+  double fx, fy;
+  axis(fp.x, double(r.map_width), r.origin_x, r.stride_x, gw, &x0, &x1, &fx);
+  axis(fp.y, double(r.map_height), r.origin_y, r.stride_y, gh, &y0, &y1, &fy);
+  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+  const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  for (int k = 0; k < 4; ++k) {
+    if (ws[k] <= 0.0) continue;
+    const size_t first = (size_t(ys[k]) * size_t(gw) + size_t(xs[k])) * size_t(nb2);
+    b->weight[b->count] = level_weight * ws[k];
+    b->index[b->count] = lv.index.data + first;
+    b->mass[b->count] = lv.mass.data + first;
+    ++b->count;
+  }
+}
+
+// Same level selection as NdfPyramid::Impl::blend.
+void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
+  b->count = 0;
+  const double s0 = levels[0].rec.sigma_texels;
+  const double top = levels[level_count - 1].rec.sigma_texels;
+  if (!(fp.sigma > s0)) {
+    addLevel(0, 1.0, fp, b);
+  } else if (fp.sigma >= top) {
+    addLevel(level_count - 1, 1.0, fp, b);
+  } else {
+    int l = 0;
+    while (l + 1 < level_count && levels[l + 1].rec.sigma_texels <= fp.sigma) ++l;
+    const double sa = levels[l].rec.sigma_texels, sb = levels[l + 1].rec.sigma_texels;
+    const double t = std::log(fp.sigma / sa) / std::log(sb / sa);  // linear in log2(sigma)
+    addLevel(l, 1.0 - t, fp, b);
+    addLevel(l + 1, t, fp, b);
+  }
+}
+
+void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const {
+  CpBlendTerm terms[kCpMaxBlend];
+  int n = 0;
+  for (int t = 0; t < b.count; ++t) {
+    const TensorIndexEntry& e = b.index[t][block];
+    if (e.group == kTensorBlankGroup) continue;
+    terms[n++] = CpBlendTerm{&groups.data[e.group].view, int32_t(e.row), float(b.weight[t])};
+  }
+  // Entries were validated at load: init cannot fail.
+  mix->init(terms, n);
+}
+
+double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, double x0, double x1, double y0,
+                                           double y1) const {
+  // Terms of one group share A and B: their weighted C rows are summed first (as CpMix does).
+  const CpGroupView* views[kCpMaxBlend];
+  double coef[kCpMaxBlend][kCpMaxRank];
+  int n = 0;
+  for (int t = 0; t < b.count; ++t) {
+    const TensorIndexEntry& e = b.index[t][block];
+    if (e.group == kTensorBlankGroup || b.weight[t] == 0.0) continue;
+    const CpGroupView* v = &groups.data[e.group].view;
+    int g = 0;
+    while (g < n && views[g] != v) ++g;
+    if (g == n) {
+      views[n++] = v;
+      for (int32_t r = 0; r < v->rank; ++r) coef[g][r] = 0.0;
+    }
+    const float* c = v->c + size_t(e.row) * size_t(v->rank);
+    for (int32_t r = 0; r < v->rank; ++r) coef[g][r] += b.weight[t] * double(c[r]);
+  }
+  const Span sx(x0, x1, bins), sy(y0, y1, bins);
+  double sum = 0.0;
+  for (int g = 0; g < n; ++g) {
+    const CpGroupView& v = *views[g];
+    for (int32_t r = 0; r < v.rank; ++r)
+      sum += sx.extent(v.a, v.a_prefix, v.rank, r) * sy.extent(v.b, v.b_prefix, v.rank, r) * coef[g][r];
+  }
+  return sum;
+}
+
+double TensorNdf::Impl::blockMass(const Blend& b, uint64_t block) const {
+  double m = 0.0;
+  for (int t = 0; t < b.count; ++t) m += b.weight[t] * b.mass[t][block];
+  return m > 0.0 ? m : 0.0;
+}
+
+double TensorNdf::Impl::totalMass(const Blend& b) const {
+  double total = 0.0;
+  for (uint64_t k = 0; k < nb2; ++k) total += blockMass(b, k);
+  return total;
+}
+
+double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
+  const double total = totalMass(b);
+  if (!(total > 0.0)) return 0.0;
+  const uint64_t block = uint64_t(j / bins) * uint64_t(nb) + uint64_t(i / bins);
+  const double m = blockMass(b, block);
+  if (!(m > 0.0)) return 0.0;
+  CpMix mix;
+  mixBlock(b, block, &mix);
+  // A block whose blended raw mass is positive but whose float range sum rounds to <= 0 is
+  // sampled uniformly (sample() does the same).
+  const double p = mix.blockMass() > 0.0f ? mix.pdf(i % bins, j % bins) : 1.0 / (double(bins) * bins);
+  return combinePdf(m, total, p, bin_area);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  const int bin = m.binOf(s.x, s.y);
+  if (bin < 0) {
+    *value = 0.0;
+    return Status::kOk;
+  }
+  Impl::Blend b;
+  m.blend(footprint, &b);
+  const int i = bin % m.res, j = bin / m.res;
+  CpMix mix;
+  m.mixBlock(b, uint64_t(j / m.bins) * uint64_t(m.nb) + uint64_t(i / m.bins), &mix);
+  *value = double(mix.value(i % m.bins, j % m.bins));
+  return Status::kOk;
+}
+
+Status TensorNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
+      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  double integral = 0.0;
+  if (x1 > x0 && y1 > y0) {
+    Impl::Blend b;
+    m.blend(footprint, &b);
+    // Blocks touched (bins as NdfPyramid::average finds them); within each block the integral of
+    // the piecewise-constant model over the clipped rectangle is a rank-R product of continuous
+    // cumulative sums, partial bins weighted by their overlap.
+    const int i0 = std::min(m.res - 1, int((x0 + 1.0) / m.bin)), i1 = std::min(m.res - 1, int((x1 + 1.0) / m.bin));
+    const int j0 = std::min(m.res - 1, int((1.0 - y1) / m.bin)), j1 = std::min(m.res - 1, int((1.0 - y0) / m.bin));
+    const double fx0 = (x0 + 1.0) / m.bin, fx1 = (x1 + 1.0) / m.bin;  // bin coordinates from the left
+    const double fy0 = (1.0 - y1) / m.bin, fy1 = (1.0 - y0) / m.bin;  // bin coordinates from the top
+    const double full = double(m.bins);
+    for (int by = j0 / m.bins; by <= j1 / m.bins; ++by) {
+      const double row0 = double(by * m.bins);
+      const double ly0 = std::clamp(fy0 - row0, 0.0, full), ly1 = std::clamp(fy1 - row0, 0.0, full);
+      if (!(ly1 > ly0)) continue;
+      for (int bx = i0 / m.bins; bx <= i1 / m.bins; ++bx) {
+        const double col0 = double(bx * m.bins);
+        const double lx0 = std::clamp(fx0 - col0, 0.0, full), lx1 = std::clamp(fx1 - col0, 0.0, full);
+        if (!(lx1 > lx0)) continue;
+        const double block_integral =
+            m.blockRangeIntegral(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), lx0, lx1, ly0, ly1);
+        if (block_integral > 0.0) integral += block_integral * m.bin_area;
+      }
+    }
+  }
+  *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return Status::kOk;
+}
+
+Status TensorNdf::mass(const Footprint& footprint, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint)) return Status::kInvalidArgument;
+  Impl::Blend b;
+  impl_->blend(footprint, &b);
+  *value = impl_->totalMass(b);
+  return Status::kOk;
+}
+
+Status TensorNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  const int bin = m.binOf(s.x, s.y);
+  if (bin < 0) {
+    *value = 0.0;
+    return Status::kOk;
+  }
+  Impl::Blend b;
+  m.blend(footprint, &b);
+  *value = m.binPdf(b, bin % m.res, bin / m.res);
+  return Status::kOk;
+}
+
+Status TensorNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+  if (!impl_) return Status::kInvalidArgument;
+  if (!out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  Impl::Blend b;
+  m.blend(footprint, &b);
+  const double total = m.totalMass(b);
+  if (!(total > 0.0)) return Status::kInvalidArgument;
+
+  // 1. Block by clamped blended mass; u1 is rescaled to [0, 1) within the chosen block.
+  const double target = u1 * total;
+  double before = 0.0, chosen_mass = 0.0;
+  uint64_t chosen = 0;
+  for (uint64_t k = 0; k < m.nb2; ++k) {
+    const double mk = m.blockMass(b, k);
+    if (!(mk > 0.0)) continue;
+    chosen = k;
+    chosen_mass = mk;
+    if (target < before + mk) break;
+    before += mk;  // rounding may run past the last block with mass: it is kept
+  }
+  u1 = (target - before) / chosen_mass;
+  u1 = u1 < kOneMinusEpsilon ? (u1 > 0.0 ? u1 : 0.0) : kOneMinusEpsilon;
+
+  // 2. Bin and point inside the block.
+  const int bx = int(chosen % uint64_t(m.nb)), by = int(chosen / uint64_t(m.nb));
+  CpMix mix;
+  m.mixBlock(b, chosen, &mix);
+  double x, y, p;
+  int i, j;
+  CpBlockSample cs;
+  if (mix.blockMass() > 0.0f && mix.sample(u1, u2, &cs)) {
+    x = cs.x;
+    y = cs.y;
+    i = cs.i;
+    j = cs.j;
+    p = cs.pdf;
+  } else {
+    x = u1 * m.bins;
+    y = u2 * m.bins;
+    i = std::min(m.bins - 1, int(x));
+    j = std::min(m.bins - 1, int(y));
+    p = 1.0 / (double(m.bins) * m.bins);
+  }
+  const int col = bx * m.bins + i, row = by * m.bins + j;
+  SPoint s{-1.0 + (bx * m.bins + x) * m.bin, 1.0 - (by * m.bins + y) * m.bin};
+  // Rounding of the s-plane conversion must not move the point into a neighbouring bin (pdf()
+  // locates the bin from s): fall back to the bin centre in that rare case.
+  if (m.binOf(s.x, s.y) != row * m.res + col) s = SPoint{-1.0 + (col + 0.5) * m.bin, 1.0 - (row + 0.5) * m.bin};
+  out->s = s;
+  out->pdf = combinePdf(chosen_mass, total, p, m.bin_area);
+  return Status::kOk;
+}
+
+Status TensorNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!impl_) return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  const size_t n = size_t(m.res) * size_t(m.res);
+  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
+  Impl::Blend b;
+  m.blend(footprint, &b);
+  CpMix mix;
+  for (int by = 0; by < m.nb; ++by) {
+    for (int bx = 0; bx < m.nb; ++bx) {
+      m.mixBlock(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), &mix);
+      for (int j = 0; j < m.bins; ++j) {
+        float* dst = out + size_t(by * m.bins + j) * size_t(m.res) + size_t(bx * m.bins);
+        for (int i = 0; i < m.bins; ++i) dst[i] = mix.value(i, j);
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+}  // namespace glintbake::runtime

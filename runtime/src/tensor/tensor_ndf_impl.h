@@ -1,0 +1,82 @@
+// Internal state of TensorNdf, shared by its loader (tensor_ndf_load.cpp) and its queries
+// (tensor_ndf.cpp). Not installed.
+#pragma once
+
+#include <glintbake/format/container.h>
+#include <glintbake/runtime/tensor_ndf.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <new>
+
+namespace glintbake::runtime {
+
+// Heap array that reports allocation failure instead of throwing.
+template <typename T>
+struct Array {
+  T* data = nullptr;
+  size_t size = 0;
+  Array() = default;
+  Array(const Array&) = delete;
+  Array& operator=(const Array&) = delete;
+  ~Array() { delete[] data; }
+  bool allocate(size_t n) {
+    delete[] data;
+    data = new (std::nothrow) T[n];
+    size = data ? n : 0;
+    return data != nullptr;
+  }
+};
+
+struct TensorNdf::Impl {
+  struct Group {
+    Array<float> data;  // A, B, C, A prefix, B prefix (float32)
+    CpGroupView view;
+    uint32_t level = 0, region = 0;
+  };
+  struct TLevel {
+    NdfLevelRecord rec;
+    Array<TensorIndexEntry> index;  // [centre * nb2 + block]
+    Array<double> mass;             // raw block integral over its s-plane area (0 for blank blocks)
+  };
+  // Up to 8 weighted centres (2 levels x 4 centres), as NdfPyramid blends them.
+  struct Blend {
+    int count = 0;
+    double weight[8];
+    const TensorIndexEntry* index[8];  // the centre's nb2 entries
+    const double* mass[8];             // the centre's nb2 raw masses
+  };
+
+  TensorInfoRecord info;
+  int res = 0, bins = 0, nb = 0;
+  uint64_t nb2 = 0;
+  bool nonneg = false;
+  double bin = 0.0, bin_area = 0.0;  // 2 / R, (2 / R)^2
+  int level_count = 0;
+  TLevel levels[kMaxNdfLevels];
+  uint32_t group_count = 0;
+  Array<Group> groups;
+  uint64_t blocks_kept = 0;
+  uint64_t memory_bytes = 0;
+
+  Status load(const format::Reader& reader);
+  Status loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch);
+  Status loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch);
+
+  void blend(const Footprint& fp, Blend* b) const;
+  void addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const;
+  // The CpMix of block `block` of the blend (blank entries skipped).
+  void mixBlock(const Blend& b, uint64_t block, CpMix* mix) const;
+  // Raw (unclamped) integral of the blended block over [x0, x1] x [y0, y1] in block-local bin
+  // coordinates (0 <= x0 <= x1 <= B, rows from the top), in bin-area units.
+  double blockRangeIntegral(const Blend& b, uint64_t block, double x0, double x1, double y0, double y1) const;
+  // Blended clamped mass of one block, max(0, sum_t w_t m_t), and of the whole blend.
+  double blockMass(const Blend& b, uint64_t block) const;
+  double totalMass(const Blend& b) const;
+  // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf().
+  double binPdf(const Blend& b, int i, int j) const;
+  // Bin of s, or -1 outside [-1, 1]^2 (as NdfPyramid).
+  int binOf(double sx, double sy) const;
+};
+
+}  // namespace glintbake::runtime

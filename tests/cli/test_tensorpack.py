@@ -1,0 +1,128 @@
+"""tensorpack: tensor-ndf assets from normal maps and ndf-pyramid containers. Schema-valid --json,
+the default output name, byte-identical output for every thread count and run, and the documented
+exit codes for bad arguments and bad input with nothing left behind."""
+
+import os
+import shutil
+
+import clitest
+from clitest import ToolTestCase, run
+
+PYRAMID = ["--ndf-res", "32", "--stride", "8", "--sigma0", "4"]
+PACK = ["--rank", "8", "--block", "16", "--quiet"]
+
+
+class TensorPack(ToolTestCase):
+    def test_help_and_version(self):
+        code, out, _ = run("tensorpack", "--help")
+        self.assertEqual(code, clitest.OK)
+        for option in ("--rank", "--block", "--error-target", "--blank-threshold", "--precision", "--nonneg",
+                       "--ndf-res", "--json", "--depfile", "--threads"):
+            self.assertIn(option, out)
+        code, out, _ = run("tensorpack", "--version")
+        self.assertEqual(code, clitest.OK)
+        self.assertIn("tensorpack", out)
+
+    def test_json_report_and_default_output_name(self):
+        m = self.mapgen("scratches", "scr.png", "--size", "32", "--seed", "5")
+        doc = self.run_json("tensorpack", m, *PYRAMID, *PACK, schema="tensorpack.schema.json")
+        out = self.path("scr.gbk")  # beside the input, extension replaced
+        self.assertTrue(os.path.exists(out))
+        self.assertEqual(doc["output"], "scr.gbk")
+        self.assertEqual(doc["source"], "normal-map")
+        self.assertEqual(doc["file_bytes"], os.path.getsize(out))
+        self.assertEqual(doc["groups"], sum(l["groups"] for l in doc["levels"]))
+        self.assertEqual(doc["blocks_kept"], sum(l["blocks_kept"] for l in doc["levels"]))
+        self.assertEqual(doc["raw_bytes"], sum(l["raw_bytes"] for l in doc["levels"]))
+        self.assertEqual(sum(doc["rank_histogram"].values()), doc["groups"])
+        self.assertEqual(doc["rank_histogram"], {"8": doc["groups"]})
+        self.assertLess(doc["ratio"], 1.0)
+        self.assertGreater(doc["relative_error"], 0.0)
+        self.assertLess(doc["relative_error"], 1.0)
+        self.assertEqual(doc["negative_mass_fraction"], 0.0)  # non-negative factors by default
+        signed = self.run_json("tensorpack", m, "-o", self.path("signed.gbk"), *PYRAMID, *PACK, "--no-nonneg",
+                               schema="tensorpack.schema.json")
+        self.assertFalse(signed["parameters"]["nonneg"])
+        self.assertGreater(signed["negative_mass_fraction"], 0.0)
+        if os.path.exists(clitest.tool_path("glintinfo")):
+            code, _, err = run("glintinfo", "validate", out)
+            self.assertEqual(code, clitest.OK, err)
+            code, info, err = run("glintinfo", "info", out, "--json")
+            self.assertEqual(code, clitest.OK, err)
+            self.assertIn("tensor-ndf", info)
+
+    def test_pyramid_container_input(self):
+        m = self.mapgen("flakes", "fl.png", "--size", "32")
+        pyramid = self.path("fl.gbk")
+        self.run_ok("ndfgen", m, "-o", pyramid, *PYRAMID, "--quiet")
+        doc = self.run_json("tensorpack", pyramid, *PACK, "--error-target", "0.2",
+                            schema="tensorpack.schema.json")
+        self.assertEqual(doc["source"], "ndf-pyramid")
+        self.assertIsNone(doc["map"])
+        self.assertEqual(doc["output"], "fl.tensor.gbk")  # never overwrites its input
+        self.assertTrue(os.path.exists(self.path("fl.tensor.gbk")))
+        self.assertLessEqual(doc["max_rank"], 8)
+        # Pyramid options belong to map inputs.
+        out = self.path("x.gbk")
+        self.assert_fails(clitest.BAD_ARGS, "tensorpack", pyramid, "-o", out, *PACK, "--ndf-res", "64",
+                          outputs=[out])
+
+    def test_identical_bytes_for_any_thread_count_and_run(self):
+        m = self.mapgen("beckmann", "b.png", "--size", "48")
+        a, b, c = self.path("a.gbk"), self.path("b.gbk"), self.path("c.gbk")
+        self.run_ok("tensorpack", m, "-o", a, *PYRAMID, *PACK, "-j", "1")
+        self.run_ok("tensorpack", m, "-o", b, *PYRAMID, *PACK, "-j", "2")
+        self.run_ok("tensorpack", m, "-o", c, *PYRAMID, *PACK, "-j", "2")
+        self.assertEqual(clitest.file_hash(a), clitest.file_hash(b))
+        self.assertEqual(clitest.file_hash(b), clitest.file_hash(c))
+
+    def test_depfile(self):
+        m = self.mapgen("brushed", "br.png", "--size", "32")
+        out, dep = self.path("br.gbk"), self.path("br.d")
+        self.run_ok("tensorpack", m, "-o", out, *PYRAMID, *PACK, "--depfile", dep)
+        with open(dep) as f:
+            text = f.read()
+        self.assertIn("br.gbk", text)
+        self.assertIn("br.png", text)
+
+    def test_bad_arguments(self):
+        m = self.mapgen("beckmann", "m.png", "--size", "32")
+        out = self.path("out.gbk")
+        for args in (["--rank", "0"], ["--rank", "65"], ["--block", "12"], ["--method", "svd"],
+                     ["--precision", "float8"], ["--error-target", "2"], ["--blank-threshold", "-1"]):
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", out, *PYRAMID, "--quiet", *args, outputs=[out])
+
+    def test_bad_inputs(self):
+        out = self.path("out.gbk")
+        self.assert_fails(clitest.IO, "tensorpack", self.path("missing.png"), "-o", out, *PACK, outputs=[out])
+        # Every block blank: no block of a normalised NDF image carries the whole mass.
+        m = self.mapgen("beckmann", "m.png", "--size", "32")
+        err = self.assert_fails(clitest.INVALID, "tensorpack", m, "-o", out, *PYRAMID, *PACK,
+                                "--blank-threshold", "1", outputs=[out])
+        self.assertIn("blank", err)
+        # A corrupt container: one byte flipped inside a chunk.
+        pyramid = self.path("p.gbk")
+        self.run_ok("ndfgen", m, "-o", pyramid, *PYRAMID, "--quiet")
+        corrupt = self.path("corrupt.gbk")
+        shutil.copy(pyramid, corrupt)
+        with open(corrupt, "r+b") as f:
+            f.seek(300)
+            byte = f.read(1)
+            f.seek(300)
+            f.write(bytes([byte[0] ^ 0x5A]))
+        self.assert_fails(clitest.INVALID, "tensorpack", corrupt, "-o", out, *PACK, outputs=[out])
+        # A truncated container.
+        truncated = self.path("trunc.gbk")
+        with open(pyramid, "rb") as f:
+            data = f.read()
+        with open(truncated, "wb") as f:
+            f.write(data[: len(data) // 2])
+        self.assert_fails(clitest.INVALID, "tensorpack", truncated, "-o", out, *PACK, outputs=[out])
+        # A container of another kind.
+        tensor = self.path("t.gbk")
+        self.run_ok("tensorpack", pyramid, "-o", tensor, *PACK)
+        self.assert_fails(clitest.INVALID, "tensorpack", tensor, "-o", out, *PACK, outputs=[out])
+
+
+if __name__ == "__main__":
+    clitest.main()

@@ -1,0 +1,318 @@
+// TensorNdf queries: values at pyramid centres against the factors, trilinear blending against
+// NdfPyramid on the reconstructed images, range averages against the mean of eval(), and the
+// agreement of pdf * mass with eval() (non-negative assets) or its measured gap (plain CP).
+#include "tensor_assets.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <thread>
+
+namespace glintbake::runtime::testing {
+namespace {
+
+Footprint footprint(double x, double y, double sigma) {
+  Footprint f;
+  f.x = x;
+  f.y = y;
+  f.sigma = sigma;
+  return f;
+}
+
+double binCentreX(int i, int res) { return -1.0 + (i + 0.5) * 2.0 / res; }
+double binCentreY(int j, int res) { return 1.0 - (j + 0.5) * 2.0 / res; }
+
+TEST(TensorNdf, DescribesTheAsset) {
+  const TensorNdf& t = assets().nonneg;
+  ASSERT_TRUE(t.isOpen());
+  EXPECT_EQ(t.resolution(), 32);
+  EXPECT_EQ(t.levelCount(), 3);
+  ASSERT_NE(t.info(), nullptr);
+  EXPECT_EQ(t.info()->block, 16u);
+  EXPECT_EQ(t.info()->blocks_per_side, 2u);
+  EXPECT_NE(t.info()->flags & kTensorFlagNonNegative, 0u);
+  EXPECT_EQ(assets().plain.info()->flags & kTensorFlagNonNegative, 0u);
+  EXPECT_GT(t.groupCount(), 0);
+  EXPECT_GT(t.blocksKept(), 0u);
+  EXPECT_LE(t.blocksKept(), uint64_t(16 + 4 + 1) * 4);
+  EXPECT_GT(t.memoryBytes(), 0u);
+  EXPECT_EQ(t.level(0)->grid_width, 4u);
+  EXPECT_EQ(t.level(2)->grid_width, 1u);
+  EXPECT_EQ(t.level(3), nullptr);
+  EXPECT_EQ(t.group(t.groupCount()), nullptr);
+  EXPECT_EQ(t.indexEntry(0, 4, 0, 0), nullptr);
+  EXPECT_EQ(t.indexEntry(0, 0, 0, 4), nullptr);
+}
+
+TEST(TensorNdf, EvalAtCentresEqualsTheFactors) {
+  for (const TensorNdf* t : {&assets().nonneg, &assets().plain}) {
+    const int res = t->resolution();
+    for (int l = 0; l < t->levelCount(); ++l) {
+      const NdfLevelRecord& r = *t->level(l);
+      for (uint32_t cj = 0; cj < r.grid_height; ++cj) {
+        for (uint32_t ci = 0; ci < r.grid_width; ++ci) {
+          const std::vector<double> model = modelImage(*t, l, int(ci), int(cj));
+          const double peak = *std::max_element(model.begin(), model.end());
+          const Footprint fp = footprint(r.origin_x + ci * r.stride_x, r.origin_y + cj * r.stride_y, r.sigma_texels);
+          for (int j = 0; j < res; ++j) {
+            for (int i = 0; i < res; ++i) {
+              double v = -1.0;
+              ASSERT_EQ(t->eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), Status::kOk);
+              const double expected = std::max(0.0, model[size_t(j) * res + i]);
+              ASSERT_NEAR(v, expected, 1e-5 * peak)
+                  << "level " << l << " centre " << ci << "," << cj << " bin " << i << "," << j;
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(TensorNdf, BlendingMatchesNdfPyramid) {
+  const TensorNdf& t = assets().nonneg;
+  const std::string path = writeReconstructedPyramid(t, "blend");
+  NdfPyramid ref;
+  ASSERT_EQ(ref.open(path.c_str()), Status::kOk);
+  const int res = t.resolution();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(-40.0, 110.0), sig(0.0, 40.0), sp(-1.05, 1.05);
+  std::vector<float> img_t(size_t(res) * res), img_r(size_t(res) * res);
+  for (int q = 0; q < 200; ++q) {
+    const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
+    ASSERT_EQ(t.image(fp, img_t.data(), img_t.size()), Status::kOk);
+    ASSERT_EQ(ref.image(fp, img_r.data(), img_r.size()), Status::kOk);
+    const float peak = *std::max_element(img_r.begin(), img_r.end());
+    for (size_t n = 0; n < img_t.size(); ++n) ASSERT_NEAR(img_t[n], img_r[n], 2e-5 * peak) << "bin " << n;
+    for (int k = 0; k < 20; ++k) {
+      const SPoint s{sp(rng), sp(rng)};
+      double a = -1.0, b = -1.0;
+      ASSERT_EQ(t.eval(fp, s, &a), Status::kOk);
+      ASSERT_EQ(ref.eval(fp, s, &b), Status::kOk);
+      ASSERT_NEAR(a, b, 2e-5 * peak);
+    }
+    double ma = 0.0, mb = 0.0;
+    ASSERT_EQ(t.mass(fp, &ma), Status::kOk);
+    ASSERT_EQ(ref.mass(fp, &mb), Status::kOk);
+    EXPECT_NEAR(ma, mb, 1e-5 * mb);
+  }
+  std::remove(path.c_str());
+}
+
+// Exact average of the piecewise-constant eval() over a rectangle, bin by bin.
+double meanOfEval(const TensorNdf& t, const Footprint& fp, const SRect& r) {
+  const int res = t.resolution();
+  const double bin = 2.0 / res;
+  double integral = 0.0;
+  for (int j = 0; j < res; ++j) {
+    const double hy = std::min(1.0 - j * bin, r.y1) - std::max(1.0 - (j + 1) * bin, r.y0);
+    if (hy <= 0.0) continue;
+    for (int i = 0; i < res; ++i) {
+      const double hx = std::min(-1.0 + (i + 1) * bin, r.x1) - std::max(-1.0 + i * bin, r.x0);
+      if (hx <= 0.0) continue;
+      double v = 0.0;
+      EXPECT_EQ(t.eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), Status::kOk);
+      integral += hx * hy * v;
+    }
+  }
+  return integral / ((r.x1 - r.x0) * (r.y1 - r.y0));
+}
+
+TEST(TensorNdf, AverageEqualsMeanOfEval) {
+  const TensorNdf& t = assets().nonneg;
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> pos(0.0, 64.0), sig(1.0, 40.0), c(-1.1, 1.1), w(0.001, 1.2);
+  double worst = 0.0;
+  int compared = 0;
+  for (int q = 0; q < 400; ++q) {
+    const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
+    SRect r;
+    r.x0 = c(rng);
+    r.y0 = c(rng);
+    r.x1 = r.x0 + w(rng);
+    r.y1 = r.y0 + w(rng);
+    if (q == 0) r = SRect{};  // the whole plane: mass / 4
+    double avg = -1.0;
+    ASSERT_EQ(t.average(fp, r, &avg), Status::kOk);
+    const double expected = meanOfEval(t, fp, r);
+    ASSERT_GE(avg, 0.0);
+    // Float32 prefix sums: a range sum carries a rounding error of a few ulps of the block's
+    // column totals, which is what the absolute term (well below 1e-6 of the plane's mean density,
+    // mass / 4) allows for on small averages.
+    EXPECT_LE(std::fabs(avg - expected), 1e-5 * expected + 5e-8) << "query " << q;
+    if (expected < 1e-2) continue;
+    worst = std::max(worst, std::fabs(avg - expected) / expected);
+    ++compared;
+  }
+  std::printf("[ figures  ] average vs mean of eval: %d rectangles, worst relative difference %.3g\n", compared, worst);
+  EXPECT_GT(compared, 100);
+  // Invalid rectangles and footprints are rejected.
+  double v = 0.0;
+  SRect empty;
+  empty.x1 = empty.x0;
+  EXPECT_EQ(t.average(footprint(1, 1, 1), empty, &v), Status::kInvalidArgument);
+  EXPECT_EQ(t.average(footprint(1, 1, NAN), SRect{}, &v), Status::kInvalidArgument);
+}
+
+// pdf * mass against eval at the sampled points; returns the mean relative gap.
+double pdfEvalGap(const TensorNdf& t, const Footprint& fp, int n, uint64_t seed, double* worst) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double total = 0.0, sum = 0.0;
+  *worst = 0.0;
+  EXPECT_EQ(t.mass(fp, &total), Status::kOk);
+  for (int k = 0; k < n; ++k) {
+    NdfSample s;
+    EXPECT_EQ(t.sample(fp, u(rng), u(rng), &s), Status::kOk);
+    double v = 0.0;
+    EXPECT_EQ(t.eval(fp, s.s, &v), Status::kOk);
+    const double gap = v > 0.0 ? std::fabs(s.pdf * total - v) / v : 1.0;
+    sum += gap;
+    *worst = std::max(*worst, gap);
+  }
+  return sum / n;
+}
+
+TEST(TensorNdf, PdfTimesMassEqualsEvalForNonNegativeAssets) {
+  const TensorNdf& t = assets().nonneg;
+  double worst_all = 0.0;
+  for (const Footprint& fp : {footprint(20, 30, 6), footprint(3, 60, 11), footprint(40, 40, 30)}) {
+    double m = 0.0;
+    ASSERT_EQ(t.mass(fp, &m), Status::kOk);
+    EXPECT_NEAR(m, 1.0, 2e-2);  // repeat map: every footprint's NDF is (nearly) normalised
+    double worst = 0.0;
+    const double mean = pdfEvalGap(t, fp, 4000, 3, &worst);
+    EXPECT_LT(mean, 1e-5);
+    EXPECT_LT(worst, 1e-4);
+    worst_all = std::max(worst_all, worst);
+  }
+  std::printf("[ figures  ] non-negative CP: worst |pdf*mass - eval| / eval = %.3g\n", worst_all);
+}
+
+TEST(TensorNdf, PlainCpGapsAreMeasured) {
+  const TensorNdf& t = assets().plain;
+  // Negative mass of the unclamped model at every centre of every level.
+  double negative = 0.0, absolute = 0.0;
+  for (int l = 0; l < t.levelCount(); ++l) {
+    for (uint32_t j = 0; j < t.level(l)->grid_height; ++j) {
+      for (uint32_t i = 0; i < t.level(l)->grid_width; ++i) {
+        for (double v : modelImage(t, l, int(i), int(j))) {
+          negative += std::max(0.0, -v);
+          absolute += std::fabs(v);
+        }
+      }
+    }
+  }
+  double worst = 0.0, mean = 0.0;
+  const Footprint fps[] = {footprint(20, 30, 6), footprint(3, 60, 11), footprint(40, 40, 30)};
+  for (const Footprint& fp : fps) mean += pdfEvalGap(t, fp, 4000, 9, &worst) / 3.0;
+  std::printf(
+      "[ figures  ] plain CP (rank 16): negative mass fraction before clamping %.3g; mean |pdf*mass - eval| / "
+      "eval %.3g (worst %.3g)\n",
+      negative / absolute, mean, worst);
+  EXPECT_TRUE(std::isfinite(mean));
+  EXPECT_LT(negative / absolute, 0.2);
+  EXPECT_LT(mean, 0.2);
+}
+
+TEST(TensorNdf, ValuesAreNeverNegativeAndZeroOutsideTheSquare) {
+  const TensorNdf& t = assets().plain;
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> pos(-100.0, 200.0), sig(0.0, 80.0), sp(-1.0, 1.0);
+  for (int q = 0; q < 2000; ++q) {
+    const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
+    double v = -1.0;
+    ASSERT_EQ(t.eval(fp, SPoint{sp(rng), sp(rng)}, &v), Status::kOk);
+    ASSERT_GE(v, 0.0);
+    ASSERT_EQ(t.pdf(fp, SPoint{sp(rng), sp(rng)}, &v), Status::kOk);
+    ASSERT_GE(v, 0.0);
+  }
+  double v = -1.0;
+  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{1.5, 0.0}, &v), Status::kOk);
+  EXPECT_EQ(v, 0.0);
+  EXPECT_EQ(t.pdf(footprint(1, 1, 5), SPoint{0.0, -1.01}, &v), Status::kOk);
+  EXPECT_EQ(v, 0.0);
+  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{NAN, 0.0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(t.eval(footprint(1, 1, -1), SPoint{0.0, 0.0}, &v), Status::kInvalidArgument);
+  NdfSample s;
+  EXPECT_EQ(t.sample(footprint(1, 1, 5), 1.0, 0.5, &s), Status::kInvalidArgument);
+  TensorNdf closed;
+  EXPECT_EQ(closed.eval(footprint(1, 1, 5), SPoint{0, 0}, &v), Status::kInvalidArgument);
+}
+
+TEST(TensorNdf, Float16FactorsMatchFloat32) {
+  const bake::NormalMap map = tinyMap();
+  const std::vector<uint8_t> half = packAsset(map, true, 16, "half", 1);
+  TensorNdf h;
+  ASSERT_EQ(h.openMemory(half.data(), half.size()), Status::kOk);
+  EXPECT_EQ(h.info()->precision, 1u);
+  const TensorNdf& f = assets().nonneg;
+  const int res = f.resolution();
+  std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
+  for (const Footprint& fp : {footprint(20, 30, 6), footprint(50, 9, 14)}) {
+    ASSERT_EQ(f.image(fp, a.data(), a.size()), Status::kOk);
+    ASSERT_EQ(h.image(fp, b.data(), b.size()), Status::kOk);
+    double err = 0.0, norm = 0.0;
+    for (size_t n = 0; n < a.size(); ++n) {
+      err += (double(a[n]) - b[n]) * (double(a[n]) - b[n]);
+      norm += double(a[n]) * a[n];
+    }
+    EXPECT_LT(std::sqrt(err / norm), 5e-3);
+  }
+}
+
+TEST(TensorNdf, ClampMapsClampTheCentreGrid) {
+  const std::vector<uint8_t> bytes = packAsset(tinyMap(bake::MapKind::kBeckmann, true), true, 8, "clamp");
+  TensorNdf t;
+  ASSERT_EQ(t.openMemory(bytes.data(), bytes.size()), Status::kOk);
+  EXPECT_EQ(t.level(0)->wrap, 1u);
+  const std::string path = writeReconstructedPyramid(t, "clamp");
+  NdfPyramid ref;
+  ASSERT_EQ(ref.open(path.c_str()), Status::kOk);
+  const int res = t.resolution();
+  std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
+  for (const Footprint& fp : {footprint(-10, 3, 6), footprint(70, 80, 9), footprint(63, 1, 20)}) {
+    ASSERT_EQ(t.image(fp, a.data(), a.size()), Status::kOk);
+    ASSERT_EQ(ref.image(fp, b.data(), b.size()), Status::kOk);
+    const float peak = *std::max_element(b.begin(), b.end());
+    for (size_t n = 0; n < a.size(); ++n) ASSERT_NEAR(a[n], b[n], 2e-5 * peak);
+  }
+  std::remove(path.c_str());
+}
+
+TEST(TensorNdf, ConcurrentQueriesGiveTheSingleThreadedAnswers) {
+  const TensorNdf& t = assets().plain;
+  constexpr int kQueries = 2000;
+  auto run = [&](uint64_t seed, std::vector<double>* out) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> pos(0.0, 64.0), sig(1.0, 40.0), u(0.0, 1.0);
+    for (int q = 0; q < kQueries; ++q) {
+      const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
+      NdfSample s;
+      double v = 0.0, a = 0.0;
+      if (t.sample(fp, u(rng), u(rng), &s) != Status::kOk) s = NdfSample{};
+      t.eval(fp, s.s, &v);
+      SRect r;
+      r.x0 = s.s.x - 0.1;
+      r.x1 = s.s.x + 0.1;
+      r.y0 = s.s.y - 0.2;
+      r.y1 = s.s.y + 0.05;
+      t.average(fp, r, &a);
+      out->insert(out->end(), {s.s.x, s.s.y, s.pdf, v, a});
+    }
+  };
+  std::vector<double> serial[2], threaded[2];
+  run(1, &serial[0]);
+  run(2, &serial[1]);
+  std::thread first(run, 1, &threaded[0]), second(run, 2, &threaded[1]);
+  first.join();
+  second.join();
+  EXPECT_EQ(serial[0], threaded[0]);
+  EXPECT_EQ(serial[1], threaded[1]);
+}
+
+}  // namespace
+}  // namespace glintbake::runtime::testing

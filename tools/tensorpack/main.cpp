@@ -1,0 +1,309 @@
+// tensorpack: compresses the footprint pyramid of NDF images of a normal map (built on the fly) or of
+// an ndf-pyramid container into a tensor-ndf asset: per region and level, the non-blank B x B
+// angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md
+// section 10.4).
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/bake/tensor/tensor_pack.h>
+#include <glintbake/cli/container_output.h>
+#include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/tool.h>
+#include <glintbake/format/container.h>
+
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace {
+
+using glintbake::cli::Error;
+using glintbake::cli::Json;
+namespace bake = glintbake::bake;
+namespace cli = glintbake::cli;
+namespace format = glintbake::format;
+namespace tensor = glintbake::bake::tensor;
+
+constexpr unsigned char kContainerMagic[8] = {0xAB, 'G', 'B', 'K', '\r', '\n', 0x1A, '\n'};
+
+// True when the file starts with the container magic. Throws the I/O error for unreadable files.
+bool isContainer(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error(cli::kExitIo, path + ": cannot open (missing or unreadable)");
+  unsigned char head[8] = {};
+  f.read(reinterpret_cast<char*>(head), sizeof(head));
+  return f.gcount() == sizeof(head) && std::memcmp(head, kContainerMagic, sizeof(head)) == 0;
+}
+
+// Default output: beside the input, its extension replaced by .gbk (a container input keeps its
+// name and gets .tensor.gbk, so it is never overwritten).
+std::string defaultOutput(const std::string& input, bool container) {
+  const size_t slash = input.find_last_of("/\\");
+  const size_t dot = input.find_last_of('.');
+  const std::string stem =
+      (dot != std::string::npos && (slash == std::string::npos || dot > slash)) ? input.substr(0, dot) : input;
+  return stem + (container ? ".tensor.gbk" : ".gbk");
+}
+
+int exitCodeOf(const bake::Error& e) { return int(e.code); }
+
+Json levelJson(const tensor::TensorPackLevelReport& l) {
+  Json j;
+  j["level"] = l.level;
+  j["grid"] = {l.grid_width, l.grid_height};
+  j["groups"] = l.groups;
+  j["blocks_kept"] = l.blocks_kept;
+  j["blocks_dropped"] = l.blocks_dropped;
+  j["raw_bytes"] = l.raw_bytes;
+  j["stored_bytes"] = l.stored_bytes;
+  j["relative_error"] = l.relative_error;
+  return j;
+}
+
+Json rankHistogramJson(const tensor::TensorPackReport& r) {
+  Json h = Json::object();
+  for (const auto& [rank, groups] : r.rank_histogram) h[std::to_string(rank)] = groups;
+  return h;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Tool tool(
+      "tensorpack",
+      "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
+  std::string input, output, levels_text = "auto", method_text = "compressed", precision_text = "float32";
+  bake::IngestOptions ingest;
+  bake::ndf::PyramidOptions pyr;
+  tensor::TensorPackOptions opt;
+  // Non-negative factors by default. Measured on 256^2 mapgen maps at the default pyramid (R = 128,
+  // B = 32): at equal rank their relative error is 1-4% higher than plain ALS (beckmann rank 16:
+  // 0.364 vs 0.356), but their files are about half as large (zstd packs the sparse HALS factors
+  // well), so at equal file size they are more accurate (beckmann: nonneg rank 32, 0.309 in 204 kB,
+  // vs plain rank 16, 0.356 in 247 kB; likewise on brushed, scratches and flakes); and they have no
+  // negative density, where plain factors put 1-5% of the absolute density below zero (queries
+  // clamp it, so pdf and value / mass disagree there).
+  opt.cp.nonneg = true;
+  double error_target = -1.0;
+  int zstd_level = 9;
+  CLI::App& app = tool.app();
+  app.add_option("input", input, "Normal map (or height field with --height), or an ndf-pyramid container (.gbk)")
+      ->required();
+  app.add_option("-o,--output", output, "Output tensor-ndf container (default: the input's name with .gbk)");
+  app.add_option("--rank", opt.cp.rank, "CP rank per group (1..64); the largest rank with --error-target")
+      ->capture_default_str();
+  app.add_option("--block", opt.block, "Bins per angular block side B (divides --ndf-res)")->capture_default_str();
+  app.add_option("--method", method_text, "CP method: compressed, als or als-plain")->capture_default_str();
+  app.add_flag("--nonneg,!--no-nonneg", opt.cp.nonneg,
+               "Non-negative factors (HALS; default on): no negative density anywhere");
+  app.add_option("--tol", opt.cp.tol, "Stop when the fit changes by less than this (>= 0)")->capture_default_str();
+  app.add_option("--max-iters", opt.cp.max_iters, "Most ALS sweeps per group (>= 1)")->capture_default_str();
+  app.add_option("--error-target", error_target,
+                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1)");
+  app.add_option("--blank-threshold", opt.blank_threshold, "Drop blocks whose mass is below this (0..1)")
+      ->capture_default_str();
+  app.add_option("--precision", precision_text, "Factor storage: float32 or float16")->capture_default_str();
+  app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
+  app.add_option("--zstd-level", zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
+  // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
+  std::vector<CLI::Option*> pyramid_flags = {
+      app.add_option("--ndf-res", pyr.splat.ndf_res, "NDF image resolution R (bins per side, 2..4096)")
+          ->capture_default_str(),
+      app.add_option("--sigma-r", pyr.splat.sigma_r, "Intrinsic roughness: s-plane std of every flake (0, 1]")
+          ->capture_default_str(),
+      app.add_option("--stride", pyr.stride0, "Level-0 spacing of footprint centres, texels (> 0)")
+          ->capture_default_str(),
+      app.add_option("--sigma0", pyr.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str(),
+      app.add_option("--levels", levels_text, "Number of levels, or auto")->capture_default_str(),
+      app.add_option("--converge-mse", pyr.converge_mse, "auto levels: relative MSE between levels to stop at")
+          ->capture_default_str(),
+      app.add_option("--rate", pyr.rate, "Flakes per texel side (1..16)")->capture_default_str(),
+      app.add_option("--region", pyr.region_size, "Footprint centres per group side (1..256)")->capture_default_str(),
+  };
+  cli::addIngestOptions(app, ingest);
+
+  return tool.run(argc, argv, [&](cli::Tool& t) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::optional<tensor::CpMethod> method = tensor::parseCpMethod(method_text);
+    if (!method) throw Error(cli::kExitBadArguments, "--method must be compressed, als or als-plain");
+    opt.cp.method = *method;
+    if (precision_text != "float32" && precision_text != "float16") {
+      throw Error(cli::kExitBadArguments, "--precision must be float32 or float16");
+    }
+    opt.precision = precision_text == "float16" ? 1 : 0;
+    opt.error_target = error_target;
+    if (app.count("--error-target") && !(error_target >= 0.0 && error_target <= 1.0)) {
+      throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
+    }
+    if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
+    if (levels_text == "auto") {
+      pyr.levels = 0;
+    } else {
+      try {
+        size_t used = 0;
+        pyr.levels = std::stoi(levels_text, &used);
+        if (used != levels_text.size() || pyr.levels < 1) throw std::invalid_argument("levels");
+      } catch (const std::exception&) {
+        throw Error(cli::kExitBadArguments, "--levels must be auto or a positive integer");
+      }
+    }
+    if (bake::Status s = tensor::validateTensorPackOptions(opt); !s)
+      throw Error(exitCodeOf(s.error()), s.error().message);
+
+    const bool from_container = isContainer(input);
+    if (output.empty()) output = defaultOutput(input, from_container);
+
+    Json params;
+    params["rank"] = opt.cp.rank;
+    params["block"] = opt.block;
+    params["method"] = tensor::cpMethodName(opt.cp.method);
+    params["nonneg"] = opt.cp.nonneg;
+    params["tol"] = opt.cp.tol;
+    params["max_iters"] = opt.cp.max_iters;
+    params["error_target"] = error_target < 0.0 ? Json(nullptr) : Json(error_target);
+    params["blank_threshold"] = opt.blank_threshold;
+    params["precision"] = precision_text;
+    params["seed"] = opt.cp.seed;
+    params["zstd_level"] = zstd_level;
+
+    tensor::TensorPackReport report;
+    Json map_json = nullptr, source_asset = nullptr;
+    std::unique_ptr<cli::ContainerOutput> out;
+    if (from_container) {
+      for (CLI::Option* o : pyramid_flags) {
+        if (o->count() > 0) throw Error(cli::kExitBadArguments, o->get_name() + " applies to normal-map inputs only");
+      }
+      t.addInput(input);
+      format::Reader reader;
+      if (format::Status st = reader.open(input); st != format::Status::kOk) {
+        const int code = st == format::Status::kIoError              ? cli::kExitIo
+                         : st == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
+                                                                     : cli::kExitInvalidInput;
+        throw Error(code, input + ": " + format::statusString(st));
+      }
+      if (reader.kind() != format::AssetKind::kNdfPyramid) {
+        throw Error(cli::kExitInvalidInput, input + ": not an ndf-pyramid container (asset kind " +
+                                                format::assetKindString(reader.kind()) + ")");
+      }
+      std::string meta_text;
+      if (reader.readMetadata(&meta_text) == format::Status::kOk) {
+        const Json source = Json::parse(meta_text, nullptr, false);
+        if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
+        if (source.is_object() && source.contains("asset")) source_asset = source["asset"];
+      }
+      params["source"] = "ndf-pyramid";
+      out = std::make_unique<cli::ContainerOutput>(t, output, format::AssetKind::kTensorNdf, zstd_level);
+      if (bake::Status s = tensor::packTensorNdfFromPyramid(reader, opt, out->writer(), &report); !s) {
+        throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
+      }
+    } else {
+      if (bake::Status s = bake::ndf::validatePyramidOptions(pyr); !s)
+        throw Error(exitCodeOf(s.error()), s.error().message);
+      if (pyr.splat.ndf_res % opt.block != 0) {
+        throw Error(cli::kExitBadArguments, "--block " + std::to_string(opt.block) + " must divide --ndf-res " +
+                                                std::to_string(pyr.splat.ndf_res));
+      }
+      bake::IngestReport ingest_report;
+      const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
+      if (map.width < 2 || map.height < 2) {
+        throw Error(cli::kExitInvalidInput, input + ": a normal map needs at least 2x2 texels (got " +
+                                                std::to_string(map.width) + "x" + std::to_string(map.height) + ")");
+      }
+      map_json = {{"width", map.width}, {"height", map.height}, {"wrap", bake::wrapString(map.wrap)}};
+      Json p;
+      p["ndf_res"] = pyr.splat.ndf_res;
+      p["sigma_r"] = pyr.splat.sigma_r;
+      p["stride"] = pyr.stride0;
+      p["sigma0"] = pyr.sigma0;
+      p["levels"] = levels_text == "auto" ? Json("auto") : Json(pyr.levels);
+      p["converge_mse"] = pyr.converge_mse;
+      p["rate"] = pyr.rate;
+      p["region"] = pyr.region_size;
+      p["footprint_truncation"] = pyr.splat.footprint_truncation;
+      p["ingest"] = cli::ingestOptionsJson(ingest);
+      params["pyramid"] = p;
+      params["source"] = "normal-map";
+      out = std::make_unique<cli::ContainerOutput>(t, output, format::AssetKind::kTensorNdf, zstd_level);
+
+      std::unique_ptr<cli::Progress> bar;
+      int bar_level = -1;
+      uint64_t bar_done = 0;
+      bake::Status s = tensor::packTensorNdfFromMap(map, pyr, opt, out->writer(), &report,
+                                                    [&](int level, uint64_t done, uint64_t total) {
+                                                      if (level != bar_level) {
+                                                        if (bar) bar->finish();
+                                                        bar = t.progress("level " + std::to_string(level), total);
+                                                        bar_level = level;
+                                                        bar_done = 0;
+                                                      }
+                                                      bar->advance(done - bar_done);
+                                                      bar_done = done;
+                                                    });
+      if (bar) bar->finish();
+      if (!s) throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
+    }
+
+    Json asset;
+    asset["ndf_res"] = report.ndf_res;
+    asset["block"] = opt.block;
+    asset["blocks_per_side"] = report.blocks_per_side;
+    asset["levels"] = Json::array();
+    for (const auto& l : report.levels) {
+      asset["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
+    }
+    asset["groups"] = report.groups;
+    asset["max_rank"] = report.max_rank;
+    asset["rank_histogram"] = rankHistogramJson(report);
+    asset["precision"] = precision_text;
+    asset["nonneg"] = opt.cp.nonneg;
+    asset["blank_threshold"] = opt.blank_threshold;
+    asset["relative_error"] = report.relative_error;
+    if (!map_json.is_null()) asset["map"] = map_json;
+    if (source_asset.is_object()) {
+      for (const char* key : {"map_size", "wrap", "sigma_r", "rate"}) {
+        if (source_asset.contains(key)) asset[key] = source_asset[key];
+      }
+    }
+    Json meta = t.makeMetadata("tensor-ndf", params);
+    meta["asset"] = asset;
+    out->finish(meta);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const uint64_t file_bytes = out->bytesWritten();
+    const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
+
+    if (t.common().json) {
+      Json doc;
+      doc["tool"] = "tensorpack";
+      doc["input"] = cli::baseName(input);
+      doc["output"] = cli::baseName(output);
+      doc["source"] = from_container ? "ndf-pyramid" : "normal-map";
+      doc["map"] = map_json;
+      doc["parameters"] = params;
+      doc["ndf_res"] = report.ndf_res;
+      Json levels = Json::array();
+      for (const auto& l : report.levels) levels.push_back(levelJson(l));
+      doc["levels"] = levels;
+      doc["groups"] = report.groups;
+      doc["blocks_kept"] = report.blocks_kept;
+      doc["blocks_dropped"] = report.blocks_dropped;
+      doc["rank_histogram"] = rankHistogramJson(report);
+      doc["max_rank"] = report.max_rank;
+      doc["raw_bytes"] = report.raw_bytes;
+      doc["stored_bytes"] = report.stored_bytes;
+      doc["file_bytes"] = file_bytes;
+      doc["ratio"] = ratio;
+      doc["relative_error"] = report.relative_error;
+      doc["max_group_error"] = report.max_group_error;
+      doc["negative_mass_fraction"] = report.negative_mass_fraction;
+      doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},
+                        {"wait", report.wait_seconds}, {"pack", report.total_seconds}, {"total", seconds}};
+      t.printJson(doc);
+    } else {
+      t.info("wrote " + output + ": " + std::to_string(report.groups) + " groups, " + std::to_string(file_bytes) +
+             " bytes (" + std::to_string(100.0 * ratio) + "% of " + std::to_string(report.raw_bytes) +
+             " raw), relative error " + std::to_string(report.relative_error) + ", " + std::to_string(seconds) + " s");
+    }
+    return cli::kExitOk;
+  });
+}
