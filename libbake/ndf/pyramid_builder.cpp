@@ -197,6 +197,68 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
     next_samples = planSamples(levelGeometry(map.width, map.height, options, level + 1), geo, map.wrap, image_floats);
     double mse_sum = 0.0;
 
+    // Footprints with very many flakes (the top levels: few images, each costing up to several
+    // map's worth of flakes) are split over kSplitParts interleaved row sets computed in parallel
+    // and summed in a fixed order; the split depends only on the level, never on the thread count.
+    const bool split = splatters.local().flakesPerImage(geo.sigma) > kSplitFlakes;
+    // Image of centre (i, j) of this level. Split footprints use the shared part buffers: call those
+    // from one thread at a time.
+    auto computeImage = [&](int i, int j, float* out) {
+      const double x = (i + 0.5) * geo.stride_x, y = (j + 0.5) * geo.stride_y;
+      if (!split) {
+        splatters.local().image(x, y, geo.sigma, out);
+        return;
+      }
+      tbb::parallel_for(0, kSplitParts, [&](int part) {
+        std::vector<double>& acc = part_acc[size_t(part)];
+        std::fill(acc.begin(), acc.end(), 0.0);
+        splatters.local().accumulate(x, y, geo.sigma, part, kSplitParts, acc.data());
+      });
+      for (int part = 1; part < kSplitParts; ++part) {
+        for (size_t b = 0; b < image_floats; ++b) part_acc[0][b] += part_acc[size_t(part)][b];
+      }
+      splatters.local().finish(part_acc[0].data(), out);
+    };
+
+    // Automatic level count: probe this level at its convergence samples before computing it. If
+    // the runtime's prediction from the level below is already within converge_mse there, the
+    // level would add little (queries above the top clamp to the level below), so it is not
+    // computed at all. Otherwise the probed images are reused when their regions are computed.
+    std::vector<std::vector<float>> probe_images;
+    if (options.levels == 0 && !samples.empty()) {
+      try {
+        probe_images.assign(samples.size(), std::vector<float>(image_floats));
+      } catch (const std::bad_alloc&) {
+        return makeError(ErrorCode::kRuntime, "out of memory allocating convergence samples");
+      }
+      auto probe = [&](size_t q) {
+        const int centre = samples[q].centre;
+        computeImage(centre % geo.grid_width, centre / geo.grid_width, probe_images[q].data());
+      };
+      if (split) {
+        for (size_t q = 0; q < samples.size(); ++q) probe(q);
+      } else {
+        tbb::parallel_for(size_t(0), samples.size(), probe);
+      }
+      if (cancelled()) return cancelError();
+      double probe_mse = 0.0;
+      for (size_t q = 0; q < samples.size(); ++q) {
+        probe_mse += relativeMse(probe_images[q].data(), samples[q].prediction.data(), image_floats);
+      }
+      probe_mse /= double(samples.size());
+      if (probe_mse < options.converge_mse) {
+        rep.stop_reason = "converged";
+        rep.next_level_mse = probe_mse;
+        return okStatus();
+      }
+    }
+    auto probedImage = [&](int centre) -> const float* {
+      for (size_t q = 0; q < probe_images.size(); ++q) {
+        if (samples[q].centre == centre) return probe_images[q].data();
+      }
+      return nullptr;
+    };
+
     runtime::NdfLevelRecord rec;
     rec.level = uint32_t(level);
     rec.ndf_res = uint32_t(res);
@@ -229,37 +291,30 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
       *cw = std::min(options.region_size, geo.grid_width - *cx0);
       *ch = std::min(options.region_size, geo.grid_height - *cy0);
     };
-    // Footprints with very many flakes (the top levels: few images, each costing up to several
-    // map's worth of flakes) are split over kSplitParts interleaved row sets computed in parallel
-    // and summed in a fixed order; the split depends only on the level, never on the thread count.
-    const bool split = splatters.local().flakesPerImage(geo.sigma) > kSplitFlakes;
     auto computeRegion = [&](int r, int slot) {
       int cx0, cy0, cw, ch;
       regionExtent(r, &cx0, &cy0, &cw, &ch);
       float* images = buffers[slot].data() + 8;
+      auto one = [&](int k) {
+        const int i = cx0 + k % cw, j = cy0 + k / cw;
+        float* out = images + size_t(k) * image_floats;
+        if (const float* probed = probedImage(j * geo.grid_width + i)) {
+          std::memcpy(out, probed, image_floats * sizeof(float));
+        } else {
+          computeImage(i, j, out);
+        }
+      };
       if (split) {
         for (int k = 0; k < cw * ch; ++k) {
           if (cancelled()) return;
-          const int i = cx0 + k % cw, j = cy0 + k / cw;
-          tbb::parallel_for(0, kSplitParts, [&](int part) {
-            std::vector<double>& acc = part_acc[size_t(part)];
-            std::fill(acc.begin(), acc.end(), 0.0);
-            splatters.local().accumulate((i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, geo.sigma, part,
-                                         kSplitParts, acc.data());
-          });
-          for (int part = 1; part < kSplitParts; ++part) {
-            for (size_t b = 0; b < image_floats; ++b) part_acc[0][b] += part_acc[size_t(part)][b];
-          }
-          splatters.local().finish(part_acc[0].data(), images + size_t(k) * image_floats);
+          one(k);
         }
         return;
       }
       tbb::parallel_for(tbb::blocked_range<int>(0, cw * ch, 1), [&](const tbb::blocked_range<int>& range) {
-        Splatter& sp = splatters.local();
         for (int k = range.begin(); k != range.end(); ++k) {
           if (cancelled()) return;
-          const int i = cx0 + k % cw, j = cy0 + k / cw;
-          sp.image((i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, geo.sigma, images + size_t(k) * image_floats);
+          one(k);
         }
       });
     };
@@ -318,10 +373,6 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
     lrep.seconds = secondsSince(t_level);
     rep.levels.push_back(lrep);
 
-    if (options.levels == 0 && lrep.mse_vs_previous >= 0.0 && lrep.mse_vs_previous < options.converge_mse) {
-      rep.stop_reason = "converged";
-      return okStatus();
-    }
     if (options.levels == 0 && geo.grid_width == 1 && geo.grid_height == 1) {
       rep.stop_reason = "grid-1x1";
       return okStatus();

@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
     asset["levels"] = Json::array();
     for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
     asset["stop_reason"] = report.stop_reason;
+    if (report.next_level_mse >= 0) asset["converged_mse"] = report.next_level_mse;
     meta["asset"] = asset;
     out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -160,6 +161,7 @@ int main(int argc, char** argv) {
       }
       doc["levels"] = levels;
       doc["stop_reason"] = report.stop_reason;
+      doc["converged_mse"] = report.next_level_mse < 0 ? Json(nullptr) : Json(report.next_level_mse);
       doc["flakes"] = report.flakes;
       doc["images"] = images;
       doc["raw_bytes"] = raw;

@@ -18,13 +18,18 @@
 // (R^2 * 8 bytes per thread and 16 R^2 * 8 for split footprints), plus what the sink keeps.
 // Measured: 4096^2 map, 1.15 GB peak RSS in ndfgen (ingest + flakes dominate).
 //
-// Automatic level count (levels = 0): at up to 4 x 4 evenly spread centres of each level l >= 1,
-// the image is compared with what the runtime predicts there from level l - 1 (the bilinear blend
-// of the level-(l-1) images around that position, collected while level l - 1 was written, so the
-// check costs no extra splatting): relative MSE = sum |D_l - P_l|^2 / sum |P_l|^2, averaged over the
-// samples. The pyramid stops after the first level whose MSE is below converge_mse (the levels
-// above would add little: queries clamp to the top), after the first level whose grid is 1 x 1
-// (the stride reached the map size), or at kMaxPyramidLevels.
+// Automatic level count (levels = 0): before level l >= 1 is computed, its images at up to 4 x 4
+// evenly spread centres are computed and compared with what the runtime predicts there from level
+// l - 1 (the bilinear blend of the level-(l-1) images around that position, collected while level
+// l - 1 was written): relative MSE = sum |D_l - P_l|^2 / sum |P_l|^2, averaged over the samples.
+// If it is below converge_mse, level l would add little (queries above the top level clamp to it,
+// and its blend already predicts level l within the tolerance), so the pyramid stops without
+// computing it (stop reason "converged"; the probe's MSE is reported). Otherwise the probed images
+// are reused when their regions are computed, so the probe costs nothing extra. The pyramid also
+// stops after the first level whose grid is 1 x 1 (the stride reached the map size), or at
+// kMaxPyramidLevels. Measured on the 1024^2 maps of the demo data: skipping the converged level
+// saves a third to a half of the bake time (each level costs about the same: a quarter of the
+// footprints, each with four times the flakes).
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
@@ -80,7 +85,8 @@ struct PyramidLevelReport {
 
 struct PyramidReport {
   std::vector<PyramidLevelReport> levels;
-  std::string stop_reason;  // "levels", "converged", "grid-1x1", "max-levels"
+  std::string stop_reason;     // "levels", "converged", "grid-1x1", "max-levels"
+  double next_level_mse = -1;  // "converged": sampled relative MSE of the level that was not needed
   uint64_t flakes = 0;
   double flake_seconds = 0.0;
 };
