@@ -4,7 +4,7 @@
 # TBB or Eigen) is built and tested, as a renderer would build it; then the full project.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+scripts/install-deps.sh --browser
 
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)

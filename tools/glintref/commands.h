@@ -1,5 +1,6 @@
 // glintref subcommands: the reference P-NDF of a normal map at one point (ndf), as a bin-averaged
-// image (image) and as samples (sample). Each command registers its CLI11 subcommand and runs when
+// image (image) and as samples (sample); a renderer of scenes with that P-NDF, a baked asset or a
+// smooth BRDF (render), and image comparison (compare). Each command registers its CLI11 subcommand and runs when
 // selected; they share the map, footprint and flake options (query.h).
 #pragma once
 
@@ -7,7 +8,10 @@
 
 #include <glintbake/cli/tool.h>
 
+#include <glintbake/bake/io/normal_map.h>
+
 #include <cstdint>
+#include <limits>
 #include <string>
 
 namespace glintbake::glintref {
@@ -30,13 +34,41 @@ struct SampleOptions {
   std::string output;  // .csv; empty: CSV on stdout (or the samples in the --json document)
 };
 
+struct RenderOptions {
+  std::string scene;
+  std::string output;
+  std::string ndf = "smooth";
+  int spp = 16;
+  uint64_t seed = 1;
+  std::string env = "prefilter";
+  std::string ltc;         // LTC table for polygon lights (smooth mode)
+  std::string asset;       // overrides material.asset
+  std::string normal_map;  // overrides material.normal_map
+  std::string image_size;  // --image-size W,H; empty: the scene's
+  std::string preview;  // tone-mapped PNG
+  double exposure = 1.0;
+  bake::IngestOptions ingest;
+};
+
+struct CompareOptions {
+  std::string image;
+  std::string reference;
+  std::string heatmap;
+  double heatmap_scale = 0.0;
+  double max_rel_mse = std::numeric_limits<double>::infinity();
+};
+
 CLI::App* addNdfCommand(CLI::App& app, NdfOptions& options);
 CLI::App* addImageCommand(CLI::App& app, ImageOptions& options);
 CLI::App* addSampleCommand(CLI::App& app, SampleOptions& options);
+CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options);
+CLI::App* addCompareCommand(CLI::App& app, CompareOptions& options);
 
 // Each returns a documented exit code or throws cli::Error.
 int runNdf(cli::Tool& tool, NdfOptions& options);
 int runImage(cli::Tool& tool, ImageOptions& options);
 int runSample(cli::Tool& tool, SampleOptions& options);
+int runRender(cli::Tool& tool, RenderOptions& options);
+int runCompare(cli::Tool& tool, CompareOptions& options);
 
 }  // namespace glintbake::glintref

@@ -1,10 +1,11 @@
 // glintref: the reference P-NDF evaluator of glintbake (the slow, obviously-correct definition
-// every fast path is checked against): point values, bin-averaged NDF images and samples.
+// every fast path is checked against): point values, bin-averaged NDF images and samples, a
+// reference renderer and image comparison.
 #include "commands.h"
 
 int main(int argc, char** argv) {
   using namespace glintbake;
-  cli::Tool tool("glintref", "Reference P-NDF of a normal map: point values, bin-averaged images, samples");
+  cli::Tool tool("glintref", "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();
@@ -16,11 +17,17 @@ int main(int argc, char** argv) {
   CLI::App* ndf_cmd = glintref::addNdfCommand(app, ndf);
   CLI::App* image_cmd = glintref::addImageCommand(app, image);
   CLI::App* sample_cmd = glintref::addSampleCommand(app, sample);
+  glintref::RenderOptions render;
+  glintref::CompareOptions compare;
+  CLI::App* render_cmd = glintref::addRenderCommand(app, render);
+  CLI::App* compare_cmd = glintref::addCompareCommand(app, compare);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     if (ndf_cmd->parsed()) return glintref::runNdf(t, ndf);
     if (image_cmd->parsed()) return glintref::runImage(t, image);
     if (sample_cmd->parsed()) return glintref::runSample(t, sample);
+    if (render_cmd->parsed()) return glintref::runRender(t, render);
+    if (compare_cmd->parsed()) return glintref::runCompare(t, compare);
     throw cli::Error(cli::kExitBadArguments, "no command given");
   });
 }

@@ -1,0 +1,87 @@
+// The reference P-NDF of one footprint as an NdfSource.
+#include "reference_ndf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace glintbake::bake::render {
+
+using runtime::Status;
+
+ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r) {
+  reference::Footprint fp;
+  fp.x = footprint.x;
+  fp.y = footprint.y;
+  fp.sigma = footprint.sigma;
+  const std::vector<reference::FlakeLobe> lobes = reference::footprintLobes(flakes, fp, sigma_r);
+  lobes_.reserve(lobes.size());
+  cdf_.reserve(lobes.size());
+  for (const reference::FlakeLobe& l : lobes) {
+    if (!(l.weight > 0.0)) continue;
+    Lobe e;
+    e.lobe = l;
+    const double l00 = std::sqrt(l.cov[0]);
+    const double l10 = l.cov[1] / l00;
+    e.chol[0] = l00;
+    e.chol[1] = l10;
+    e.chol[2] = std::sqrt(std::max(0.0, l.cov[2] - l10 * l10));
+    lobes_.push_back(e);
+    total_ += l.weight;
+    cdf_.push_back(total_);
+  }
+}
+
+double ReferencePndf::evalSum(double sx, double sy) const {
+  double sum = 0.0;
+  for (const Lobe& l : lobes_) sum += reference::lobeDensity(l.lobe, sx, sy);
+  return sum;
+}
+
+Status ReferencePndf::eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
+  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return Status::kInvalidArgument;
+  *value = evalSum(s.x, s.y);
+  return Status::kOk;
+}
+
+Status ReferencePndf::average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const {
+  if (!(rect.x1 > rect.x0) || !(rect.y1 > rect.y0)) return Status::kInvalidArgument;
+  double sum = 0.0;
+  for (const Lobe& l : lobes_) {
+    sum += l.lobe.weight * reference::gaussianRectangleIntegral(l.lobe.mean, l.lobe.cov, rect.x0, rect.x1, rect.y0,
+                                                                 rect.y1);
+  }
+  *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return Status::kOk;
+}
+
+Status ReferencePndf::sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const {
+  if (lobes_.empty() || !(total_ > 0.0)) return Status::kInvalidArgument;
+  // Choose a lobe with u1 and reuse the remainder of u1 inside the lobe's interval.
+  const double target = u1 * total_;
+  const size_t k = std::min(lobes_.size() - 1, size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin()));
+  const double lo = k == 0 ? 0.0 : cdf_[k - 1];
+  double v1 = (target - lo) / (cdf_[k] - lo);
+  v1 = std::min(std::max(v1, 1e-300), 1.0 - 1e-16);
+  // Box-Muller: two independent normals from (v1, u2).
+  const double r = std::sqrt(-2.0 * std::log1p(-v1));
+  const double phi = 2.0 * 3.14159265358979323846 * u2;
+  const double z0 = r * std::cos(phi), z1 = r * std::sin(phi);
+  const Lobe& l = lobes_[k];
+  out->s.x = l.lobe.mean[0] + l.chol[0] * z0;
+  out->s.y = l.lobe.mean[1] + l.chol[1] * z0 + l.chol[2] * z1;
+  out->pdf = evalSum(out->s.x, out->s.y) / total_;
+  return Status::kOk;
+}
+
+Status ReferencePndf::pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
+  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return Status::kInvalidArgument;
+  *value = total_ > 0.0 ? evalSum(s.x, s.y) / total_ : 0.0;
+  return Status::kOk;
+}
+
+Status ReferencePndf::mass(const runtime::Footprint&, double* value) const {
+  *value = total_;
+  return Status::kOk;
+}
+
+}  // namespace glintbake::bake::render

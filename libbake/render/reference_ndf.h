@@ -1,0 +1,45 @@
+// The reference P-NDF of one footprint behind the runtime's NdfSource interface, so that the
+// renderer's BRDF code is the same for every --ndf mode. The lobes (glintbake::reference,
+// footprintLobes) are gathered at construction; every query ignores its footprint argument and
+// answers for the footprint given to the constructor.
+//  - eval: the exact sum of the lobe densities (not zeroed outside the unit disk);
+//  - sample: a lobe chosen by weight, then s ~ N(mu_k, C_k): the density is eval / total weight,
+//    which pdf() returns;
+//  - average: the exact rectangle integral of every lobe over the rectangle's area;
+//  - mass: the total lobe weight; image: not offered (kInvalidArgument).
+// Not shared between threads (one per pixel); const queries do not allocate.
+#pragma once
+
+#include <glintbake/reference/pndf.h>
+#include <glintbake/runtime/ndf_source.h>
+
+#include <vector>
+
+namespace glintbake::bake::render {
+
+class ReferencePndf final : public runtime::NdfSource {
+ public:
+  ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r);
+
+  int resolution() const override { return 0; }
+  runtime::Status eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
+  runtime::Status average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const override;
+  runtime::Status sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const override;
+  runtime::Status pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
+  runtime::Status mass(const runtime::Footprint&, double* value) const override;
+  runtime::Status image(const runtime::Footprint&, float*, size_t) const override {
+    return runtime::Status::kInvalidArgument;
+  }
+
+ private:
+  struct Lobe {
+    reference::FlakeLobe lobe;
+    double chol[3];  // lower Cholesky factor of the covariance {l00, l10, l11}
+  };
+  std::vector<Lobe> lobes_;
+  std::vector<double> cdf_;  // running weight sums
+  double total_ = 0.0;
+  double evalSum(double sx, double sy) const;
+};
+
+}  // namespace glintbake::bake::render

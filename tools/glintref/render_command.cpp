@@ -1,0 +1,240 @@
+// glintref render: a small CPU renderer of one object under direct lighting, with the P-NDF from
+// the reference evaluator, a baked asset through the runtime, or a smooth analytic BRDF
+// (libbake/render; scene format: schemas/scene.schema.json).
+#include "commands.h"
+
+#include <glintbake/bake/io/image_io.h>
+#include <glintbake/bake/render/image_compare.h>
+#include <glintbake/bake/render/renderer.h>
+#include <glintbake/bake/render/scene.h>
+#include <glintbake/cli/ingest_options.h>
+#include <glintbake/reference/flakes.h>
+#include <glintbake/runtime/ltc.h>
+#include <glintbake/runtime/ndf_source.h>
+
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+namespace glintbake::glintref {
+namespace {
+
+int exitCodeOf(runtime::Status st) {
+  switch (st) {
+    case runtime::Status::kIoError:
+      return cli::kExitIo;
+    case runtime::Status::kUnsupportedVersion:
+      return cli::kExitUnsupported;
+    case runtime::Status::kOutOfMemory:
+      return cli::kExitRuntime;
+    default:
+      return cli::kExitInvalidInput;
+  }
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options) {
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Render a scene (schemas/scene.schema.json) with the reference P-NDF, a baked asset or a smooth BRDF");
+  cmd->add_option("scene", options.scene, "Scene JSON file")->required();
+  cmd->add_option("-o,--output", options.output, "Output image: float .exr (linear radiance)")->required();
+  cmd->add_option("--ndf", options.ndf,
+                  "Where D comes from: reference (exact P-NDF of the normal map, slow), asset (the baked asset "
+                  "through the runtime) or smooth (analytic GGX/Beckmann of the base roughness)")
+      ->check(CLI::IsMember({"reference", "asset", "smooth"}));
+  cmd->add_option("--spp", options.spp, "Light and BRDF samples per pixel for area and environment lights (1..65536)");
+  cmd->add_option("--seed", options.seed, "Seed of the per-pixel random streams");
+  cmd->add_option("--env", options.env,
+                  "SG environment shading with --ndf asset: prefilter (averaged NDF over the light's support) or "
+                  "sample (MIS like the other modes)")
+      ->check(CLI::IsMember({"prefilter", "sample"}));
+  cmd->add_option("--ltc", options.ltc,
+                  "Shade polygon lights with this GGX LTC table (ltcfit table) instead of sampling; needs --ndf smooth");
+  cmd->add_option("--asset", options.asset, "Override the material's asset (any NDF asset kind)");
+  cmd->add_option("--normal-map", options.normal_map, "Override the material's normal map");
+  cmd->add_option("--image-size", options.image_size, "Override the camera's image size: W,H in pixels (1..8192)");
+  cmd->add_option("--preview", options.preview, "Also write a tone-mapped sRGB PNG preview");
+  cmd->add_option("--exposure", options.exposure, "Exposure multiplier of the preview (> 0)");
+  cli::addIngestOptions(*cmd, options.ingest);
+  return cmd;
+}
+
+int runRender(cli::Tool& tool, RenderOptions& options) {
+  const auto t_start = std::chrono::steady_clock::now();
+  bake::render::NdfMode mode = bake::render::NdfMode::kSmooth;
+  bake::render::ndfModeFromString(options.ndf, &mode);
+  if (options.spp < 1 || options.spp > 65536) {
+    throw cli::Error(cli::kExitBadArguments, "--spp must be in 1..65536, got " + std::to_string(options.spp));
+  }
+  int width = 0, height = 0;
+  if (!options.image_size.empty()) {
+    double w = 0.0, h = 0.0;
+    parsePair("--image-size", options.image_size, &w, &h);
+    if (w < 1 || w > 8192 || h < 1 || h > 8192 || w != std::floor(w) || h != std::floor(h)) {
+      throw cli::Error(cli::kExitBadArguments, "--image-size must be two integers W,H in 1..8192");
+    }
+    width = int(w);
+    height = int(h);
+  }
+  if (!options.ltc.empty() && mode != bake::render::NdfMode::kSmooth) {
+    throw cli::Error(cli::kExitBadArguments, "--ltc needs --ndf smooth (the table holds the smooth GGX BRDF)");
+  }
+  if (!(options.exposure > 0.0) || !std::isfinite(options.exposure)) {
+    throw cli::Error(cli::kExitBadArguments, "--exposure must be positive");
+  }
+  if (!bake::isFloatImagePath(options.output) || bake::imageExtension(options.output) != "exr") {
+    throw cli::Error(cli::kExitBadArguments, "-o " + options.output + ": the render must be written as .exr");
+  }
+  if (!options.preview.empty() && bake::imageExtension(options.preview) != "png") {
+    throw cli::Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
+  }
+  for (const std::string& out : {options.output, options.preview}) {
+    if (out.empty()) continue;
+    const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+      throw cli::Error(cli::kExitIo, "cannot write " + out + ": no such directory");
+    }
+  }
+
+  tool.addInput(options.scene);
+  bake::Result<bake::render::Scene> loaded = bake::render::loadScene(options.scene);
+  if (!loaded) throw cli::Error(int(loaded.error().code), loaded.error().message);
+  bake::render::Scene scene = std::move(loaded.value());
+  if (!options.asset.empty()) scene.material.asset = options.asset;
+  if (!options.normal_map.empty()) scene.material.normal_map = options.normal_map;
+  if (width > 0) {
+    scene.camera.width = width;
+    scene.camera.height = height;
+  }
+
+  // The inputs the mode needs.
+  bake::render::NdfInputs inputs;
+  inputs.map_width = scene.material.map_width;
+  inputs.map_height = scene.material.map_height;
+  std::optional<reference::FlakeSet> flakes;
+  std::unique_ptr<runtime::NdfSource> asset;
+  // The map is read for the reference's flakes, and otherwise only for its size (the uv to texel
+  // mapping of the footprints) when the scene does not state it.
+  const bool need_map = mode == bake::render::NdfMode::kReference ||
+                        (inputs.map_width == 0 && (mode == bake::render::NdfMode::kAsset ||
+                                                   !scene.material.normal_map.empty()));
+  if (need_map) {
+    if (scene.material.normal_map.empty()) {
+      throw cli::Error(cli::kExitBadArguments, mode == bake::render::NdfMode::kReference
+                                                   ? "--ndf reference needs material.normal_map (or --normal-map)"
+                                                   : "--ndf asset needs material.map_size or a normal map for the map size");
+    }
+    bake::IngestReport report;
+    const bake::NormalMap map = cli::loadNormalMapForTool(tool, scene.material.normal_map, options.ingest, &report);
+    if (inputs.map_width == 0) {
+      inputs.map_width = map.width;
+      inputs.map_height = map.height;
+    }
+    if (mode == bake::render::NdfMode::kReference) {
+      flakes = reference::buildFlakes(map, scene.material.rate);
+      inputs.flakes = &*flakes;
+    }
+  }
+  if (mode == bake::render::NdfMode::kAsset) {
+    if (scene.material.asset.empty()) {
+      throw cli::Error(cli::kExitBadArguments, "--ndf asset needs material.asset (or --asset)");
+    }
+    tool.addInput(scene.material.asset);
+    const runtime::Status st = runtime::openNdfAsset(scene.material.asset.c_str(), &asset);
+    if (st != runtime::Status::kOk) {
+      throw cli::Error(exitCodeOf(st), "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
+    }
+    inputs.asset = asset.get();
+  }
+  if (mode == bake::render::NdfMode::kSmooth && inputs.map_width == 0) {
+    inputs.map_width = inputs.map_height = 1;  // footprints are not used by the smooth BRDF
+  }
+  runtime::LtcTable ltc;
+  if (!options.ltc.empty()) {
+    tool.addInput(options.ltc);
+    const runtime::Status st = ltc.open(options.ltc.c_str());
+    if (st != runtime::Status::kOk) {
+      throw cli::Error(exitCodeOf(st), "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
+    }
+  }
+  const double load_seconds = secondsSince(t_start);
+
+  bake::render::RenderOptions ro;
+  ro.mode = mode;
+  ro.env_method = options.env == "sample" ? bake::render::EnvMethod::kSample : bake::render::EnvMethod::kPrefilter;
+  ro.spp = options.spp;
+  ro.seed = options.seed;
+  ro.ltc = options.ltc.empty() ? nullptr : &ltc;
+  const uint64_t pixels = uint64_t(scene.camera.width) * uint64_t(scene.camera.height);
+  std::unique_ptr<cli::Progress> progress = tool.progress("render", pixels);
+  ro.progress = [&](uint64_t n) { progress->advance(n); };
+
+  const auto t_render = std::chrono::steady_clock::now();
+  bake::Result<bake::render::RenderedImage> rendered = bake::render::renderScene(scene, inputs, ro);
+  const double render_seconds = secondsSince(t_render);
+  progress->finish();
+  if (!rendered) throw cli::Error(int(rendered.error().code), rendered.error().message);
+  const bake::render::RenderedImage& image = rendered.value();
+
+  // The render, then the preview, each atomically.
+  {
+    cli::AtomicOutput out(options.output);
+    bake::ImageWriteOptions wo;
+    wo.temporary_path = out.temporaryPath();
+    wo.rename = false;
+    const bake::Status st = bake::writeImage(options.output, image.width, image.height, 3, image.rgb.data(), wo);
+    if (!st) throw cli::Error(int(st.error().code), st.error().message);
+    out.commit();
+    tool.addOutput(options.output);
+  }
+  if (!options.preview.empty()) {
+    bake::render::RgbImage rgb{image.width, image.height, image.rgb};
+    const std::vector<float> display = bake::render::tonemapSrgb(rgb, options.exposure);
+    cli::AtomicOutput out(options.preview);
+    bake::ImageWriteOptions wo;
+    wo.png_bits = 8;
+    wo.temporary_path = out.temporaryPath();
+    wo.rename = false;
+    const bake::Status st = bake::writeImage(options.preview, image.width, image.height, 3, display.data(), wo);
+    if (!st) throw cli::Error(int(st.error().code), st.error().message);
+    out.commit();
+    tool.addOutput(options.preview);
+  }
+
+  if (tool.common().json) {
+    cli::Json doc;
+    doc["tool"] = "glintref";
+    doc["command"] = "render";
+    doc["scene"] = cli::baseName(options.scene);
+    doc["ndf"] = bake::render::ndfModeString(mode);
+    doc["env"] = options.env;
+    doc["area"] = options.ltc.empty() ? "sample" : "ltc";
+    doc["spp"] = options.spp;
+    doc["seed"] = options.seed;
+    doc["width"] = image.width;
+    doc["height"] = image.height;
+    doc["threads"] = tool.threadCount();
+    doc["pixels_hit"] = image.stats.pixels_hit;
+    doc["footprint_sigma_texels"] = {{"mean", image.stats.mean_sigma_texels}, {"max", image.stats.max_sigma_texels}};
+    doc["mean_radiance"] = {image.stats.mean_radiance[0], image.stats.mean_radiance[1], image.stats.mean_radiance[2]};
+    doc["map_size"] = {inputs.map_width, inputs.map_height};
+    doc["time_seconds"] = {{"load", load_seconds}, {"render", render_seconds}};
+    doc["output"] = cli::baseName(options.output);
+    if (!options.preview.empty()) doc["preview"] = cli::baseName(options.preview);
+    tool.printJson(doc);
+  } else {
+    tool.info("wrote " + options.output + " (" + std::to_string(image.width) + "x" + std::to_string(image.height) +
+              ", --ndf " + options.ndf + ", " + std::to_string(render_seconds) + " s)");
+  }
+  return cli::kExitOk;
+}
+
+}  // namespace glintbake::glintref
