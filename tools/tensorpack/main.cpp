@@ -10,6 +10,7 @@
 #include <glintbake/format/container.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -300,10 +301,13 @@ int main(int argc, char** argv) {
                         {"wait", report.wait_seconds}, {"pack", report.total_seconds}, {"total", seconds}};
       t.printJson(doc);
     } else {
-      t.info("wrote " + output + ": " + std::to_string(report.groups) + " groups, " + std::to_string(file_bytes) +
-             " bytes (" + std::to_string(100.0 * ratio) + "% of " + std::to_string(report.raw_bytes) +
-             " raw), relative error " + std::to_string(report.relative_error) + ", " + std::to_string(seconds) + " s");
-    }
+      char summary[256];
+      std::snprintf(summary, sizeof(summary),
+                    ": %zu levels, %llu groups (rank <= %d), %llu bytes = %.2f%% of the raw float32 NDF images, "
+                    "relative error %.4f, %.1f s",
+                    report.levels.size(), static_cast<unsigned long long>(report.groups), report.max_rank,
+                    static_cast<unsigned long long>(file_bytes), 100.0 * ratio, report.relative_error, seconds);
+      t.info("wrote " + output + summary);    }
     return cli::kExitOk;
   });
 }
