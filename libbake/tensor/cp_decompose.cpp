@@ -185,6 +185,23 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
   if (options.method == CpMethod::kAlsPlain) {
     randomStart(bins, blocks, rank, options.seed, s);
     err_sq = runSweeps(engine, s, err_sq, settings, &sweeps);
+  } else if (options.nonneg && options.method == CpMethod::kCompressed && blocks > basis) {
+    // Non-negative model on compressed data: HALS sweeps against X~ = core x_3 Q (contractions
+    // through the L-column core and Q; the constraint stays on the full C), then up to
+    // refine_sweeps full HALS sweeps against X.
+    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed);
+    Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
+    MatF core_t(xt.rows(), basis);
+    core_t.noalias() = xt * q;
+    CpEngine compressed(core_t.data(), bins, basis, rank, &q);
+    hosvdStart(core_t.data(), bins, basis, rank, options.seed, true, s);
+    s.c = MatF::Constant(blocks, rank, 1.0f);
+    double core_err = compressed.solveC(s, options.ridge, true);
+    runSweeps(compressed, s, core_err, settings, &core_sweeps);
+    SweepSettings refine = settings;
+    refine.max_sweeps = options.refine_sweeps;
+    err_sq = options.refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
+    err_sq = runSweeps(engine, s, err_sq, refine, &sweeps);
   } else if (options.nonneg || options.method == CpMethod::kAls || blocks <= basis) {
     hosvdStart(x, bins, blocks, rank, options.seed, options.nonneg, s);
     if (options.nonneg) s.c = MatF::Constant(blocks, rank, 1.0f);  // HALS refines C from a positive start

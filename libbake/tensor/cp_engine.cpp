@@ -50,7 +50,7 @@ MatD solveNormalEquations(const MatD& m, const MatD& g, double ridge) {
 }
 
 CpEngine::CpEngine(const float* x, int bins, int blocks, int rank)
-    : xt_(x, static_cast<Eigen::Index>(bins) * bins, blocks), bins_(bins), blocks_(blocks), rank_(rank) {
+    : xt_(x, static_cast<Eigen::Index>(bins) * bins, blocks), bins_(bins), blocks_(blocks), rank_(rank), c_rows_(blocks) {
   double sum = 0.0;
   const size_t count = static_cast<size_t>(bins) * bins * blocks;
   for (size_t n = 0; n < count; ++n) sum += static_cast<double>(x[n]) * x[n];
@@ -62,7 +62,21 @@ CpEngine::CpEngine(const float* x, int bins, int blocks, int rank)
   m_.resize(bins, rank);
 }
 
-void CpEngine::contractW(const MatF& c) { w_.noalias() = xt_ * c; }
+CpEngine::CpEngine(const float* core, int bins, int basis, int rank, const MatF* q)
+    : CpEngine(core, bins, basis, rank) {
+  expand_ = q;
+  c_rows_ = static_cast<int>(q->rows());
+  mc_.resize(c_rows_, rank);
+}
+
+void CpEngine::contractW(const MatF& c) {
+  if (expand_) {
+    const MatF cq = expand_->transpose() * c;  // L x R
+    w_.noalias() = xt_ * cq;
+  } else {
+    w_.noalias() = xt_ * c;
+  }
+}
 
 void CpEngine::contractModeA(const MatF& b, MatD& out) const {
   out.resize(bins_, rank_);
@@ -89,18 +103,23 @@ void CpEngine::contractModeC(const MatF& a, const MatF& b) {
     for (int j = 0; j < bins_; ++j)
       kr_.col(r).segment(static_cast<Eigen::Index>(j) * bins_, bins_) = a.col(r) * b(j, r);
   }
-  mc_.noalias() = xt_.transpose() * kr_;
+  if (expand_) {
+    const MatF core_mc = xt_.transpose() * kr_;  // L x R
+    mc_.noalias() = *expand_ * core_mc;
+  } else {
+    mc_.noalias() = xt_.transpose() * kr_;
+  }
 }
 
 double CpEngine::errorSquared(const MatD& ata, const MatD& btb, const MatF& c) const {
   const MatD ctc = gram(c);
   double inner = 0.0;
   for (int r = 0; r < rank_; ++r) {
-    for (int k = 0; k < blocks_; ++k) inner += static_cast<double>(mc_(k, r)) * c(k, r);
+    for (int k = 0; k < c_rows_; ++k) inner += static_cast<double>(mc_(k, r)) * c(k, r);
   }
   const double model = (ata.array() * btb.array() * ctc.array()).sum();
   const double err_sq = norm_sq_ - 2.0 * inner + model;
-  if (err_sq > kGramErrorFloor * norm_sq_) return err_sq;
+  if (err_sq > kGramErrorFloor * norm_sq_ || expand_) return std::max(err_sq, 0.0);
   // Near-exact fits: the Gram identity cancels |X|^2 against float-rounded inner products (noise
   // about 1e-7 |X|^2), so the residual is formed explicitly instead; kr_ holds B kr A.
   MatF model_t(xt_.rows(), blocks_);

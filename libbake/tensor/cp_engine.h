@@ -22,9 +22,15 @@ class CpEngine {
   // x: K x (B*B) row-major values (read as the column-major (B*B) x K matrix X^T); must outlive
   // the engine.
   CpEngine(const float* x, int bins, int blocks, int rank);
+  // Compressed engine: x holds the B x B x L core of a tensor compressed in mode 3 by an
+  // orthonormal basis q (K x L), i.e. the data are X~ = core x_3 q, while C stays K x R. Sweeps then
+  // cost O(B^2 L R + K L R) instead of O(B^2 K R), and their errors are measured against X~ (|X~| =
+  // |core|). Used to run non-negative sweeps (whose constraint lives on the full C) on compressed
+  // data. q must outlive the engine.
+  CpEngine(const float* core, int bins, int basis, int rank, const MatF* q);
 
   int bins() const { return bins_; }
-  int blocks() const { return blocks_; }
+  int blocks() const { return c_rows_; }
   int rank() const { return rank_; }
   double normSquared() const { return norm_sq_; }
   const float* data() const { return xt_.data(); }
@@ -52,10 +58,12 @@ class CpEngine {
 
   Eigen::Map<const MatF> xt_;  // (B*B) x K
   int bins_, blocks_, rank_;
+  int c_rows_;                    // rows of C: blocks_, or K of a compressed engine
+  const MatF* expand_ = nullptr;  // compressed engine: the K x L basis
   double norm_sq_ = 0.0;
   MatF w_;   // (B*B) x R
   MatF kr_;  // (B*B) x R
-  MatF mc_;  // K x R
+  MatF mc_;  // K x R (rows of C)
   MatD m_;   // B x R scratch
 };
 

@@ -32,9 +32,14 @@
 // is redone from the last accepted factors.
 //
 // nonneg = true replaces the least-squares updates by HALS column updates (Cichocki & Phan 2009)
-// projected onto A, B, C >= 0, on full sweeps from a non-negative start (|HOSVD| for kCompressed
-// and kAls, uniform random for kAlsPlain); the range finder is not used (its core is not
-// non-negative). Every reconstructed value and every range sum is then >= 0.
+// projected onto A, B, C >= 0, from a non-negative start (|HOSVD| for kCompressed and kAls,
+// uniform random for kAlsPlain). kCompressed runs its HALS sweeps against the mode-3 compressed
+// tensor X~ = core x_3 Q (contractions through the B x B x L core and Q, the constraint on the
+// full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Measured on real
+// 32 x 32 x K groups at rank 16 (bench_tensorpack): 3.5-4.4x faster than the published
+// non-negative baseline at +0.3..0.7% error (beckmann K = 2620: 180 vs 796 ms, error 0.4013 vs
+// 0.4001; scratches K = 3766: 199 vs 706 ms, 0.0535 vs 0.0531), 1.7x on a flakes group with lower
+// error. Every reconstructed value and every range sum is >= 0.
 //
 // Determinism: results depend only on the tensor and the options (seeded generators, fixed
 // summation order, no threading inside one decomposition): identical bytes on every run and for
