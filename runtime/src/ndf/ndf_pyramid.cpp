@@ -1,4 +1,5 @@
 #include "../format_status.h"
+#include "../pyramid_blend.h"
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
@@ -56,7 +57,6 @@ struct NdfPyramid::Impl {
 
   Status load(const format::Reader& reader);
   void blend(const Footprint& fp, Blend* b) const;
-  void addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const;
   // Bin of s, or -1 outside [-1,1]^2.
   int binOf(double sx, double sy) const {
     if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
@@ -157,67 +157,16 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
   return Status::kOk;
 }
 
-void NdfPyramid::Impl::addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const {
-  const Level& lv = levels[l];
-  const NdfLevelRecord& r = lv.rec;
-  const int gw = int(r.grid_width), gh = int(r.grid_height);
-  auto axis = [&](double pos, double map_size, double origin, double stride, int n, int* i0, int* i1, double* f) {
-    if (r.wrap == 0) {
-      pos -= std::floor(pos / map_size) * map_size;  // into [0, map size)
-      double g = (pos - origin) / stride;
-      double fl = std::floor(g);
-      *f = g - fl;
-      int a = int(fl);
-      *i0 = ((a % n) + n) % n;
-      *i1 = (*i0 + 1) % n;
-    } else {
-      double g = (pos - origin) / stride;
-      if (!(g > 0.0)) {
-        *i0 = *i1 = 0;
-        *f = 0.0;
-      } else if (g >= double(n - 1)) {
-        *i0 = *i1 = n - 1;
-        *f = 0.0;
-      } else {
-        double fl = std::floor(g);
-        *i0 = int(fl);
-        *i1 = *i0 + 1;
-        *f = g - fl;
-      }
-    }
-  };
-  int x0, x1, y0, y1;
-  double fx, fy;
-  axis(fp.x, double(r.map_width), r.origin_x, r.stride_x, gw, &x0, &x1, &fx);
-  axis(fp.y, double(r.map_height), r.origin_y, r.stride_y, gh, &y0, &y1, &fy);
-  const size_t image_floats = size_t(res) * size_t(res);
-  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-  const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-  for (int k = 0; k < 4; ++k) {
-    if (ws[k] <= 0.0) continue;
-    const size_t centre = size_t(ys[k]) * size_t(gw) + size_t(xs[k]);
-    b->weight[b->count] = level_weight * ws[k];
-    b->image[b->count] = lv.images.data + centre * image_floats;
-    b->prefix[b->count] = lv.prefix.data + centre * size_t(res + 1);
-    ++b->count;
-  }
-}
-
 void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
-  b->count = 0;
-  const double s0 = levels[0].rec.sigma_texels;
-  const double top = levels[level_count - 1].rec.sigma_texels;
-  if (!(fp.sigma > s0)) {
-    addLevel(0, 1.0, fp, b);
-  } else if (fp.sigma >= top) {
-    addLevel(level_count - 1, 1.0, fp, b);
-  } else {
-    int l = 0;
-    while (l + 1 < level_count && levels[l + 1].rec.sigma_texels <= fp.sigma) ++l;
-    const double sa = levels[l].rec.sigma_texels, sb = levels[l + 1].rec.sigma_texels;
-    const double t = std::log(fp.sigma / sa) / std::log(sb / sa);  // linear in log2(sigma)
-    addLevel(l, 1.0 - t, fp, b);
-    addLevel(l + 1, t, fp, b);
+  CentreBlend cb;
+  blendCentres(levels, level_count, fp, &cb);
+  const size_t image_floats = size_t(res) * size_t(res);
+  b->count = cb.count;
+  for (int k = 0; k < cb.count; ++k) {
+    const Level& lv = levels[cb.level[k]];
+    b->weight[k] = cb.weight[k];
+    b->image[k] = lv.images.data + cb.centre[k] * image_floats;
+    b->prefix[k] = lv.prefix.data + cb.centre[k] * size_t(res + 1);
   }
 }
 

@@ -2,6 +2,8 @@
 // a CpMix (cp_block.h) of at most 8 (group, row, weight) terms.
 #include "tensor_ndf_impl.h"
 
+#include "../pyramid_blend.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -53,70 +55,16 @@ int TensorNdf::Impl::binOf(double sx, double sy) const {
   return j * res + i;
 }
 
-// Same centre selection and weights as NdfPyramid::Impl::addLevel (ndf_pyramid.cpp).
-void TensorNdf::Impl::addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const {
-  const TLevel& lv = levels[l];
-  const NdfLevelRecord& r = lv.rec;
-  const int gw = int(r.grid_width), gh = int(r.grid_height);
-  auto axis = [&](double pos, double map_size, double origin, double stride, int n, int* i0, int* i1, double* f) {
-    if (r.wrap == 0) {
-      pos -= std::floor(pos / map_size) * map_size;  // into [0, map size)
-      const double g = (pos - origin) / stride;
-      const double fl = std::floor(g);
-      *f = g - fl;
-      // pos in [0, map size) puts a in [-1, n - 1]: wrap without integer division (the same
-      // indices as ((a % n) + n) % n, which stays as the fallback).
-      const int a = int(fl);
-      *i0 = a >= 0 && a < n ? a : (a == -1 ? n - 1 : ((a % n) + n) % n);
-      *i1 = *i0 + 1 < n ? *i0 + 1 : 0;
-    } else {
-      const double g = (pos - origin) / stride;
-      if (!(g > 0.0)) {
-        *i0 = *i1 = 0;
-        *f = 0.0;
-      } else if (g >= double(n - 1)) {
-        *i0 = *i1 = n - 1;
-        *f = 0.0;
-      } else {
-        const double fl = std::floor(g);
-        *i0 = int(fl);
-        *i1 = *i0 + 1;
-        *f = g - fl;
-      }
-    }
-  };
-  int x0, x1, y0, y1;
-  double fx, fy;
-  axis(fp.x, double(r.map_width), r.origin_x, r.stride_x, gw, &x0, &x1, &fx);
-  axis(fp.y, double(r.map_height), r.origin_y, r.stride_y, gh, &y0, &y1, &fy);
-  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-  const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-  for (int k = 0; k < 4; ++k) {
-    if (ws[k] <= 0.0) continue;
-    const size_t first = (size_t(ys[k]) * size_t(gw) + size_t(xs[k])) * size_t(nb2);
-    b->weight[b->count] = level_weight * ws[k];
-    b->index[b->count] = lv.index.data + first;
-    b->mass[b->count] = lv.mass.data + first;
-    ++b->count;
-  }
-}
-
-// Same level selection as NdfPyramid::Impl::blend.
 void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
-  b->count = 0;
-  const double s0 = levels[0].rec.sigma_texels;
-  const double top = levels[level_count - 1].rec.sigma_texels;
-  if (!(fp.sigma > s0)) {
-    addLevel(0, 1.0, fp, b);
-  } else if (fp.sigma >= top) {
-    addLevel(level_count - 1, 1.0, fp, b);
-  } else {
-    int l = 0;
-    while (l + 1 < level_count && levels[l + 1].rec.sigma_texels <= fp.sigma) ++l;
-    const double sa = levels[l].rec.sigma_texels, sb = levels[l + 1].rec.sigma_texels;
-    const double t = std::log(fp.sigma / sa) / std::log(sb / sa);  // linear in log2(sigma)
-    addLevel(l, 1.0 - t, fp, b);
-    addLevel(l + 1, t, fp, b);
+  CentreBlend cb;
+  blendCentres(levels, level_count, fp, &cb);
+  b->count = cb.count;
+  for (int k = 0; k < cb.count; ++k) {
+    const TLevel& lv = levels[cb.level[k]];
+    const size_t first = cb.centre[k] * size_t(nb2);
+    b->weight[k] = cb.weight[k];
+    b->index[k] = lv.index.data + first;
+    b->mass[k] = lv.mass.data + first;
   }
 }
 

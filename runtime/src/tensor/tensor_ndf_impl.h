@@ -64,7 +64,6 @@ struct TensorNdf::Impl {
   Status loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch);
 
   void blend(const Footprint& fp, Blend* b) const;
-  void addLevel(int l, double level_weight, const Footprint& fp, Blend* b) const;
   // The CpMix of block `block` of the blend (blank entries skipped).
   void mixBlock(const Blend& b, uint64_t block, CpMix* mix) const;
   // Raw (unclamped) integral of the blended block over [x0, x1] x [y0, y1] in block-local bin
