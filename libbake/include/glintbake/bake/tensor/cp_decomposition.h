@@ -35,11 +35,13 @@
 // projected onto A, B, C >= 0, from a non-negative start (|HOSVD| for kCompressed and kAls,
 // uniform random for kAlsPlain). kCompressed runs its HALS sweeps against the mode-3 compressed
 // tensor X~ = core x_3 Q (contractions through the B x B x L core and Q, the constraint on the
-// full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Measured on real
-// 32 x 32 x K groups at rank 16 (bench_tensorpack): 3.5-4.4x faster than the published
-// non-negative baseline at +0.3..0.7% error (beckmann K = 2620: 180 vs 796 ms, error 0.4013 vs
-// 0.4001; scratches K = 3766: 199 vs 706 ms, 0.0535 vs 0.0531), 1.7x on a flakes group with lower
-// error. Every reconstructed value and every range sum is >= 0.
+// full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Its basis defaults to
+// L = max(32, 2 R): the core sweeps cost O(K L R), and L = 32 was both faster and as accurate as
+// 64. Measured on real 32 x 32 x K groups at rank 16 (bench_tensorpack, CPU-time medians) against
+// the published non-negative baseline (random start, plain HALS, its stopping rule): beckmann
+// K = 2620 170 vs 759 ms (error 0.4004 vs 0.4001), scratches K = 3766 131 vs 666 ms (0.0505 vs
+// 0.0531), flakes K = 1024 43 vs 112 ms (0.8711 vs 0.8671), i.e. 0.20-0.39 of the time with the
+// error within +0.5%. Every reconstructed value and every range sum is >= 0.
 //
 // Determinism: results depend only on the tensor and the options (seeded generators, fixed
 // summation order, no threading inside one decomposition): identical bytes on every run and for
@@ -84,7 +86,8 @@ struct CpOptions {
   int max_iters = 500;                    // sweeps of the main ALS loop, >= 1
   double tol = 1e-5;                      // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
   double ridge = 1e-7;                    // relative Tikhonov term of the normal equations, [0, 1)
-  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R) (kCompressed runs
+  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R), or max(32, 2 R)
+                                          // when nonneg (kCompressed runs
                                           // kAls instead when K <= L)
   int refine_sweeps = 10;                 // full sweeps after expanding the compressed solution, >= 0
   int core_starts = 3;                    // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
