@@ -86,11 +86,9 @@ struct TypeName {
 };
 
 constexpr TypeName kTypeNames[] = {
-    {kSectionMetadata, "metadata"},  {kSectionNdfLevel, "ndf-level"},
-    {kSectionNdfChunk, "ndf-chunk"}, {kSectionTensorIndex, "tensor-index"},
-    {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
-    {kSectionLtcTable, "ltc-table"}, {kSectionRoughness, "roughness"},
-    {kSectionImage, "image"},
+    {kSectionMetadata, "metadata"},        {kSectionNdfLevel, "ndf-level"},     {kSectionNdfChunk, "ndf-chunk"},
+    {kSectionTensorIndex, "tensor-index"}, {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
+    {kSectionLtcTable, "ltc-table"},       {kSectionRoughness, "roughness"},    {kSectionImage, "image"},
 };
 
 }  // namespace

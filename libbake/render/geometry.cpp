@@ -42,7 +42,7 @@ CameraModel::CameraModel(const Camera& camera) : camera_(camera) {
   right_ = normalize(cross(forward_, toVec(camera.up)));
   up_ = cross(right_, forward_);
   half_height_ = camera.type == CameraType::kPerspective ? std::tan(0.5 * camera.fov_degrees * kPi / 180.0)
-                                                          : 0.5 * camera.ortho_height;
+                                                         : 0.5 * camera.ortho_height;
 }
 
 RayWithDifferentials CameraModel::generate(double px, double py) const {

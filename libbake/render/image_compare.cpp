@@ -40,10 +40,9 @@ Result<RgbImage> loadRgbImage(const std::string& path) {
 
 Result<CompareMetrics> compareImages(const RgbImage& test, const RgbImage& reference) {
   if (test.width != reference.width || test.height != reference.height) {
-    return makeError(ErrorCode::kBadArgument, "the images differ in size (" + std::to_string(test.width) + "x" +
-                                                  std::to_string(test.height) + " vs " +
-                                                  std::to_string(reference.width) + "x" +
-                                                  std::to_string(reference.height) + ")");
+    return makeError(ErrorCode::kBadArgument,
+                     "the images differ in size (" + std::to_string(test.width) + "x" + std::to_string(test.height) +
+                         " vs " + std::to_string(reference.width) + "x" + std::to_string(reference.height) + ")");
   }
   CompareMetrics m;
   double se = 0.0, ref2 = 0.0, peak = 0.0;

@@ -47,8 +47,8 @@ Status ReferencePndf::average(const runtime::Footprint&, const runtime::SRect& r
   if (!(rect.x1 > rect.x0) || !(rect.y1 > rect.y0)) return Status::kInvalidArgument;
   double sum = 0.0;
   for (const Lobe& l : lobes_) {
-    sum += l.lobe.weight * reference::gaussianRectangleIntegral(l.lobe.mean, l.lobe.cov, rect.x0, rect.x1, rect.y0,
-                                                                 rect.y1);
+    sum += l.lobe.weight *
+           reference::gaussianRectangleIntegral(l.lobe.mean, l.lobe.cov, rect.x0, rect.x1, rect.y0, rect.y1);
   }
   *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
   return Status::kOk;
@@ -58,7 +58,8 @@ Status ReferencePndf::sample(const runtime::Footprint&, double u1, double u2, ru
   if (lobes_.empty() || !(total_ > 0.0)) return Status::kInvalidArgument;
   // Choose a lobe with u1 and reuse the remainder of u1 inside the lobe's interval.
   const double target = u1 * total_;
-  const size_t k = std::min(lobes_.size() - 1, size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin()));
+  const size_t k =
+      std::min(lobes_.size() - 1, size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin()));
   const double lo = k == 0 ? 0.0 : cdf_[k - 1];
   double v1 = (target - lo) / (cdf_[k] - lo);
   v1 = std::min(std::max(v1, 1e-300), 1.0 - 1e-16);

@@ -125,8 +125,7 @@ class Shader {
   }
 
   // Outgoing radiance at the hit towards wo (world). Returns false when an NDF query failed.
-  bool shade(const MicrofacetBrdf& brdf, const SurfaceHit& hit, const Vec3& wo_world, uint64_t pixel,
-             Rgb* out) const {
+  bool shade(const MicrofacetBrdf& brdf, const SurfaceHit& hit, const Vec3& wo_world, uint64_t pixel, Rgb* out) const {
     const Frame frame{hit.tangent, hit.bitangent, hit.normal};
     const Vec3 wo = frame.toLocal(wo_world);
     Rgb total;
@@ -285,7 +284,8 @@ class Shader {
     float fx[3], fy[3], fz[3];
     runtime::ltcShadingFrame(n, v, fx, fy, fz);
     runtime::LtcCoefficients ltc;
-    if (options_.ltc->lookup(float(std::sqrt(brdf.alpha())), runtime::ltcCosTheta(n, v), &ltc) != runtime::Status::kOk) {
+    if (options_.ltc->lookup(float(std::sqrt(brdf.alpha())), runtime::ltcCosTheta(n, v), &ltc) !=
+        runtime::Status::kOk) {
       return Rgb{};
     }
     float verts[runtime::kLtcMaxPolygonVertices][3];
@@ -389,44 +389,41 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
   std::vector<float> sigmas(size_t(cam.width) * cam.height, -1.0f);
   std::atomic<bool> failed{false};
 
-  tbb::parallel_for(tbb::blocked_range2d<int>(0, cam.height, kTile, 0, cam.width, kTile),
-                    [&](const tbb::blocked_range2d<int>& tile) {
-                      if (failed.load() || (options.cancel != nullptr && options.cancel->load())) return;
-                      for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
-                        for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-                          const size_t index = size_t(y) * cam.width + x;
-                          const RayWithDifferentials rays = camera.generate(x + 0.5, y + 0.5);
-                          SurfaceHit hit;
-                          Rgb color = toRgb(scene.background);
-                          if (object.intersect(rays.ray, &hit)) {
-                            const runtime::Footprint fp =
-                                pixelFootprint(rays, hit, cam.pixel_sigma, std::max(1, inputs.map_width),
-                                               std::max(1, inputs.map_height), scene.object.uv_scale);
-                            sigmas[index] = float(fp.sigma);
-                            const Vec3 wo = -1.0 * rays.ray.direction;
-                            bool ok = true;
-                            if (options.mode == NdfMode::kSmooth) {
-                              ok = shader.shade(MicrofacetBrdf::smooth(model, mat.alpha, fresnel), hit, wo, index,
-                                                &color);
-                            } else if (options.mode == NdfMode::kAsset) {
-                              ok = shader.shade(MicrofacetBrdf::glinty(inputs.asset, fp, model, mat.alpha, fresnel),
-                                                hit, wo, index, &color);
-                            } else {
-                              const ReferencePndf ref(*inputs.flakes, fp, mat.sigma_r);
-                              ok = shader.shade(MicrofacetBrdf::glinty(&ref, fp, model, mat.alpha, fresnel), hit, wo,
-                                                index, &color);
-                            }
-                            if (!ok) failed.store(true);
-                          }
-                          image.rgb[index * 3 + 0] = float(color.r);
-                          image.rgb[index * 3 + 1] = float(color.g);
-                          image.rgb[index * 3 + 2] = float(color.b);
-                        }
-                      }
-                      if (options.progress) {
-                        options.progress(uint64_t(tile.rows().size()) * uint64_t(tile.cols().size()));
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range2d<int>(0, cam.height, kTile, 0, cam.width, kTile), [&](const tbb::blocked_range2d<int>& tile) {
+        if (failed.load() || (options.cancel != nullptr && options.cancel->load())) return;
+        for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+          for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
+            const size_t index = size_t(y) * cam.width + x;
+            const RayWithDifferentials rays = camera.generate(x + 0.5, y + 0.5);
+            SurfaceHit hit;
+            Rgb color = toRgb(scene.background);
+            if (object.intersect(rays.ray, &hit)) {
+              const runtime::Footprint fp = pixelFootprint(rays, hit, cam.pixel_sigma, std::max(1, inputs.map_width),
+                                                           std::max(1, inputs.map_height), scene.object.uv_scale);
+              sigmas[index] = float(fp.sigma);
+              const Vec3 wo = -1.0 * rays.ray.direction;
+              bool ok = true;
+              if (options.mode == NdfMode::kSmooth) {
+                ok = shader.shade(MicrofacetBrdf::smooth(model, mat.alpha, fresnel), hit, wo, index, &color);
+              } else if (options.mode == NdfMode::kAsset) {
+                ok = shader.shade(MicrofacetBrdf::glinty(inputs.asset, fp, model, mat.alpha, fresnel), hit, wo, index,
+                                  &color);
+              } else {
+                const ReferencePndf ref(*inputs.flakes, fp, mat.sigma_r);
+                ok = shader.shade(MicrofacetBrdf::glinty(&ref, fp, model, mat.alpha, fresnel), hit, wo, index, &color);
+              }
+              if (!ok) failed.store(true);
+            }
+            image.rgb[index * 3 + 0] = float(color.r);
+            image.rgb[index * 3 + 1] = float(color.g);
+            image.rgb[index * 3 + 2] = float(color.b);
+          }
+        }
+        if (options.progress) {
+          options.progress(uint64_t(tile.rows().size()) * uint64_t(tile.cols().size()));
+        }
+      });
   if (failed.load()) return makeError(ErrorCode::kRuntime, "an NDF query failed during rendering");
   if (options.cancel != nullptr && options.cancel->load()) return makeError(ErrorCode::kRuntime, "cancelled");
   // Statistics in pixel order (deterministic).

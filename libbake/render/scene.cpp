@@ -47,7 +47,8 @@ int integer(const Json& j, const char* key, const std::string& where, int fallba
   const Json& v = j.at(key);
   if (!v.is_number_integer()) fail(where + "." + key + " must be an integer");
   const long long x = v.get<long long>();
-  if (x < lo || x > hi) fail(where + "." + key + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  if (x < lo || x > hi)
+    fail(where + "." + key + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return int(x);
 }
 
@@ -94,8 +95,8 @@ std::string resolve(const std::string& path, const std::string& base_dir) {
 
 Camera parseCamera(const Json& j) {
   const std::string w = "camera";
-  checkKeys(j, w, {"type", "position", "look_at", "up", "fov_degrees", "ortho_height", "width", "height",
-                   "pixel_sigma"});
+  checkKeys(j, w,
+            {"type", "position", "look_at", "up", "fov_degrees", "ortho_height", "width", "height", "pixel_sigma"});
   Camera c;
   const std::string type = text(j, "type", w, "perspective");
   if (type == "perspective") {
@@ -228,7 +229,8 @@ Light parseLight(const Json& j, size_t index) {
     if (!j.contains("vertices") || !j.at("vertices").is_array()) fail(w + ".vertices is required");
     const Json& vs = j.at("vertices");
     if (vs.size() < 3 || vs.size() > 64) fail(w + ".vertices must hold 3 to 64 points");
-    for (size_t i = 0; i < vs.size(); ++i) l.vertices.push_back(vec3(vs[i], w + ".vertices[" + std::to_string(i) + "]"));
+    for (size_t i = 0; i < vs.size(); ++i)
+      l.vertices.push_back(vec3(vs[i], w + ".vertices[" + std::to_string(i) + "]"));
     l.color = color(j, "radiance", w, l.color);
   } else if (type == "sg") {
     checkKeys(j, w, {"type", "axis", "sharpness", "amplitude"});
@@ -252,7 +254,8 @@ Light parseLight(const Json& j, size_t index) {
       const Vec3d& b = l.vertices[i];
       const Vec3d& c = l.vertices[i + 1];
       const Vec3d e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      area2 += length(Vec3d{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]});
+      area2 +=
+          length(Vec3d{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]});
     }
     if (!(area2 > 0.0)) fail(w + " has zero area");
   }

@@ -181,7 +181,8 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
 
   int sweeps = 0, core_sweeps = 0;
   double err_sq = std::numeric_limits<double>::infinity();
-  const int basis = options.compressed_basis > 0 ? options.compressed_basis : std::max(options.nonneg ? 32 : 64, 2 * rank);
+  const int basis =
+      options.compressed_basis > 0 ? options.compressed_basis : std::max(options.nonneg ? 32 : 64, 2 * rank);
   if (options.method == CpMethod::kAlsPlain) {
     randomStart(bins, blocks, rank, options.seed, s);
     err_sq = runSweeps(engine, s, err_sq, settings, &sweeps);

@@ -50,7 +50,11 @@ MatD solveNormalEquations(const MatD& m, const MatD& g, double ridge) {
 }
 
 CpEngine::CpEngine(const float* x, int bins, int blocks, int rank)
-    : xt_(x, static_cast<Eigen::Index>(bins) * bins, blocks), bins_(bins), blocks_(blocks), rank_(rank), c_rows_(blocks) {
+    : xt_(x, static_cast<Eigen::Index>(bins) * bins, blocks),
+      bins_(bins),
+      blocks_(blocks),
+      rank_(rank),
+      c_rows_(blocks) {
   double sum = 0.0;
   const size_t count = static_cast<size_t>(bins) * bins * blocks;
   for (size_t n = 0; n < count; ++n) sum += static_cast<double>(x[n]) * x[n];

@@ -52,8 +52,7 @@ inline void blendAxis(double pos, double map_size, double origin, double stride,
   }
 }
 
-inline void blendLevel(const NdfLevelRecord& r, int level, double level_weight, const Footprint& fp,
-                       CentreBlend* out) {
+inline void blendLevel(const NdfLevelRecord& r, int level, double level_weight, const Footprint& fp, CentreBlend* out) {
   const int gw = int(r.grid_width), gh = int(r.grid_height);
   const bool repeat = r.wrap == 0;
   int x0, x1, y0, y1;

@@ -45,7 +45,7 @@ struct RenderOptions {
   std::string asset;       // overrides material.asset
   std::string normal_map;  // overrides material.normal_map
   std::string image_size;  // --image-size W,H; empty: the scene's
-  std::string preview;  // tone-mapped PNG
+  std::string preview;     // tone-mapped PNG
   double exposure = 1.0;
   bake::IngestOptions ingest;
 };

@@ -6,8 +6,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 namespace glintbake::glintref {
@@ -19,7 +19,8 @@ cli::Json finiteOrNull(double x) { return std::isfinite(x) ? cli::Json(x) : cli:
 }  // namespace
 
 CLI::App* addCompareCommand(CLI::App& app, CompareOptions& options) {
-  CLI::App* cmd = app.add_subcommand("compare", "Compare an image with a reference: RMSE, relative MSE, PSNR, heat map");
+  CLI::App* cmd =
+      app.add_subcommand("compare", "Compare an image with a reference: RMSE, relative MSE, PSNR, heat map");
   cmd->add_option("image", options.image, "Image to evaluate (EXR or any format OpenImageIO reads)")->required();
   cmd->add_option("reference", options.reference, "Reference image of the same size")->required();
   cmd->add_option("--heatmap", options.heatmap, "Write the per-pixel RMS error as a colour-ramp PNG");
@@ -67,7 +68,8 @@ int runCompare(cli::Tool& tool, CompareOptions& options) {
     tool.addOutput(options.heatmap);
   }
 
-  const bool differs = options.max_rel_mse < std::numeric_limits<double>::infinity() && m.relative_mse > options.max_rel_mse;
+  const bool differs =
+      options.max_rel_mse < std::numeric_limits<double>::infinity() && m.relative_mse > options.max_rel_mse;
   if (tool.common().json) {
     cli::Json doc;
     doc["tool"] = "glintref";

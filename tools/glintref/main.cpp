@@ -5,7 +5,8 @@
 
 int main(int argc, char** argv) {
   using namespace glintbake;
-  cli::Tool tool("glintref", "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons");
+  cli::Tool tool("glintref",
+                 "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();

@@ -12,7 +12,6 @@
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_source.h>
 
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -56,8 +55,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options) {
                   "SG environment shading with --ndf asset: prefilter (averaged NDF over the light's support) or "
                   "sample (MIS like the other modes)")
       ->check(CLI::IsMember({"prefilter", "sample"}));
-  cmd->add_option("--ltc", options.ltc,
-                  "Shade polygon lights with this GGX LTC table (ltcfit table) instead of sampling; needs --ndf smooth");
+  cmd->add_option(
+      "--ltc", options.ltc,
+      "Shade polygon lights with this GGX LTC table (ltcfit table) instead of sampling; needs --ndf smooth");
   cmd->add_option("--asset", options.asset, "Override the material's asset (any NDF asset kind)");
   cmd->add_option("--normal-map", options.normal_map, "Override the material's normal map");
   cmd->add_option("--image-size", options.image_size, "Override the camera's image size: W,H in pixels (1..8192)");
@@ -123,14 +123,15 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   std::unique_ptr<runtime::NdfSource> asset;
   // The map is read for the reference's flakes, and otherwise only for its size (the uv to texel
   // mapping of the footprints) when the scene does not state it.
-  const bool need_map = mode == bake::render::NdfMode::kReference ||
-                        (inputs.map_width == 0 && (mode == bake::render::NdfMode::kAsset ||
-                                                   !scene.material.normal_map.empty()));
+  const bool need_map =
+      mode == bake::render::NdfMode::kReference ||
+      (inputs.map_width == 0 && (mode == bake::render::NdfMode::kAsset || !scene.material.normal_map.empty()));
   if (need_map) {
     if (scene.material.normal_map.empty()) {
-      throw cli::Error(cli::kExitBadArguments, mode == bake::render::NdfMode::kReference
-                                                   ? "--ndf reference needs material.normal_map (or --normal-map)"
-                                                   : "--ndf asset needs material.map_size or a normal map for the map size");
+      throw cli::Error(cli::kExitBadArguments,
+                       mode == bake::render::NdfMode::kReference
+                           ? "--ndf reference needs material.normal_map (or --normal-map)"
+                           : "--ndf asset needs material.map_size or a normal map for the map size");
     }
     bake::IngestReport report;
     const bake::NormalMap map = cli::loadNormalMapForTool(tool, scene.material.normal_map, options.ingest, &report);

@@ -307,7 +307,8 @@ int main(int argc, char** argv) {
                     "relative error %.4f, %.1f s",
                     report.levels.size(), static_cast<unsigned long long>(report.groups), report.max_rank,
                     static_cast<unsigned long long>(file_bytes), 100.0 * ratio, report.relative_error, seconds);
-      t.info("wrote " + output + summary);    }
+      t.info("wrote " + output + summary);
+    }
     return cli::kExitOk;
   });
 }

@@ -77,8 +77,7 @@ void gb_brdf_ndf_close(gb_brdf_ndf* ndf) { delete ndf; }
 
 int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]) {
   MicrofacetBrdf brdf;
-  if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || f == nullptr)
-    return code(Status::kInvalidArgument);
+  if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || f == nullptr) return code(Status::kInvalidArgument);
   Rgb value;
   const Status st = brdf.eval(toVec(wi), toVec(wo), &value);
   if (st == Status::kOk) fromRgb(value, f);

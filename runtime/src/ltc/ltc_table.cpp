@@ -1,7 +1,7 @@
 // Runtime-lite LTC table: loading an ltc-table container and bilinear lookups.
-#include "../format_status.h"
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ltc.h>
+#include "../format_status.h"
 
 #include <algorithm>
 #include <cmath>

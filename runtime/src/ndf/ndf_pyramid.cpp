@@ -1,7 +1,7 @@
-#include "../format_status.h"
-#include "../pyramid_blend.h"
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
+#include "../format_status.h"
+#include "../pyramid_blend.h"
 
 #include <algorithm>
 #include <cmath>

@@ -82,8 +82,8 @@ enum SectionType : uint32_t {
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
-// "tensor-info", "tensor-group", "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate, "unknown"
-// otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
+// "tensor-info", "tensor-group", "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate,
+// "unknown" otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);
 bool sectionTypeFromString(const std::string& name, uint32_t* type);
 

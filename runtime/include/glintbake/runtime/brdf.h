@@ -77,7 +77,7 @@ enum class FresnelKind : int32_t {
 
 struct Fresnel {
   FresnelKind kind = FresnelKind::kNone;
-  Rgb f0{1.0, 1.0, 1.0};  // kSchlick: reflectance at normal incidence, [0, 1]
+  Rgb f0{1.0, 1.0, 1.0};    // kSchlick: reflectance at normal incidence, [0, 1]
   Rgb eta{0.2, 0.92, 1.1};  // kConductor: real part of the IOR (default: gold, approx. RGB)
   Rgb k{3.9, 2.45, 2.14};   // kConductor: imaginary part (extinction), >= 0
 };

@@ -37,9 +37,9 @@ class CameraModel {
 struct SurfaceHit {
   double t = 0.0;
   Vec3 position;
-  Vec3 tangent;    // unit, along +u (texture x: right)
-  Vec3 bitangent;  // unit, texture up (along -v: rows go down)
-  Vec3 normal;     // unit, outward, = tangent x bitangent
+  Vec3 tangent;             // unit, along +u (texture x: right)
+  Vec3 bitangent;           // unit, texture up (along -v: rows go down)
+  Vec3 normal;              // unit, outward, = tangent x bitangent
   double u = 0.0, v = 0.0;  // texture coordinates in [0, 1)
   Vec3 dpdu, dpdv;          // partial derivatives of the position (world units per unit uv)
 };
@@ -53,7 +53,7 @@ class ObjectModel {
 
  private:
   Object object_;
-  double bend_ = 0.0;        // bent_quad: bend angle in radians
+  double bend_ = 0.0;         // bent_quad: bend angle in radians
   double bend_radius_ = 0.0;  // bent_quad: cylinder radius (size / bend)
   bool intersectPlane(const Ray& ray, SurfaceHit* hit) const;
   bool intersectSphere(const Ray& ray, SurfaceHit* hit) const;

@@ -32,7 +32,7 @@
 namespace glintbake::runtime {
 class NdfSource;
 class LtcTable;
-}
+}  // namespace glintbake::runtime
 namespace glintbake::reference {
 struct FlakeSet;
 }

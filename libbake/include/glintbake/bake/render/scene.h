@@ -61,7 +61,7 @@ struct Material {
   double sigma_r = 0.005;  // intrinsic roughness of the reference flakes, (0, 1]
   int rate = 1;            // reference flakes per texel side, [1, 16]
   ShadowingModel shadowing = ShadowingModel::kGgx;
-  double alpha = 0.1;      // base roughness: Smith shadowing, and D of --ndf smooth; [1e-4, 4]
+  double alpha = 0.1;  // base roughness: Smith shadowing, and D of --ndf smooth; [1e-4, 4]
   FresnelType fresnel = FresnelType::kConductor;
   Vec3d f0{0.95, 0.64, 0.54};  // Schlick reflectance at normal incidence (default: copper-like)
   Vec3d eta{0.2, 0.92, 1.1};   // conductor IOR (default: gold, approx. RGB)
@@ -81,7 +81,7 @@ struct Light {
   LightType type = LightType::kPoint;
   Vec3d position{0.0, 2.0, 0.0};
   Vec3d direction{0.0, 1.0, 0.0};
-  Vec3d color{1.0, 1.0, 1.0};  // intensity, irradiance, radiance or amplitude by type
+  Vec3d color{1.0, 1.0, 1.0};   // intensity, irradiance, radiance or amplitude by type
   std::vector<Vec3d> vertices;  // polygon, in order (3 to 64 vertices)
   double sharpness = 100.0;     // sg: lambda > 0
 };
