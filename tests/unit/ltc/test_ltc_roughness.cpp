@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include "../temp_dir.h"
 
 namespace glintbake::bake::ltc {
 namespace {
@@ -68,7 +69,7 @@ TEST(Roughness, DeterministicAndWritesMipmappedExr) {
   ASSERT_EQ(one.size(), two.size());
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].alpha, two[i].alpha);
 
-  const std::string path = ::testing::TempDir() + "ltc_rough.exr";
+  const std::string path = glintbake::testing::processTempDir() + "ltc_rough.exr";
   const Status written = writeRoughnessExr(one, path);
   ASSERT_TRUE(written.ok()) << written.error().message;
   auto input = OIIO::ImageInput::open(path);

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::runtime {
 namespace {
@@ -123,7 +124,7 @@ std::vector<uint8_t> imageSection(int n, const std::vector<float>& values, uint3
 
 std::string writeContainer(const std::string& name, format::AssetKind kind, const std::vector<uint8_t>& s0,
                            const std::vector<uint8_t>& s1) {
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = glintbake::testing::processTempDir() + name;
   format::Writer writer;
   EXPECT_EQ(writer.open(path, kind), format::Status::kOk);
   EXPECT_EQ(writer.addSection(format::kSectionLtcTable, 0, s0.data(), s0.size()), format::Status::kOk);
@@ -159,7 +160,7 @@ TEST(LtcTableRuntime, LoadsContainersAndRefusesMalformedOnes) {
       writeContainer("ltc_nan.gbk", format::AssetKind::kLtcTable, imageSection(6, l2), imageSection(6, bad));
   EXPECT_EQ(LtcTable().open(nonfinite.c_str()), Status::kInvalidAsset);
 
-  EXPECT_EQ(LtcTable().open((::testing::TempDir() + "missing.gbk").c_str()), Status::kIoError);
+  EXPECT_EQ(LtcTable().open((glintbake::testing::processTempDir() + "missing.gbk").c_str()), Status::kIoError);
   const uint8_t garbage[64] = {1, 2, 3};
   EXPECT_NE(LtcTable().openMemory(garbage, sizeof(garbage)), Status::kOk);
   for (const auto& path : {good, wrong_kind, mismatched, nonfinite}) std::remove(path.c_str());

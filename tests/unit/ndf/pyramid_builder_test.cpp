@@ -14,12 +14,13 @@
 #include <iterator>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::bake::ndf {
 namespace {
 
 std::string tempPath(const std::string& name) {
-  return std::string(::testing::TempDir()) + "/ndf_builder_" + name + ".gbk";
+  return glintbake::testing::processTempDir() + "ndf_builder_" + name + ".gbk";
 }
 
 std::vector<char> readAll(const std::string& path) {

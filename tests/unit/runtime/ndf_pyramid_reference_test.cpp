@@ -12,6 +12,7 @@
 #include <cstring>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::runtime {
 namespace {
@@ -26,7 +27,7 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
   o.stride0 = 8;
   o.sigma0 = 4;
   o.levels = 3;
-  const std::string path = std::string(::testing::TempDir()) + "/rt_ref_pyramid.gbk";
+  const std::string path = glintbake::testing::processTempDir() + "rt_ref_pyramid.gbk";
   {
     format::Writer w;
     ASSERT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);

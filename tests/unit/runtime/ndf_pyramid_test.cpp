@@ -15,6 +15,7 @@
 #include <random>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::runtime {
 namespace {
@@ -50,7 +51,7 @@ struct LevelSpec {
 // Writes a pyramid container over a kMap^2 map with the given levels and region size.
 std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int region, uint32_t wrap = 0,
                                  const std::string& path = "") {
-  const std::string file = path.empty() ? std::string(::testing::TempDir()) + "/rt_pyramid.gbk" : path;
+  const std::string file = path.empty() ? glintbake::testing::processTempDir() + "rt_pyramid.gbk" : path;
   format::Writer w;
   EXPECT_EQ(w.open(file, format::AssetKind::kNdfPyramid, 1), format::Status::kOk);
   for (size_t l = 0; l < levels.size(); ++l) {
@@ -271,7 +272,7 @@ TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {
 }
 
 TEST(NdfPyramidC, CApiMatchesTheClass) {
-  const std::string path = std::string(::testing::TempDir()) + "/rt_pyramid_c.gbk";
+  const std::string path = glintbake::testing::processTempDir() + "rt_pyramid_c.gbk";
   makePyramid(kLevels, 4, 0, path);
   gb_ndf_pyramid* p = nullptr;
   ASSERT_EQ(gb_ndf_pyramid_open(path.c_str(), &p), GB_OK);
@@ -321,7 +322,7 @@ TEST(NdfPyramidInvalid, MalformedAssetsAreRejected) {
     }
   }
   // Wrong asset kind.
-  const std::string path = std::string(::testing::TempDir()) + "/rt_wrong_kind.gbk";
+  const std::string path = glintbake::testing::processTempDir() + "rt_wrong_kind.gbk";
   {
     format::Writer w;
     ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::Status::kOk);

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include "../temp_dir.h"
 
 namespace glintbake::runtime {
 namespace {
@@ -37,7 +38,7 @@ std::unique_ptr<NdfSource> bakePyramid(bake::MapKind kind, double alpha, int ndf
   o.stride0 = 8;
   o.sigma0 = 4;
   o.levels = 2;
-  const std::string path = std::string(::testing::TempDir()) + "/" + name + ".gbk";
+  const std::string path = glintbake::testing::processTempDir() + "" + name + ".gbk";
   format::Writer w;
   EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());

@@ -19,11 +19,12 @@
 #include <memory>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::runtime::testing {
 
 inline std::string tempPath(const std::string& name) {
-  return std::string(::testing::TempDir()) + "/runtime_tensor_" + name;
+  return glintbake::testing::processTempDir() + "runtime_tensor_" + name;
 }
 
 inline std::vector<uint8_t> readFile(const std::string& path) {

@@ -19,6 +19,7 @@
 #include <map>
 #include <string>
 #include <vector>
+#include "../temp_dir.h"
 
 namespace glintbake::bake::tensor {
 namespace {
@@ -28,7 +29,7 @@ using runtime::TensorGroupHeader;
 using runtime::TensorIndexEntry;
 using runtime::TensorInfoRecord;
 
-std::string tempPath(const std::string& name) { return std::string(::testing::TempDir()) + "/tensor_pack_" + name; }
+std::string tempPath(const std::string& name) { return glintbake::testing::processTempDir() + "tensor_pack_" + name; }
 
 std::vector<char> readAll(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
