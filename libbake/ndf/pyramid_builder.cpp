@@ -68,8 +68,17 @@ void axisNeighbours(double pos, double size, double stride, int n, Wrap wrap, in
 // Up to kConvergenceSamplesPerAxis^2 evenly spread centres of level `geo`, with their neighbours
 // on the level below (`below`).
 std::vector<Sample> planSamples(const LevelGeometry& geo, const LevelGeometry& below, Wrap wrap, size_t image_floats) {
-  const int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
-  const int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
+  int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
+  int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
+  // At most a quarter of the level's centres (at least one): the level is probed before it is
+  // computed, and the probe of a level that turns out converged is work thrown away.
+  while (4 * nsx * nsy > geo.grid_width * geo.grid_height && (nsx > 1 || nsy > 1)) {
+    if (nsx >= nsy) {
+      --nsx;
+    } else {
+      --nsy;
+    }
+  }
   std::vector<Sample> samples(size_t(nsx) * size_t(nsy));
   for (int k = 0; k < nsx * nsy; ++k) {
     Sample& s = samples[size_t(k)];
