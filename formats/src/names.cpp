@@ -1,6 +1,10 @@
-// Stable names of status codes, asset kinds and codecs (used in messages, JSON and metadata).
+// Stable names of status codes, asset kinds and codecs (used in messages, JSON and metadata), and
+// the magic test.
+#include "layout.h"
+
 #include <glintbake/format/container.h>
 
+#include <cstring>
 #include <string>
 
 namespace glintbake::format {
@@ -128,6 +132,11 @@ bool sectionTypeFromString(const std::string& name, uint32_t* type) {
   }
   if (type) *type = uint32_t(value);
   return true;
+}
+
+bool hasContainerMagic(const void* data, size_t size) {
+  return data != nullptr && size >= sizeof(layout::kMagic) &&
+         std::memcmp(data, layout::kMagic, sizeof(layout::kMagic)) == 0;
 }
 
 }  // namespace glintbake::format

@@ -10,10 +10,26 @@
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/runtime.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
 namespace glintbake::runtime {
+
+// Footprint arguments every query accepts: finite, sigma >= 0, position within +-1e15 texels.
+inline bool validFootprint(const Footprint& fp) {
+  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
+         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
+}
+
+// Index j * res + i of the bin of an R x R NDF image (bin side 2 / res) holding s, or -1 outside
+// [-1, 1]^2 (row 0 at s_y = +1).
+inline int ndfBinOf(double sx, double sy, int res, double bin) {
+  if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
+  const int i = std::min(res - 1, int((sx + 1.0) / bin));
+  const int j = std::min(res - 1, int((1.0 - sy) / bin));
+  return j * res + i;
+}
 
 // Up to 8 (level, centre, weight) terms; centre = j * grid_width + i on its level. Weights sum to 1.
 struct CentreBlend {

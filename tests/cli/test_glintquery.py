@@ -103,8 +103,6 @@ class GlintQuery(ToolTestCase):
         self.assertAlmostEqual(point["value"], pdf["pdf"] * lines[2]["mass"], delta=1e-9 * point["value"])
 
     def test_tensor_asset(self):
-        if not os.path.exists(clitest.tool_path("tensorpack")):
-            self.skipTest("tensorpack is not built")
         tensor = self.path("t.gbk")
         self.run_ok("tensorpack", self.asset, "-o", tensor, "--rank", "16", "--block", "16", "--nonneg", "--quiet")
         doc = self.run_json("glintquery", "point", tensor, "--at", "12,20", "--sigma", "5", "--s", "0.02,-0.01",

@@ -2,6 +2,7 @@
 // runtime-lite, exactly as a renderer would see them: point values, the blended image of a
 // footprint, and JSON-lines batches of point, range, sample, pdf and mass queries.
 #include <glintbake/bake/io/image_io.h>
+#include <glintbake/cli/runtime_status.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -54,11 +55,7 @@ Asset openAsset(cli::Tool& tool, const std::string& path) {
                                                                      : "unknown";
     return asset;
   }
-  int code = cli::kExitInvalidInput;
-  if (s == rt::Status::kIoError) code = cli::kExitIo;
-  if (s == rt::Status::kWrongKind || s == rt::Status::kUnsupportedVersion) code = cli::kExitUnsupported;
-  if (s == rt::Status::kOutOfMemory) code = cli::kExitRuntime;
-  throw Error(code, "cannot open " + path + ": " + rt::statusString(s));
+  throw Error(cli::exitCodeOfRuntime(s), "cannot open " + path + ": " + rt::statusString(s));
 }
 
 void check(rt::Status s, const char* what) {

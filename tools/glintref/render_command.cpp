@@ -8,6 +8,7 @@
 #include <glintbake/bake/render/renderer.h>
 #include <glintbake/bake/render/scene.h>
 #include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/runtime_status.h>
 #include <glintbake/reference/flakes.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -20,19 +21,6 @@
 
 namespace glintbake::glintref {
 namespace {
-
-int exitCodeOf(runtime::Status st) {
-  switch (st) {
-    case runtime::Status::kIoError:
-      return cli::kExitIo;
-    case runtime::Status::kUnsupportedVersion:
-      return cli::kExitUnsupported;
-    case runtime::Status::kOutOfMemory:
-      return cli::kExitRuntime;
-    default:
-      return cli::kExitInvalidInput;
-  }
-}
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -151,7 +139,8 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
     tool.addInput(scene.material.asset);
     const runtime::Status st = runtime::openNdfAsset(scene.material.asset.c_str(), &asset);
     if (st != runtime::Status::kOk) {
-      throw cli::Error(exitCodeOf(st), "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
+      throw cli::Error(cli::exitCodeOfRuntime(st),
+                       "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
     }
     inputs.asset = asset.get();
   }
@@ -163,7 +152,8 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
     tool.addInput(options.ltc);
     const runtime::Status st = ltc.open(options.ltc.c_str());
     if (st != runtime::Status::kOk) {
-      throw cli::Error(exitCodeOf(st), "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
+      throw cli::Error(cli::exitCodeOfRuntime(st),
+                       "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
     }
   }
   const double load_seconds = secondsSince(t_start);

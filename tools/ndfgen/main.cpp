@@ -3,6 +3,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 
@@ -36,87 +37,38 @@ Json levelJson(const bake::ndf::PyramidLevelReport& l, int region_size) {
 
 int main(int argc, char** argv) {
   cli::Tool tool("ndfgen", "Bakes the footprint pyramid of P-NDF images of a normal map (ndf-pyramid asset)");
-  std::string input, output, levels_text = "auto";
+  std::string input, output;
   bake::IngestOptions ingest;
-  bake::ndf::PyramidOptions opt;
+  cli::PyramidCliOptions pyramid;
+  const bake::ndf::PyramidOptions& opt = pyramid.options;
   int zstd_level = 3;
   CLI::App& app = tool.app();
   app.add_option("map", input, "Normal map (or height field with --height)")->required();
   app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();
-  app.add_option("--ndf-res", opt.splat.ndf_res, "NDF image resolution R (bins per side, 2..4096)")
-      ->capture_default_str();
-  app.add_option("--sigma-r", opt.splat.sigma_r, "Intrinsic roughness: s-plane std of every flake (0, 1]")
-      ->capture_default_str();
-  app.add_option("--stride", opt.stride0, "Level-0 spacing of footprint centres, texels (> 0)")->capture_default_str();
-  app.add_option("--sigma0", opt.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str();
-  app.add_option("--levels", levels_text, "Number of levels, or auto (stop on convergence or a 1x1 grid)")
-      ->capture_default_str();
-  app.add_option("--converge-mse", opt.converge_mse,
-                 "auto levels: stop when the relative MSE between neighbouring levels is below this")
-      ->capture_default_str();
-  app.add_option("--rate", opt.rate, "Flakes per texel side (1..16)")->capture_default_str();
-  app.add_option("--region", opt.region_size, "Footprint centres per side of a streamed chunk (1..256)")
-      ->capture_default_str();
+  cli::addPyramidOptions(app, pyramid, "Footprint centres per side of a streamed chunk (1..256)");
   app.add_option("--zstd-level", zstd_level, "zstd compression level of the chunks (1..19)")->capture_default_str();
   cli::addIngestOptions(app, ingest);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
-    if (levels_text == "auto") {
-      opt.levels = 0;
-    } else {
-      try {
-        size_t used = 0;
-        opt.levels = std::stoi(levels_text, &used);
-        if (used != levels_text.size() || opt.levels < 1) throw std::invalid_argument("levels");
-      } catch (const std::exception&) {
-        throw Error(cli::kExitBadArguments, "--levels must be auto or a positive integer");
-      }
-    }
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-    if (bake::Status s = bake::ndf::validatePyramidOptions(opt); !s) {
-      throw Error(exitCodeOf(s.error().code), s.error().message);
-    }
+    cli::resolvePyramidOptions(pyramid);
 
     bake::IngestReport ingest_report;
     const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
-    if (map.width < 2 || map.height < 2) {
-      throw Error(cli::kExitInvalidInput, input + ": a normal map needs at least 2x2 texels (got " +
-                                              std::to_string(map.width) + "x" + std::to_string(map.height) + ")");
-    }
+    cli::requireBakeableMap(map, input);
 
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
 
-    std::unique_ptr<cli::Progress> bar;
-    int bar_level = -1;
-    uint64_t bar_done = 0;
     bake::ndf::PyramidReport report;
-    bake::Status built =
-        bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, [&](int level, uint64_t done, uint64_t total) {
-          if (level != bar_level) {
-            if (bar) bar->finish();
-            bar = t.progress("level " + std::to_string(level), total);
-            bar_level = level;
-            bar_done = 0;
-          }
-          bar->advance(done - bar_done);
-          bar_done = done;
-        });
-    if (bar) bar->finish();
+    cli::LevelProgress progress(t);
+    const bake::Status built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
+    progress.finish();
     if (!built) {
       throw Error(exitCodeOf(built.error().code), built.error().message);
     }
 
-    Json params;
-    params["ndf_res"] = opt.splat.ndf_res;
-    params["sigma_r"] = opt.splat.sigma_r;
-    params["stride"] = opt.stride0;
-    params["sigma0"] = opt.sigma0;
-    params["levels"] = levels_text == "auto" ? Json("auto") : Json(opt.levels);
-    params["converge_mse"] = opt.converge_mse;
-    params["rate"] = opt.rate;
-    params["region"] = opt.region_size;
-    params["footprint_truncation"] = opt.splat.footprint_truncation;
+    Json params = cli::pyramidOptionsJson(pyramid);
     params["zstd_level"] = zstd_level;
     params["ingest"] = cli::ingestOptionsJson(ingest);
     Json meta = t.makeMetadata("ndf-pyramid", params);

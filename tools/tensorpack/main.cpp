@@ -6,6 +6,7 @@
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 
@@ -26,15 +27,13 @@ namespace cli = glintbake::cli;
 namespace format = glintbake::format;
 namespace tensor = glintbake::bake::tensor;
 
-constexpr unsigned char kContainerMagic[8] = {0xAB, 'G', 'B', 'K', '\r', '\n', 0x1A, '\n'};
-
 // True when the file starts with the container magic. Throws the I/O error for unreadable files.
 bool isContainer(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw Error(cli::kExitIo, path + ": cannot open (missing or unreadable)");
   unsigned char head[8] = {};
   f.read(reinterpret_cast<char*>(head), sizeof(head));
-  return f.gcount() == sizeof(head) && std::memcmp(head, kContainerMagic, sizeof(head)) == 0;
+  return format::hasContainerMagic(head, size_t(f.gcount()));
 }
 
 // Default output: beside the input, its extension replaced by .gbk (a container input keeps its
@@ -74,9 +73,10 @@ int main(int argc, char** argv) {
   cli::Tool tool(
       "tensorpack",
       "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
-  std::string input, output, levels_text = "auto", method_text = "compressed", precision_text = "float32";
+  std::string input, output, method_text = "compressed", precision_text = "float32";
   bake::IngestOptions ingest;
-  bake::ndf::PyramidOptions pyr;
+  cli::PyramidCliOptions pyramid;
+  const bake::ndf::PyramidOptions& pyr = pyramid.options;
   tensor::TensorPackOptions opt;
   // Non-negative factors by default. Measured on 256^2 mapgen maps at the default pyramid (R = 128,
   // B = 32): at equal rank their relative error is 1-4% higher than plain ALS (beckmann rank 16:
@@ -108,20 +108,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
   app.add_option("--zstd-level", zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
-  std::vector<CLI::Option*> pyramid_flags = {
-      app.add_option("--ndf-res", pyr.splat.ndf_res, "NDF image resolution R (bins per side, 2..4096)")
-          ->capture_default_str(),
-      app.add_option("--sigma-r", pyr.splat.sigma_r, "Intrinsic roughness: s-plane std of every flake (0, 1]")
-          ->capture_default_str(),
-      app.add_option("--stride", pyr.stride0, "Level-0 spacing of footprint centres, texels (> 0)")
-          ->capture_default_str(),
-      app.add_option("--sigma0", pyr.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str(),
-      app.add_option("--levels", levels_text, "Number of levels, or auto")->capture_default_str(),
-      app.add_option("--converge-mse", pyr.converge_mse, "auto levels: relative MSE between levels to stop at")
-          ->capture_default_str(),
-      app.add_option("--rate", pyr.rate, "Flakes per texel side (1..16)")->capture_default_str(),
-      app.add_option("--region", pyr.region_size, "Footprint centres per group side (1..256)")->capture_default_str(),
-  };
+  cli::addPyramidOptions(app, pyramid, "Footprint centres per group side (1..256)");
   cli::addIngestOptions(app, ingest);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
@@ -138,17 +125,6 @@ int main(int argc, char** argv) {
       throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
     }
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-    if (levels_text == "auto") {
-      pyr.levels = 0;
-    } else {
-      try {
-        size_t used = 0;
-        pyr.levels = std::stoi(levels_text, &used);
-        if (used != levels_text.size() || pyr.levels < 1) throw std::invalid_argument("levels");
-      } catch (const std::exception&) {
-        throw Error(cli::kExitBadArguments, "--levels must be auto or a positive integer");
-      }
-    }
     if (bake::Status s = tensor::validateTensorPackOptions(opt); !s)
       throw Error(exitCodeOf(s.error()), s.error().message);
 
@@ -172,7 +148,7 @@ int main(int argc, char** argv) {
     Json map_json = nullptr, source_asset = nullptr;
     std::unique_ptr<cli::ContainerOutput> out;
     if (from_container) {
-      for (CLI::Option* o : pyramid_flags) {
+      for (CLI::Option* o : pyramid.flags) {
         if (o->count() > 0) throw Error(cli::kExitBadArguments, o->get_name() + " applies to normal-map inputs only");
       }
       t.addInput(input);
@@ -199,49 +175,24 @@ int main(int argc, char** argv) {
         throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
       }
     } else {
-      if (bake::Status s = bake::ndf::validatePyramidOptions(pyr); !s)
-        throw Error(exitCodeOf(s.error()), s.error().message);
+      cli::resolvePyramidOptions(pyramid);
       if (pyr.splat.ndf_res % opt.block != 0) {
         throw Error(cli::kExitBadArguments, "--block " + std::to_string(opt.block) + " must divide --ndf-res " +
                                                 std::to_string(pyr.splat.ndf_res));
       }
       bake::IngestReport ingest_report;
       const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
-      if (map.width < 2 || map.height < 2) {
-        throw Error(cli::kExitInvalidInput, input + ": a normal map needs at least 2x2 texels (got " +
-                                                std::to_string(map.width) + "x" + std::to_string(map.height) + ")");
-      }
+      cli::requireBakeableMap(map, input);
       map_json = {{"width", map.width}, {"height", map.height}, {"wrap", bake::wrapString(map.wrap)}};
-      Json p;
-      p["ndf_res"] = pyr.splat.ndf_res;
-      p["sigma_r"] = pyr.splat.sigma_r;
-      p["stride"] = pyr.stride0;
-      p["sigma0"] = pyr.sigma0;
-      p["levels"] = levels_text == "auto" ? Json("auto") : Json(pyr.levels);
-      p["converge_mse"] = pyr.converge_mse;
-      p["rate"] = pyr.rate;
-      p["region"] = pyr.region_size;
-      p["footprint_truncation"] = pyr.splat.footprint_truncation;
+      Json p = cli::pyramidOptionsJson(pyramid);
       p["ingest"] = cli::ingestOptionsJson(ingest);
       params["pyramid"] = p;
       params["source"] = "normal-map";
       out = std::make_unique<cli::ContainerOutput>(t, output, format::AssetKind::kTensorNdf, zstd_level);
 
-      std::unique_ptr<cli::Progress> bar;
-      int bar_level = -1;
-      uint64_t bar_done = 0;
-      bake::Status s = tensor::packTensorNdfFromMap(map, pyr, opt, out->writer(), &report,
-                                                    [&](int level, uint64_t done, uint64_t total) {
-                                                      if (level != bar_level) {
-                                                        if (bar) bar->finish();
-                                                        bar = t.progress("level " + std::to_string(level), total);
-                                                        bar_level = level;
-                                                        bar_done = 0;
-                                                      }
-                                                      bar->advance(done - bar_done);
-                                                      bar_done = done;
-                                                    });
-      if (bar) bar->finish();
+      cli::LevelProgress progress(t);
+      bake::Status s = tensor::packTensorNdfFromMap(map, pyr, opt, out->writer(), &report, progress.callback());
+      progress.finish();
       if (!s) throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
     }
 

@@ -58,12 +58,7 @@ struct NdfPyramid::Impl {
   Status load(const format::Reader& reader);
   void blend(const Footprint& fp, Blend* b) const;
   // Bin of s, or -1 outside [-1,1]^2.
-  int binOf(double sx, double sy) const {
-    if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
-    const int i = std::min(res - 1, int((sx + 1.0) / bin));
-    const int j = std::min(res - 1, int((1.0 - sy) / bin));
-    return j * res + i;
-  }
+  int binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, bin); }
   double blendValue(const Blend& b, int bin_index) const {
     double v = 0.0;
     for (int k = 0; k < b.count; ++k) v += b.weight[k] * double(b.image[k][bin_index]);
@@ -169,13 +164,6 @@ void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
     b->prefix[k] = lv.prefix.data + cb.centre[k] * size_t(res + 1);
   }
 }
-
-namespace {
-bool validFootprint(const Footprint& fp) {
-  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
-         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
-}
-}  // namespace
 
 NdfPyramid::NdfPyramid() = default;
 NdfPyramid::~NdfPyramid() = default;

@@ -10,11 +10,6 @@
 namespace glintbake::runtime {
 namespace {
 
-bool validFootprint(const Footprint& fp) {
-  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
-         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
-}
-
 constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 
 // s-plane density of a bin from the block's share of the blend's mass and the within-block pdf
@@ -48,12 +43,7 @@ struct Span {
 
 }  // namespace
 
-int TensorNdf::Impl::binOf(double sx, double sy) const {
-  if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
-  const int i = std::min(res - 1, int((sx + 1.0) / bin));
-  const int j = std::min(res - 1, int((1.0 - sy) / bin));
-  return j * res + i;
-}
+int TensorNdf::Impl::binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, bin); }
 
 void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
   CentreBlend cb;

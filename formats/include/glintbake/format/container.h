@@ -56,6 +56,10 @@ enum class AssetKind : uint32_t {
   kGlitter = 7,      // procedural discrete microfacets
   kTest = 0x7fff,    // containers made by tests and fuzzers
 };
+// True when data (size bytes, >= 8 needed) starts with the container's 8-byte magic: a cheap test
+// of whether a file is a glintbake container before choosing how to read it.
+bool hasContainerMagic(const void* data, size_t size);
+
 const char* assetKindString(AssetKind kind);  // "ndf-pyramid", "tensor-ndf", ...; "unknown" otherwise
 bool assetKindFromString(const std::string& name, AssetKind* kind);
 

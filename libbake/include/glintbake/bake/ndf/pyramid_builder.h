@@ -19,9 +19,9 @@
 // Measured: 4096^2 map, 1.15 GB peak RSS in ndfgen (ingest + flakes dominate).
 //
 // Automatic level count (levels = 0): before level l >= 1 is computed, its images at up to 4 x 4
-// evenly spread centres (at most a quarter of the level's centres, at least one) are computed and compared with what the runtime predicts there from level
-// l - 1 (the bilinear blend of the level-(l-1) images around that position, collected while level
-// l - 1 was written): relative MSE = sum |D_l - P_l|^2 / sum |P_l|^2, averaged over the samples.
+// evenly spread centres (at most a quarter of the level's centres, at least one) are computed and compared with what
+// the runtime predicts there from level l - 1 (the bilinear blend of the level-(l-1) images around that position,
+// collected while level l - 1 was written): relative MSE = sum |D_l - P_l|^2 / sum |P_l|^2, averaged over the samples.
 // If it is below converge_mse, level l would add little (queries above the top level clamp to it,
 // and its blend already predicts level l within the tolerance), so the pyramid stops without
 // computing it (stop reason "converged"; the probe's MSE is reported). Otherwise the probed images

@@ -1,0 +1,49 @@
+// The NDF pyramid options every tool that bakes a pyramid from a normal map takes, with the same
+// names and defaults (ndfgen, tensorpack): --ndf-res, --sigma-r, --stride, --sigma0, --levels,
+// --converge-mse, --rate, --region; plus the per-level progress bar of a pyramid build.
+#pragma once
+
+#include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/cli/tool.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace glintbake::cli {
+
+struct PyramidCliOptions {
+  bake::ndf::PyramidOptions options;
+  std::string levels_text = "auto";  // "auto" or a positive integer; resolvePyramidOptions fills options.levels
+  std::vector<CLI::Option*> flags;   // the registered options (to reject them where they do not apply)
+};
+
+// Registers the options; region_help describes --region for this tool.
+void addPyramidOptions(CLI::App& app, PyramidCliOptions& pyramid, const std::string& region_help);
+
+// Parses --levels and validates every option (Error with exit 1 naming the option).
+void resolvePyramidOptions(PyramidCliOptions& pyramid);
+
+// Canonical JSON form of the options (for provenance metadata and --json reports).
+Json pyramidOptionsJson(const PyramidCliOptions& pyramid);
+
+// Rejects maps too small to bake (exit 3, naming the file and its size).
+void requireBakeableMap(const bake::NormalMap& map, const std::string& path);
+
+// A progress bar per pyramid level, fed by the builder's progress callback.
+class LevelProgress {
+ public:
+  explicit LevelProgress(Tool& tool) : tool_(tool) {}
+  ~LevelProgress() { finish(); }
+  bake::ndf::PyramidProgress callback();
+  void finish();
+
+ private:
+  Tool& tool_;
+  std::unique_ptr<Progress> bar_;
+  int level_ = -1;
+  uint64_t done_ = 0;
+};
+
+}  // namespace glintbake::cli

@@ -1,0 +1,84 @@
+#include <glintbake/cli/pyramid_options.h>
+
+#include <stdexcept>
+
+namespace glintbake::cli {
+
+void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& region_help) {
+  bake::ndf::PyramidOptions& o = p.options;
+  p.flags = {
+      app.add_option("--ndf-res", o.splat.ndf_res, "NDF image resolution R (bins per side, 2..4096)")
+          ->capture_default_str(),
+      app.add_option("--sigma-r", o.splat.sigma_r, "Intrinsic roughness: s-plane std of every flake (0, 1]")
+          ->capture_default_str(),
+      app.add_option("--stride", o.stride0, "Level-0 spacing of footprint centres, texels (> 0)")
+          ->capture_default_str(),
+      app.add_option("--sigma0", o.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str(),
+      app.add_option("--levels", p.levels_text, "Number of levels, or auto (stop on convergence or a 1x1 grid)")
+          ->capture_default_str(),
+      app.add_option("--converge-mse", o.converge_mse,
+                     "auto levels: stop when the relative MSE between neighbouring levels is below this")
+          ->capture_default_str(),
+      app.add_option("--rate", o.rate, "Flakes per texel side (1..16)")->capture_default_str(),
+      app.add_option("--region", o.region_size, region_help)->capture_default_str(),
+  };
+}
+
+void resolvePyramidOptions(PyramidCliOptions& p) {
+  if (p.levels_text == "auto") {
+    p.options.levels = 0;
+  } else {
+    try {
+      size_t used = 0;
+      p.options.levels = std::stoi(p.levels_text, &used);
+      if (used != p.levels_text.size() || p.options.levels < 1) throw std::invalid_argument("levels");
+    } catch (const std::exception&) {
+      throw Error(kExitBadArguments, "--levels must be auto or a positive integer");
+    }
+  }
+  if (bake::Status s = bake::ndf::validatePyramidOptions(p.options); !s) {
+    throw Error(int(s.error().code), s.error().message);
+  }
+}
+
+Json pyramidOptionsJson(const PyramidCliOptions& p) {
+  const bake::ndf::PyramidOptions& o = p.options;
+  Json j;
+  j["ndf_res"] = o.splat.ndf_res;
+  j["sigma_r"] = o.splat.sigma_r;
+  j["stride"] = o.stride0;
+  j["sigma0"] = o.sigma0;
+  j["levels"] = p.levels_text == "auto" ? Json("auto") : Json(o.levels);
+  j["converge_mse"] = o.converge_mse;
+  j["rate"] = o.rate;
+  j["region"] = o.region_size;
+  j["footprint_truncation"] = o.splat.footprint_truncation;
+  return j;
+}
+
+void requireBakeableMap(const bake::NormalMap& map, const std::string& path) {
+  if (map.width < 2 || map.height < 2) {
+    throw Error(kExitInvalidInput, path + ": a normal map needs at least 2x2 texels (got " + std::to_string(map.width) +
+                                       "x" + std::to_string(map.height) + ")");
+  }
+}
+
+bake::ndf::PyramidProgress LevelProgress::callback() {
+  return [this](int level, uint64_t done, uint64_t total) {
+    if (level != level_) {
+      finish();
+      bar_ = tool_.progress("level " + std::to_string(level), total);
+      level_ = level;
+      done_ = 0;
+    }
+    bar_->advance(done - done_);
+    done_ = done;
+  };
+}
+
+void LevelProgress::finish() {
+  if (bar_) bar_->finish();
+  bar_.reset();
+}
+
+}  // namespace glintbake::cli
