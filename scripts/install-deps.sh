@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config make python3 python3-jsonschema
-  libopenimageio-dev libopenexr-dev libimath-dev libeigen3-dev libceres-dev libtbb-dev
+  libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev libeigen3-dev libceres-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
