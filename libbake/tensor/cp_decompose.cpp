@@ -45,8 +45,11 @@ Status validateCpOptions(const CpOptions& o) {
   if (!(o.tol >= 0.0) || !std::isfinite(o.tol)) return bad("tol must be a finite number >= 0");
   if (!(o.ridge >= 0.0 && o.ridge < 1.0)) return bad("ridge must be in [0, 1)");
   if (o.compressed_basis < 0 || o.compressed_basis > 4096) return bad("compressed basis must be in [0, 4096]");
-  if (o.refine_sweeps < 0) return bad("refine sweeps must be >= 0");
+  if (o.refine_sweeps < -1) return bad("refine sweeps must be >= 0 (or -1 for the default)");
+  if (!(o.core_tol >= 0.0 || o.core_tol == -1.0) || !std::isfinite(o.core_tol))
+    return bad("core tol must be a finite number >= 0 (or -1 for the default)");
   if (o.core_starts < 1 || o.core_starts > 64) return bad("core starts must be in [1, 64]");
+  if (o.range_power_iters < 0 || o.range_power_iters > 8) return bad("range power iterations must be in [0, 8]");
   return okStatus();
 }
 
@@ -182,15 +185,19 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
   int sweeps = 0, core_sweeps = 0;
   double err_sq = std::numeric_limits<double>::infinity();
   const int basis =
-      options.compressed_basis > 0 ? options.compressed_basis : std::max(options.nonneg ? 32 : 64, 2 * rank);
+      options.compressed_basis > 0 ? options.compressed_basis
+                                   : (options.nonneg ? std::max(24, 3 * rank / 2) : std::max(64, 2 * rank));
+  const int refine_sweeps = options.refine_sweeps >= 0 ? options.refine_sweeps : (options.nonneg ? 2 : 10);
+  const bool sparse_sketch = options.sketch == RangeSketch::kSparse || (options.sketch == RangeSketch::kAuto && options.nonneg);
   if (options.method == CpMethod::kAlsPlain) {
     randomStart(bins, blocks, rank, options.seed, s);
     err_sq = runSweeps(engine, s, err_sq, settings, &sweeps);
-  } else if (options.nonneg && options.method == CpMethod::kCompressed && blocks > basis) {
+  } else if (options.nonneg && options.method == CpMethod::kCompressed && blocks > 4 * basis) {
     // Non-negative model on compressed data: HALS sweeps against X~ = core x_3 Q (contractions
     // through the L-column core and Q; the constraint stays on the full C), then up to
-    // refine_sweeps full HALS sweeps against X.
-    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed);
+    // refine_sweeps full HALS sweeps against X. Below K = 4 L a core sweep costs over a quarter of
+    // a full one and the full-tensor HALS below is used instead.
+    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed, options.range_power_iters, sparse_sketch);
     Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
     MatF core_t(xt.rows(), basis);
     core_t.noalias() = xt * q;
@@ -198,10 +205,12 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
     hosvdStart(core_t.data(), bins, basis, rank, options.seed, true, s);
     s.c = MatF::Constant(blocks, rank, 1.0f);
     double core_err = compressed.solveC(s, options.ridge, true);
-    runSweeps(compressed, s, core_err, settings, &core_sweeps);
+    SweepSettings core_settings = settings;
+    core_settings.tol = options.core_tol >= 0.0 ? options.core_tol : 1e-4;
+    runSweeps(compressed, s, core_err, core_settings, &core_sweeps);
     SweepSettings refine = settings;
-    refine.max_sweeps = options.refine_sweeps;
-    err_sq = options.refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
+    refine.max_sweeps = refine_sweeps;
+    err_sq = refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
     err_sq = runSweeps(engine, s, err_sq, refine, &sweeps);
   } else if (options.nonneg || options.method == CpMethod::kAls || blocks <= basis) {
     hosvdStart(x, bins, blocks, rank, options.seed, options.nonneg, s);
@@ -211,11 +220,13 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
   } else {
     // Mode-3 compression: T ~ core x_3 Q with Q (K x L) orthonormal; ALS on the B x B x L core,
     // then C = Q C_core and a few full sweeps.
-    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed);
+    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed, options.range_power_iters, sparse_sketch);
     Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
     MatF core_t(xt.rows(), basis);
     core_t.noalias() = xt * q;  // column l = core block l
     CpEngine core(core_t.data(), bins, basis, rank);
+    SweepSettings core_settings = settings;
+    if (options.core_tol >= 0.0) core_settings.tol = options.core_tol;
     // Local minima are real (random starts change the error by a few percent) and core sweeps
     // are cheap: start from the HOSVD and from `core_starts - 1` seeded random points, keep the
     // best core fit.
@@ -229,7 +240,7 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
       } else {
         randomStart(bins, basis, rank, options.seed + 0x9E3779B97F4A7C15ull * static_cast<uint64_t>(start), candidate);
       }
-      err = runSweeps(core, candidate, err, settings, &core_sweeps);
+      err = runSweeps(core, candidate, err, core_settings, &core_sweeps);
       if (err < best_err) {
         best_err = err;
         s = std::move(candidate);
@@ -237,8 +248,8 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
     }
     s.c = q * s.c;
     SweepSettings refine = settings;
-    refine.max_sweeps = options.refine_sweeps;
-    err_sq = options.refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
+    refine.max_sweeps = refine_sweeps;
+    err_sq = refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
     err_sq = runSweeps(engine, s, err_sq, refine, &sweeps);
   }
 

@@ -6,7 +6,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace glintbake::bake::tensor {
 
@@ -68,26 +70,48 @@ void randomStart(int bins, int blocks, int rank, uint64_t seed, CpState& state) 
   fill(state.c, blocks, rank);
 }
 
-MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed) {
+MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed, int power_iters,
+                         bool sparse) {
   const Eigen::Index n = static_cast<Eigen::Index>(bins) * bins;
   Eigen::Map<const MatF> xt(x, n, blocks);  // X^T, (B*B) x K
   SplitMix64 rng(seed ^ 0x2545F4914F6CDD1Dull);
-  MatF omega(n, basis);
-  for (int c = 0; c < basis; ++c) {
-    for (Eigen::Index r = 0; r < n; ++r) omega(r, c) = static_cast<float>(rng.normal());
-  }
   auto orthonormalise = [blocks, basis](const MatF& y) {
     Eigen::HouseholderQR<MatF> qr(y);
     MatF q = qr.householderQ() * MatF::Identity(blocks, basis);
     return q;
   };
   MatF y(blocks, basis);
-  y.noalias() = xt.transpose() * omega;
+  if (sparse) {
+    // Sparse sign sketch (Clarkson & Woodruff 2013): bin b adds +-X(b, :) to one column h(b) of Y.
+    std::vector<int> column(static_cast<size_t>(n));
+    std::vector<float> sign(static_cast<size_t>(n));
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const uint64_t r = rng.next();
+      column[static_cast<size_t>(b)] = static_cast<int>((r >> 1) % static_cast<uint64_t>(basis));
+      sign[static_cast<size_t>(b)] = (r & 1u) ? 1.0f : -1.0f;
+    }
+    std::vector<float> row(static_cast<size_t>(basis));
+    for (int k = 0; k < blocks; ++k) {
+      std::fill(row.begin(), row.end(), 0.0f);
+      const float* xk = x + static_cast<size_t>(k) * static_cast<size_t>(n);
+      for (size_t b = 0; b < static_cast<size_t>(n); ++b) row[static_cast<size_t>(column[b])] += sign[b] * xk[b];
+      for (int c = 0; c < basis; ++c) y(k, c) = row[static_cast<size_t>(c)];
+    }
+  } else {
+    MatF omega(n, basis);
+    for (int c = 0; c < basis; ++c) {
+      for (Eigen::Index r = 0; r < n; ++r) omega(r, c) = static_cast<float>(rng.normal());
+    }
+    y.noalias() = xt.transpose() * omega;
+  }
   MatF q = orthonormalise(y);
   MatF z(n, basis);
-  z.noalias() = xt * q;
-  y.noalias() = xt.transpose() * z;
-  return orthonormalise(y);
+  for (int it = 0; it < power_iters; ++it) {
+    z.noalias() = xt * q;
+    y.noalias() = xt.transpose() * z;
+    q = orthonormalise(y);
+  }
+  return q;
 }
 
 }  // namespace glintbake::bake::tensor

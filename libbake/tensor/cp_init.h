@@ -14,8 +14,10 @@ void hosvdStart(const float* x, int bins, int blocks, int rank, uint64_t seed, b
 // Seeded uniform [0, 1) entries in A, B and C (the published random start).
 void randomStart(int bins, int blocks, int rank, uint64_t seed, CpState& state);
 
-// Orthonormal K x L basis of the mode-3 fibres' range: a seeded Gaussian sketch with one power
-// iteration and QR re-orthonormalisation (Halko, Martinsson & Tropp 2011, alg. 4.4).
-MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed);
+// Orthonormal K x L basis of the mode-3 fibres' range: a seeded sketch Y = X Omega (Gaussian
+// Omega, or with `sparse` a sign sketch with one non-zero per bin, Clarkson & Woodruff 2013)
+// followed by `power_iters` power iterations, each re-orthonormalised by QR (Halko, Martinsson &
+// Tropp 2011, alg. 4.4).
+MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed, int power_iters, bool sparse);
 
 }  // namespace glintbake::bake::tensor

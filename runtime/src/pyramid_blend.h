@@ -22,13 +22,17 @@ inline bool validFootprint(const Footprint& fp) {
          std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
 }
 
-// Index j * res + i of the bin of an R x R NDF image (bin side 2 / res) holding s, or -1 outside
-// [-1, 1]^2 (row 0 at s_y = +1).
+// Column i and row j of the bin of an R x R NDF image (bin side 2 / res) holding s (row 0 at
+// s_y = +1), false outside [-1, 1]^2; ndfBinOf gives the index j * res + i, or -1 outside.
+inline bool ndfBinCoords(double sx, double sy, int res, double bin, int* i, int* j) {
+  if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return false;
+  *i = std::min(res - 1, int((sx + 1.0) / bin));
+  *j = std::min(res - 1, int((1.0 - sy) / bin));
+  return true;
+}
 inline int ndfBinOf(double sx, double sy, int res, double bin) {
-  if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return -1;
-  const int i = std::min(res - 1, int((sx + 1.0) / bin));
-  const int j = std::min(res - 1, int((1.0 - sy) / bin));
-  return j * res + i;
+  int i, j;
+  return ndfBinCoords(sx, sy, res, bin, &i, &j) ? j * res + i : -1;
 }
 
 // Up to 8 (level, centre, weight) terms; centre = j * grid_width + i on its level. Weights sum to 1.

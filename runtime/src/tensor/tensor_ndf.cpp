@@ -32,12 +32,19 @@ struct Span {
     f1 = x1 - k1;
     single = k0 == k1;
   }
-  double extent(const float* factor, const float* prefix, int32_t rank, int32_t r) const {
-    const float* a0 = factor + size_t(k0) * rank;
-    if (single) return (f1 - f0) * double(a0[r]);
-    const float* a1 = factor + size_t(k1) * rank;
-    return (double(prefix[size_t(k1) * rank + r]) - double(prefix[size_t(k0) * rank + r])) + f1 * double(a1[r]) -
-           f0 * double(a0[r]);
+  // The integrals of all `rank` columns, into out[0, rank).
+  void extents(const float* factor, const float* prefix, int32_t rank, double* out) const {
+    const float* a0 = factor + size_t(k0) * size_t(rank);
+    if (single) {
+      const double w = f1 - f0;
+      for (int32_t r = 0; r < rank; ++r) out[r] = w * double(a0[r]);
+      return;
+    }
+    const float* a1 = factor + size_t(k1) * size_t(rank);
+    const float* p0 = prefix + size_t(k0) * size_t(rank);
+    const float* p1 = prefix + size_t(k1) * size_t(rank);
+    for (int32_t r = 0; r < rank; ++r)
+      out[r] = (double(p1[r]) - double(p0[r])) + f1 * double(a1[r]) - f0 * double(a0[r]);
   }
 };
 
@@ -72,29 +79,28 @@ void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const
 
 double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, double x0, double x1, double y0,
                                            double y1) const {
-  // Terms of one group share A and B: their weighted C rows are summed first (as CpMix does).
-  const CpGroupView* views[kCpMaxBlend];
-  double coef[kCpMaxBlend][kCpMaxRank];
-  int n = 0;
+  // Rank-1 terms are separable: per group, the R products of the column integrals over x and y,
+  // then one dot product with each term's C row. Terms of one group are usually adjacent in the
+  // blend, so the products are formed once per run of equal groups.
+  const Span sx(x0, x1, bins), sy(y0, y1, bins);
+  const CpGroupView* current = nullptr;
+  double ex[kCpMaxRank], ey[kCpMaxRank];
+  double sum = 0.0;
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup || b.weight[t] == 0.0) continue;
     const CpGroupView* v = &groups.data[e.group].view;
-    int g = 0;
-    while (g < n && views[g] != v) ++g;
-    if (g == n) {
-      views[n++] = v;
-      for (int32_t r = 0; r < v->rank; ++r) coef[g][r] = 0.0;
+    const int32_t rank = v->rank;
+    if (v != current) {
+      sx.extents(v->a, v->a_prefix, rank, ex);
+      sy.extents(v->b, v->b_prefix, rank, ey);
+      for (int32_t r = 0; r < rank; ++r) ex[r] *= ey[r];
+      current = v;
     }
-    const float* c = v->c + size_t(e.row) * size_t(v->rank);
-    for (int32_t r = 0; r < v->rank; ++r) coef[g][r] += b.weight[t] * double(c[r]);
-  }
-  const Span sx(x0, x1, bins), sy(y0, y1, bins);
-  double sum = 0.0;
-  for (int g = 0; g < n; ++g) {
-    const CpGroupView& v = *views[g];
-    for (int32_t r = 0; r < v.rank; ++r)
-      sum += sx.extent(v.a, v.a_prefix, v.rank, r) * sy.extent(v.b, v.b_prefix, v.rank, r) * coef[g][r];
+    const float* c = v->c + size_t(e.row) * size_t(rank);
+    double dot = 0.0;
+    for (int32_t r = 0; r < rank; ++r) dot += ex[r] * double(c[r]);
+    sum += b.weight[t] * dot;
   }
   return sum;
 }
@@ -132,17 +138,33 @@ Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* valu
   if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
     return Status::kInvalidArgument;
   const Impl& m = *impl_;
-  const int bin = m.binOf(s.x, s.y);
-  if (bin < 0) {
+  int i, j;
+  if (!ndfBinCoords(s.x, s.y, m.res, m.bin, &i, &j)) {
     *value = 0.0;
     return Status::kOk;
   }
   Impl::Blend b;
   m.blend(footprint, &b);
-  const int i = bin % m.res, j = bin / m.res;
-  CpMix mix;
-  m.mixBlock(b, uint64_t(j / m.bins) * uint64_t(m.nb) + uint64_t(i / m.bins), &mix);
-  *value = double(mix.value(i % m.bins, j % m.bins));
+  int bx, by, bi, bj;
+  m.splitBin(i, &bx, &bi);
+  m.splitBin(j, &by, &bj);
+  const uint64_t block = uint64_t(by) * uint64_t(m.nb) + uint64_t(bx);
+  // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
+  // first summing the terms' C rows: a point needs only R products per term).
+  float sum = 0.0f;
+  for (int t = 0; t < b.count; ++t) {
+    const TensorIndexEntry& e = b.index[t][block];
+    if (e.group == kTensorBlankGroup) continue;
+    const CpGroupView& v = m.groups.data[e.group].view;
+    const int32_t rank = v.rank;
+    const float* a = v.a + size_t(bi) * size_t(rank);
+    const float* bb = v.b + size_t(bj) * size_t(rank);
+    const float* c = v.c + size_t(e.row) * size_t(rank);
+    float dot = 0.0f;
+    for (int32_t r = 0; r < rank; ++r) dot += a[r] * bb[r] * c[r];
+    sum += float(b.weight[t]) * dot;
+  }
+  *value = sum > 0.0f ? double(sum) : 0.0;
   return Status::kOk;
 }
 
@@ -161,16 +183,21 @@ Status TensorNdf::average(const Footprint& footprint, const SRect& rect, double*
     // Blocks touched (bins as NdfPyramid::average finds them); within each block the integral of
     // the piecewise-constant model over the clipped rectangle is a rank-R product of continuous
     // cumulative sums, partial bins weighted by their overlap.
-    const int i0 = std::min(m.res - 1, int((x0 + 1.0) / m.bin)), i1 = std::min(m.res - 1, int((x1 + 1.0) / m.bin));
-    const int j0 = std::min(m.res - 1, int((1.0 - y1) / m.bin)), j1 = std::min(m.res - 1, int((1.0 - y0) / m.bin));
-    const double fx0 = (x0 + 1.0) / m.bin, fx1 = (x1 + 1.0) / m.bin;  // bin coordinates from the left
-    const double fy0 = (1.0 - y1) / m.bin, fy1 = (1.0 - y0) / m.bin;  // bin coordinates from the top
+    const double fx0 = (x0 + 1.0) * m.inv_bin, fx1 = (x1 + 1.0) * m.inv_bin;  // bin coordinates from the left
+    const double fy0 = (1.0 - y1) * m.inv_bin, fy1 = (1.0 - y0) * m.inv_bin;  // bin coordinates from the top
+    const int i0 = std::min(m.res - 1, int(fx0)), i1 = std::min(m.res - 1, int(fx1));
+    const int j0 = std::min(m.res - 1, int(fy0)), j1 = std::min(m.res - 1, int(fy1));
+    int bx0, bx1, by0, by1, unused;
+    m.splitBin(i0, &bx0, &unused);
+    m.splitBin(i1, &bx1, &unused);
+    m.splitBin(j0, &by0, &unused);
+    m.splitBin(j1, &by1, &unused);
     const double full = double(m.bins);
-    for (int by = j0 / m.bins; by <= j1 / m.bins; ++by) {
+    for (int by = by0; by <= by1; ++by) {
       const double row0 = double(by * m.bins);
       const double ly0 = std::clamp(fy0 - row0, 0.0, full), ly1 = std::clamp(fy1 - row0, 0.0, full);
       if (!(ly1 > ly0)) continue;
-      for (int bx = i0 / m.bins; bx <= i1 / m.bins; ++bx) {
+      for (int bx = bx0; bx <= bx1; ++bx) {
         const double col0 = double(bx * m.bins);
         const double lx0 = std::clamp(fx0 - col0, 0.0, full), lx1 = std::clamp(fx1 - col0, 0.0, full);
         if (!(lx1 > lx0)) continue;

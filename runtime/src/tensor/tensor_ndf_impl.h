@@ -49,9 +49,11 @@ struct TensorNdf::Impl {
 
   TensorInfoRecord info;
   int res = 0, bins = 0, nb = 0;
+  int bins_shift = -1;  // log2(bins) when bins is a power of two (no integer division per query)
   uint64_t nb2 = 0;
   bool nonneg = false;
   double bin = 0.0, bin_area = 0.0;  // 2 / R, (2 / R)^2
+  double inv_bin = 0.0;              // R / 2
   int level_count = 0;
   TLevel levels[kMaxNdfLevels];
   uint32_t group_count = 0;
@@ -74,6 +76,16 @@ struct TensorNdf::Impl {
   double totalMass(const Blend& b) const;
   // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf().
   double binPdf(const Blend& b, int i, int j) const;
+  // Image bin column (or row) n -> block column `block` and bin within it `local`.
+  void splitBin(int n, int* block, int* local) const {
+    if (bins_shift >= 0) {
+      *block = n >> bins_shift;
+      *local = n & (bins - 1);
+    } else {
+      *block = n / bins;
+      *local = n - *block * bins;
+    }
+  }
   // Bin of s, or -1 outside [-1, 1]^2 (as NdfPyramid).
   int binOf(double sx, double sy) const;
 };

@@ -199,10 +199,15 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
   if (Status s = checkInfo(info); s != Status::kOk) return s;
   res = int(info.ndf_res);
   bins = int(info.block);
+  bins_shift = -1;
+  for (int k = 0; k < 31; ++k) {
+    if (bins == (1 << k)) bins_shift = k;
+  }
   nb = int(info.blocks_per_side);
   nb2 = uint64_t(nb) * uint64_t(nb);
   nonneg = (info.flags & kTensorFlagNonNegative) != 0;
   bin = 2.0 / res;
+  inv_bin = res / 2.0;
   bin_area = bin * bin;
 
   for (int l = 0; l < int(info.level_count); ++l) {

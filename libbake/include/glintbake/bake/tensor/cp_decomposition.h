@@ -35,13 +35,18 @@
 // projected onto A, B, C >= 0, from a non-negative start (|HOSVD| for kCompressed and kAls,
 // uniform random for kAlsPlain). kCompressed runs its HALS sweeps against the mode-3 compressed
 // tensor X~ = core x_3 Q (contractions through the B x B x L core and Q, the constraint on the
-// full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Its basis defaults to
-// L = max(32, 2 R): the core sweeps cost O(K L R), and L = 32 was both faster and as accurate as
-// 64. Measured on real 32 x 32 x K groups at rank 16 (bench_tensorpack, CPU-time medians) against
-// the published non-negative baseline (random start, plain HALS, its stopping rule): beckmann
-// K = 2620 170 vs 759 ms (error 0.4004 vs 0.4001), scratches K = 3766 131 vs 666 ms (0.0505 vs
-// 0.0531), flakes K = 1024 43 vs 112 ms (0.8711 vs 0.8671), i.e. 0.20-0.39 of the time with the
-// error within +0.5%. Every reconstructed value and every range sum is >= 0.
+// full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Its defaults differ
+// from the signed path's, each chosen by measurement (bench_zexplore-style survey of 12 real groups:
+// 4 mapgen kinds x 3 seeds, 32 x 32 x K, K = 1024-3836, rank 16, against 500 plain HALS sweeps):
+//   - sparse sign sketch + one power iteration: as accurate as the Gaussian sketch + one power
+//     iteration and one GEMM cheaper; without the power iteration either sketch lands up to +5.5%;
+//   - L = max(24, 3 R / 2): the core sweeps cost O(K L R); L = 32 gained nothing over 24;
+//   - core sweeps stop at a fit change of 1e-4 (3e-4 cost up to +3.3% on two groups);
+//   - 2 refinement sweeps (3 gained at most 0.1%; the tol is never reached before).
+// With these the error stays within -2.6..+0.5% of 500 plain sweeps on all 12 groups, in a median
+// 0.11 (0.055-0.17; 0.38 on one group whose plain run stopped after 18 sweeps) of the time of the
+// published non-negative baseline (random start, plain HALS, its stopping rule) and at most 0.13 of
+// the signed als-plain's. Every reconstructed value and every range sum is >= 0.
 //
 // Determinism: results depend only on the tensor and the options (seeded generators, fixed
 // summation order, no threading inside one decomposition): identical bytes on every run and for
@@ -75,6 +80,11 @@ struct GroupTensor {
 
 enum class CpMethod { kCompressed, kAls, kAlsPlain };
 
+// The first sketch of kCompressed's range finder: Gaussian (a dense B^2 x L GEMM) or a sparse sign
+// sketch (each bin added to one of L columns with a random sign; Clarkson & Woodruff 2013), whose
+// cost is one read of the tensor. kAuto: sparse when nonneg, Gaussian otherwise.
+enum class RangeSketch { kAuto, kGaussian, kSparse };
+
 // "compressed", "als", "als-plain".
 const char* cpMethodName(CpMethod method);
 std::optional<CpMethod> parseCpMethod(std::string_view name);
@@ -86,10 +96,15 @@ struct CpOptions {
   int max_iters = 500;                    // sweeps of the main ALS loop, >= 1
   double tol = 1e-5;                      // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
   double ridge = 1e-7;                    // relative Tikhonov term of the normal equations, [0, 1)
-  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R), or max(32, 2 R)
-                                          // when nonneg (kCompressed runs
-                                          // kAls instead when K <= L)
-  int refine_sweeps = 10;                 // full sweeps after expanding the compressed solution, >= 0
+  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R), or max(24, 3 R / 2)
+                                          // when nonneg (kCompressed runs kAls instead when K <= L,
+                                          // or K <= 4 L when nonneg: core sweeps would then cost
+                                          // over a quarter of a full sweep)
+  int refine_sweeps = -1;                 // full sweeps after expanding the compressed solution, >= 0;
+                                          // -1 = 10, or 2 when nonneg
+  int range_power_iters = 1;              // kCompressed: power iterations of the range finder, [0, 8]
+  RangeSketch sketch = RangeSketch::kAuto;  // kCompressed: the range finder's first sketch
+  double core_tol = -1.0;                 // kCompressed: tol of the core sweeps, >= 0; -1 = tol, or 1e-4 when nonneg
   int core_starts = 3;                    // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
   bool extrapolate = true;                // momentum with restart (kCompressed and kAls)
   uint64_t seed = 0x243F6A8885A308D3ull;  // seeds the range finder and the random start
