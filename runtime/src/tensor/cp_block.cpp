@@ -2,6 +2,8 @@
 // quadtree sampler (Deng et al. 2022, sec. 4.3).
 #include <glintbake/runtime/cp_block.h>
 
+#include "lane_sum.h"
+
 #include <cmath>
 
 namespace glintbake::runtime {
@@ -49,8 +51,7 @@ float CpMix::rawValue(int32_t i, int32_t j) const {
     const int32_t rank = v.rank;
     const float* a = v.a + static_cast<size_t>(i) * rank;
     const float* b = v.b + static_cast<size_t>(j) * rank;
-    const float* coef = coef_[g];
-    for (int32_t r = 0; r < rank; ++r) sum += a[r] * b[r] * coef[r];
+    sum += laneDot3(coef_[g], a, b, rank);
   }
   return sum;
 }
@@ -71,7 +72,12 @@ float CpMix::rawRangeSum(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const {
     const float* pb0 = v.b_prefix + static_cast<size_t>(j0) * rank;
     const float* pb1 = v.b_prefix + static_cast<size_t>(j1) * rank;
     const float* coef = coef_[g];
-    for (int32_t r = 0; r < rank; ++r) sum += (pa1[r] - pa0[r]) * (pb1[r] - pb0[r]) * coef[r];
+    float da[kCpMaxRank], db[kCpMaxRank];
+    for (int32_t r = 0; r < rank; ++r) {
+      da[r] = pa1[r] - pa0[r];
+      db[r] = pb1[r] - pb0[r];
+    }
+    sum += laneDot3(coef, da, db, rank);
   }
   return sum;
 }
@@ -104,14 +110,17 @@ void CpMix::childWeights(int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t
     const float* pbym = v.b_prefix + static_cast<size_t>(ym) * rank;
     const float* pby1 = v.b_prefix + static_cast<size_t>(y1) * rank;
     const float* coef = coef_[g];
+    float left[kCpMaxRank], right[kCpMaxRank], top[kCpMaxRank], bottom[kCpMaxRank];
     for (int32_t r = 0; r < rank; ++r) {
-      const float left = paxm[r] - pax0[r], right = pax1[r] - paxm[r];
-      const float top = (pbym[r] - pby0[r]) * coef[r], bottom = (pby1[r] - pbym[r]) * coef[r];
-      s00 += left * top;
-      s10 += right * top;
-      s01 += left * bottom;
-      s11 += right * bottom;
+      left[r] = paxm[r] - pax0[r];
+      right[r] = pax1[r] - paxm[r];
+      top[r] = (pbym[r] - pby0[r]) * coef[r];
+      bottom[r] = (pby1[r] - pbym[r]) * coef[r];
     }
+    s00 += laneDot(left, top, rank);
+    s10 += laneDot(right, top, rank);
+    s01 += laneDot(left, bottom, rank);
+    s11 += laneDot(right, bottom, rank);
   }
   // Empty children (a side of width 0) have exactly zero sums.
   w[0] = s00 > 0.0f ? s00 : 0.0f;

@@ -3,6 +3,7 @@
 #include "tensor_ndf_impl.h"
 
 #include "../pyramid_blend.h"
+#include "lane_sum.h"
 
 #include <algorithm>
 #include <cmath>
@@ -98,9 +99,7 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
       current = v;
     }
     const float* c = v->c + size_t(e.row) * size_t(rank);
-    double dot = 0.0;
-    for (int32_t r = 0; r < rank; ++r) dot += ex[r] * double(c[r]);
-    sum += b.weight[t] * dot;
+    sum += b.weight[t] * laneDot(ex, c, rank);
   }
   return sum;
 }
@@ -160,9 +159,7 @@ Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* valu
     const float* a = v.a + size_t(bi) * size_t(rank);
     const float* bb = v.b + size_t(bj) * size_t(rank);
     const float* c = v.c + size_t(e.row) * size_t(rank);
-    float dot = 0.0f;
-    for (int32_t r = 0; r < rank; ++r) dot += a[r] * bb[r] * c[r];
-    sum += float(b.weight[t]) * dot;
+    sum += float(b.weight[t]) * laneDot3(a, bb, c, rank);
   }
   *value = sum > 0.0f ? double(sum) : 0.0;
   return Status::kOk;
