@@ -36,8 +36,9 @@
 // uniform random for kAlsPlain). kCompressed runs its HALS sweeps against the mode-3 compressed
 // tensor X~ = core x_3 Q (contractions through the B x B x L core and Q, the constraint on the
 // full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Its defaults differ
-// from the signed path's, each chosen by measurement (bench_zexplore-style survey of 12 real groups:
-// 4 mapgen kinds x 3 seeds, 32 x 32 x K, K = 1024-3836, rank 16, against 500 plain HALS sweeps):
+// from the signed path's, each chosen by measurement (a survey of 12 real groups cut as
+// bench_tensorpack cuts them: 4 mapgen kinds x 3 seeds, 32 x 32 x K, K = 1024-3836, rank 16,
+// against 500 plain HALS sweeps):
 //   - sparse sign sketch + one power iteration: as accurate as the Gaussian sketch + one power
 //     iteration and one GEMM cheaper; without the power iteration either sketch lands up to +5.5%;
 //   - L = max(24, 3 R / 2): the core sweeps cost O(K L R); L = 32 gained nothing over 24;
