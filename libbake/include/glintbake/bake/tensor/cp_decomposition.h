@@ -43,7 +43,7 @@
 //     iteration and one GEMM cheaper; without the power iteration either sketch lands up to +5.5%;
 //   - L = max(24, 3 R / 2): the core sweeps cost O(K L R); L = 32 gained nothing over 24;
 //   - core sweeps stop at a fit change of 1e-4 (3e-4 cost up to +3.3% on two groups);
-//   - 2 refinement sweeps (3 gained at most 0.1%; the tol is never reached before).
+//   - 2 refinement sweeps (a third gained at most 0.12%; the tol is never reached before).
 // With these the error stays within -2.6..+0.5% of 500 plain sweeps on all 12 groups, in a median
 // 0.11 (0.055-0.17; 0.38 on one group whose plain run stopped after 18 sweeps) of the time of the
 // published non-negative baseline (random start, plain HALS, its stopping rule) and at most 0.13 of
