@@ -184,11 +184,27 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
 
   int sweeps = 0, core_sweeps = 0;
   double err_sq = std::numeric_limits<double>::infinity();
-  const int basis =
-      options.compressed_basis > 0 ? options.compressed_basis
-                                   : (options.nonneg ? std::max(24, 3 * rank / 2) : std::max(64, 2 * rank));
-  const int refine_sweeps = options.refine_sweeps >= 0 ? options.refine_sweeps : (options.nonneg ? 2 : 10);
-  const bool sparse_sketch = options.sketch == RangeSketch::kSparse || (options.sketch == RangeSketch::kAuto && options.nonneg);
+  const int basis = options.compressed_basis > 0
+                        ? options.compressed_basis
+                        : (options.nonneg ? std::max(24, 3 * rank / 2) : std::max(64, 2 * rank));
+  const bool sparse_sketch =
+      options.sketch == RangeSketch::kSparse || (options.sketch == RangeSketch::kAuto && options.nonneg);
+  SweepSettings core_settings = settings;  // sweeps on the compressed core
+  core_settings.tol = options.core_tol >= 0.0 ? options.core_tol : (options.nonneg ? 1e-4 : options.tol);
+  SweepSettings refine = settings;  // full sweeps after the core
+  refine.max_sweeps = options.refine_sweeps >= 0 ? options.refine_sweeps : (options.nonneg ? 2 : 10);
+  // Mode-3 compression T ~ core x_3 Q, Q (K x L) orthonormal; core_t column l is core block l.
+  auto compress = [&](MatF* q, MatF* core_t) {
+    *q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed, options.range_power_iters, sparse_sketch);
+    Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
+    core_t->resize(xt.rows(), basis);
+    core_t->noalias() = xt * *q;
+  };
+  // Up to refine.max_sweeps full sweeps from s; the squared error of the result.
+  auto refineFull = [&]() {
+    const double start = refine.max_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
+    return runSweeps(engine, s, start, refine, &sweeps);
+  };
   if (options.method == CpMethod::kAlsPlain) {
     randomStart(bins, blocks, rank, options.seed, s);
     err_sq = runSweeps(engine, s, err_sq, settings, &sweeps);
@@ -197,21 +213,14 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
     // through the L-column core and Q; the constraint stays on the full C), then up to
     // refine_sweeps full HALS sweeps against X. Below K = 4 L a core sweep costs over a quarter of
     // a full one and the full-tensor HALS below is used instead.
-    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed, options.range_power_iters, sparse_sketch);
-    Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
-    MatF core_t(xt.rows(), basis);
-    core_t.noalias() = xt * q;
+    MatF q, core_t;
+    compress(&q, &core_t);
     CpEngine compressed(core_t.data(), bins, basis, rank, &q);
     hosvdStart(core_t.data(), bins, basis, rank, options.seed, true, s);
     s.c = MatF::Constant(blocks, rank, 1.0f);
-    double core_err = compressed.solveC(s, options.ridge, true);
-    SweepSettings core_settings = settings;
-    core_settings.tol = options.core_tol >= 0.0 ? options.core_tol : 1e-4;
+    const double core_err = compressed.solveC(s, options.ridge, true);
     runSweeps(compressed, s, core_err, core_settings, &core_sweeps);
-    SweepSettings refine = settings;
-    refine.max_sweeps = refine_sweeps;
-    err_sq = refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
-    err_sq = runSweeps(engine, s, err_sq, refine, &sweeps);
+    err_sq = refineFull();
   } else if (options.nonneg || options.method == CpMethod::kAls || blocks <= basis) {
     hosvdStart(x, bins, blocks, rank, options.seed, options.nonneg, s);
     if (options.nonneg) s.c = MatF::Constant(blocks, rank, 1.0f);  // HALS refines C from a positive start
@@ -220,13 +229,9 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
   } else {
     // Mode-3 compression: T ~ core x_3 Q with Q (K x L) orthonormal; ALS on the B x B x L core,
     // then C = Q C_core and a few full sweeps.
-    const MatF q = modeThreeRangeBasis(x, bins, blocks, basis, options.seed, options.range_power_iters, sparse_sketch);
-    Eigen::Map<const MatF> xt(x, static_cast<Eigen::Index>(bins) * bins, blocks);
-    MatF core_t(xt.rows(), basis);
-    core_t.noalias() = xt * q;  // column l = core block l
+    MatF q, core_t;
+    compress(&q, &core_t);
     CpEngine core(core_t.data(), bins, basis, rank);
-    SweepSettings core_settings = settings;
-    if (options.core_tol >= 0.0) core_settings.tol = options.core_tol;
     // Local minima are real (random starts change the error by a few percent) and core sweeps
     // are cheap: start from the HOSVD and from `core_starts - 1` seeded random points, keep the
     // best core fit.
@@ -247,10 +252,7 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
       }
     }
     s.c = q * s.c;
-    SweepSettings refine = settings;
-    refine.max_sweeps = refine_sweeps;
-    err_sq = refine_sweeps > 0 ? std::numeric_limits<double>::infinity() : engine.evaluate(s);
-    err_sq = runSweeps(engine, s, err_sq, refine, &sweeps);
+    err_sq = refineFull();
   }
 
   CpFactors f = packFactors(s, bins, blocks, rank);

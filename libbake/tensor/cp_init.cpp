@@ -70,8 +70,7 @@ void randomStart(int bins, int blocks, int rank, uint64_t seed, CpState& state) 
   fill(state.c, blocks, rank);
 }
 
-MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed, int power_iters,
-                         bool sparse) {
+MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64_t seed, int power_iters, bool sparse) {
   const Eigen::Index n = static_cast<Eigen::Index>(bins) * bins;
   Eigen::Map<const MatF> xt(x, n, blocks);  // X^T, (B*B) x K
   SplitMix64 rng(seed ^ 0x2545F4914F6CDD1Dull);

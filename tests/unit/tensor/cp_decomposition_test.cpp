@@ -39,6 +39,16 @@ TEST(CpDecomposition, RecoversExactLowRankTensorWithEveryMethod) {
     EXPECT_LT(cpReconstructionError(t, f), 1e-4) << cpMethodName(method);
     EXPECT_NEAR(f.relative_error, cpReconstructionError(t, f), 1e-5) << cpMethodName(method);
   }
+  // Either range-finder sketch captures the whole mode-3 range of an exact rank-5 tensor.
+  for (RangeSketch sketch : {RangeSketch::kGaussian, RangeSketch::kSparse}) {
+    CpOptions o;
+    o.rank = 5;
+    o.tol = 1e-10;
+    o.compressed_basis = 32;
+    o.sketch = sketch;
+    const CpFactors f = decompose(t, o);
+    EXPECT_LT(cpReconstructionError(t, f), 1e-4) << "sketch " << static_cast<int>(sketch);
+  }
 }
 
 TEST(CpDecomposition, GramErrorEqualsExplicitError) {
@@ -124,6 +134,27 @@ TEST(CpDecomposition, DefaultWithinOnePercentOfFiveHundredPlainSweeps) {
   }
 }
 
+// The non-negative default (the tool's) against 500 plain HALS sweeps of the same model; K = 512
+// takes the compressed path (K > 4 L).
+TEST(CpDecomposition, NonnegativeDefaultWithinOnePercentOfFiveHundredPlainSweeps) {
+  for (uint64_t seed : {33u, 34u}) {
+    const GroupTensor t = makeNdfLikeGroup(32, 512, seed);
+    CpOptions plain;
+    plain.method = CpMethod::kAlsPlain;
+    plain.nonneg = true;
+    plain.tol = 0.0;
+    plain.max_iters = 500;
+    const CpFactors reference = decompose(t, plain);
+    CpOptions fast_options;
+    fast_options.nonneg = true;
+    const CpFactors fast = decompose(t, fast_options);
+    std::printf("seed %d: plain HALS x500 error %.5f, non-negative default %.5f (%d+%d sweeps)\n",
+                static_cast<int>(seed), reference.relative_error, fast.relative_error, fast.core_sweeps, fast.sweeps);
+    EXPECT_GT(fast.core_sweeps, 0) << "the compressed path was not taken";
+    EXPECT_LE(fast.relative_error, 1.01 * reference.relative_error);
+  }
+}
+
 TEST(CpDecomposition, NonnegativeFactorsAndErrorCost) {
   const GroupTensor t = makeNdfLikeGroup(32, 256, 41);
   CpOptions o;
@@ -172,6 +203,17 @@ TEST(CpDecomposition, RejectsBadOptionsAndInputs) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error().code, ErrorCode::kBadArgument);
   }
+  auto rejected = [&t](void (*edit)(CpOptions&)) {
+    CpOptions o;
+    edit(o);
+    Result<CpFactors> r = decomposeCp(t, o);
+    return !r.ok() && r.error().code == ErrorCode::kBadArgument;
+  };
+  EXPECT_TRUE(rejected([](CpOptions& o) { o.refine_sweeps = -2; }));
+  EXPECT_TRUE(rejected([](CpOptions& o) { o.core_tol = -0.5; }));
+  EXPECT_TRUE(rejected([](CpOptions& o) { o.core_tol = std::nan(""); }));
+  EXPECT_TRUE(rejected([](CpOptions& o) { o.range_power_iters = 9; }));
+  EXPECT_TRUE(rejected([](CpOptions& o) { o.range_power_iters = -1; }));
   GroupTensor bad = t;
   bad.values[5] = std::nanf("");
   EXPECT_EQ(decomposeCp(bad, CpOptions{}).error().code, ErrorCode::kInvalidInput);

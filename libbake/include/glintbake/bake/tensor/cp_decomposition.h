@@ -93,22 +93,22 @@ std::optional<CpMethod> parseCpMethod(std::string_view name);
 struct CpOptions {
   int rank = 16;  // R, [1, kMaxCpRank]
   CpMethod method = CpMethod::kCompressed;
-  bool nonneg = false;                    // non-negative factors (HALS)
-  int max_iters = 500;                    // sweeps of the main ALS loop, >= 1
-  double tol = 1e-5;                      // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
-  double ridge = 1e-7;                    // relative Tikhonov term of the normal equations, [0, 1)
-  int compressed_basis = 0;               // L of kCompressed, [0, 4096]; 0 = max(64, 2 R), or max(24, 3 R / 2)
-                                          // when nonneg (kCompressed runs kAls instead when K <= L,
-                                          // or K <= 4 L when nonneg: core sweeps would then cost
-                                          // over a quarter of a full sweep)
-  int refine_sweeps = -1;                 // full sweeps after expanding the compressed solution, >= 0;
-                                          // -1 = 10, or 2 when nonneg
-  int range_power_iters = 1;              // kCompressed: power iterations of the range finder, [0, 8]
+  bool nonneg = false;                      // non-negative factors (HALS)
+  int max_iters = 500;                      // sweeps of the main ALS loop, >= 1
+  double tol = 1e-5;                        // stop when |fit_n - fit_{n-1}| < tol (fit = 1 - rel. error), >= 0
+  double ridge = 1e-7;                      // relative Tikhonov term of the normal equations, [0, 1)
+  int compressed_basis = 0;                 // L of kCompressed, [0, 4096]; 0 = max(64, 2 R), or max(24, 3 R / 2)
+                                            // when nonneg (kCompressed runs kAls instead when K <= L,
+                                            // or K <= 4 L when nonneg: core sweeps would then cost
+                                            // over a quarter of a full sweep)
+  int refine_sweeps = -1;                   // full sweeps after expanding the compressed solution, >= 0;
+                                            // -1 = 10, or 2 when nonneg
+  int range_power_iters = 1;                // kCompressed: power iterations of the range finder, [0, 8]
   RangeSketch sketch = RangeSketch::kAuto;  // kCompressed: the range finder's first sketch
-  double core_tol = -1.0;                 // kCompressed: tol of the core sweeps, >= 0; -1 = tol, or 1e-4 when nonneg
-  int core_starts = 3;                    // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
-  bool extrapolate = true;                // momentum with restart (kCompressed and kAls)
-  uint64_t seed = 0x243F6A8885A308D3ull;  // seeds the range finder and the random start
+  double core_tol = -1.0;                   // kCompressed: tol of the core sweeps, >= 0; -1 = tol, or 1e-4 when nonneg
+  int core_starts = 3;                      // kCompressed: core ALS runs (HOSVD + seeded random), best kept, [1, 64]
+  bool extrapolate = true;                  // momentum with restart (kCompressed and kAls)
+  uint64_t seed = 0x243F6A8885A308D3ull;    // seeds the range finder and the random start
 };
 
 // Validates ranges (kBadArgument naming the option).
