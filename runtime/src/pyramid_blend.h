@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 
 namespace glintbake::runtime {
 
@@ -43,71 +44,127 @@ struct CentreBlend {
   double weight[8];
 };
 
-// Bilinear neighbours of a position along one axis of a level's centre grid (n centres).
-inline void blendAxis(double pos, double map_size, double origin, double stride, int n, bool repeat, int* i0, int* i1,
-                      double* f) {
-  if (repeat) {
-    pos -= std::floor(pos / map_size) * map_size;  // into [0, map size)
-    const double g = (pos - origin) / stride;
-    const double fl = std::floor(g);
-    *f = g - fl;
-    // pos in [0, map size) puts a in [-1, n - 1]: wrap without integer division in the usual cases.
-    const int a = int(fl);
-    *i0 = a >= 0 && a < n ? a : (a == -1 ? n - 1 : ((a % n) + n) % n);
-    *i1 = *i0 + 1 < n ? *i0 + 1 : 0;
-    return;
-  }
-  const double g = (pos - origin) / stride;
-  if (!(g > 0.0)) {
-    *i0 = *i1 = 0;
-    *f = 0.0;
-  } else if (g >= double(n - 1)) {
-    *i0 = *i1 = n - 1;
-    *f = 0.0;
-  } else {
-    const double fl = std::floor(g);
-    *i0 = int(fl);
-    *i1 = *i0 + 1;
-    *f = g - fl;
-  }
-}
+// One axis of a level's centre grid, with the divisions of the blend done once at load.
+struct BlendAxis {
+  double size = 1.0, inv_size = 1.0;      // map texels along the axis and their reciprocal
+  double origin = 0.0, inv_stride = 1.0;  // centre 0 and 1 / texels between centres
+  int n = 1;                              // centres along the axis
+  bool repeat = true;
 
-inline void blendLevel(const NdfLevelRecord& r, int level, double level_weight, const Footprint& fp, CentreBlend* out) {
-  const int gw = int(r.grid_width), gh = int(r.grid_height);
-  const bool repeat = r.wrap == 0;
-  int x0, x1, y0, y1;
-  double fx, fy;
-  blendAxis(fp.x, double(r.map_width), r.origin_x, r.stride_x, gw, repeat, &x0, &x1, &fx);
-  blendAxis(fp.y, double(r.map_height), r.origin_y, r.stride_y, gh, repeat, &y0, &y1, &fy);
-  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-  const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-  for (int k = 0; k < 4; ++k) {
-    if (ws[k] <= 0.0) continue;
-    out->level[out->count] = level;
-    out->centre[out->count] = size_t(ys[k]) * size_t(gw) + size_t(xs[k]);
-    out->weight[out->count] = level_weight * ws[k];
-    ++out->count;
+  void set(double map_size, double origin_texels, double stride, int centres, bool wraps) {
+    size = map_size;
+    inv_size = 1.0 / map_size;
+    origin = origin_texels;
+    inv_stride = 1.0 / stride;
+    n = centres;
+    repeat = wraps;
   }
-}
 
-// levels: any array whose elements have a `rec` member (NdfLevelRecord); level_count >= 1.
-template <typename LevelArray>
-void blendCentres(const LevelArray& levels, int level_count, const Footprint& fp, CentreBlend* out) {
-  out->count = 0;
-  const double s0 = levels[0].rec.sigma_texels;
-  const double top = levels[level_count - 1].rec.sigma_texels;
-  if (!(fp.sigma > s0)) {
-    blendLevel(levels[0].rec, 0, 1.0, fp, out);
-  } else if (fp.sigma >= top) {
-    blendLevel(levels[level_count - 1].rec, level_count - 1, 1.0, fp, out);
-  } else {
-    int l = 0;
-    while (l + 1 < level_count && levels[l + 1].rec.sigma_texels <= fp.sigma) ++l;
-    const double sa = levels[l].rec.sigma_texels, sb = levels[l + 1].rec.sigma_texels;
-    const double t = std::log(fp.sigma / sa) / std::log(sb / sa);  // linear in log2(sigma)
-    blendLevel(levels[l].rec, l, 1.0 - t, fp, out);
-    blendLevel(levels[l + 1].rec, l + 1, t, fp, out);
+  // Bilinear neighbours i0, i1 of a position and the weight f of i1.
+  void neighbours(double pos, int* i0, int* i1, double* f) const {
+    if (repeat) {
+      pos -= floorOf(pos * inv_size) * size;  // into [0, map size) up to rounding
+      const double g = (pos - origin) * inv_stride;
+      const double fl = floorOf(g);
+      *f = g - fl;
+      // pos in [0, map size) puts fl in [-1, n - 1]: wrap without integer division in the usual
+      // cases (rounding at the ends lands in the general branch).
+      const int a = int(fl);
+      *i0 = a >= 0 && a < n ? a : (a == -1 ? n - 1 : ((a % n) + n) % n);
+      *i1 = *i0 + 1 < n ? *i0 + 1 : 0;
+      return;
+    }
+    const double g = (pos - origin) * inv_stride;
+    if (!(g > 0.0)) {
+      *i0 = *i1 = 0;
+      *f = 0.0;
+    } else if (g >= double(n - 1)) {
+      *i0 = *i1 = n - 1;
+      *f = 0.0;
+    } else {
+      *i0 = int(g);  // g in (0, n - 1): truncation is floor
+      *i1 = *i0 + 1;
+      *f = g - double(*i0);
+    }
   }
-}
+
+  // floor() for |x| well inside the int range (footprints are bounded by validFootprint), without
+  // a library call on targets without a rounding instruction; falls back to std::floor outside.
+  static double floorOf(double x) {
+    if (!(std::fabs(x) < 1e9)) return std::floor(x);
+    const double t = double(int64_t(x));
+    return t > x ? t - 1.0 : t;
+  }
+};
+
+// The footprint blend of a pyramid (every per-level constant precomputed): levels and weights
+// for a footprint, as formats/SPEC.md 10.1 defines them.
+class PyramidBlender {
+ public:
+  // levels: any array whose elements have a `rec` member (NdfLevelRecord), validated by the
+  // loader (strides and sigmas finite and positive, sigmas increasing); 1 <= count <= kMaxNdfLevels.
+  template <typename LevelArray>
+  void init(const LevelArray& levels, int count) {
+    count_ = count;
+    for (int l = 0; l < count; ++l) {
+      const NdfLevelRecord& r = levels[l].rec;
+      const bool repeat = r.wrap == 0;
+      Level& g = level_[l];
+      g.x.set(double(r.map_width), r.origin_x, r.stride_x, int(r.grid_width), repeat);
+      g.y.set(double(r.map_height), r.origin_y, r.stride_y, int(r.grid_height), repeat);
+      g.grid_width = size_t(r.grid_width);
+      g.sigma = r.sigma_texels;
+      g.log_sigma = std::log(r.sigma_texels);
+      g.inv_log_step = 0.0;
+      if (l > 0) level_[l - 1].inv_log_step = 1.0 / std::log(r.sigma_texels / levels[l - 1].rec.sigma_texels);
+    }
+  }
+
+  // Level coordinate: sigma <= sigma_0 uses level 0, sigma >= the top level's sigma the top
+  // level, otherwise the two bracketing levels mixed linearly in log(sigma).
+  void blend(const Footprint& fp, CentreBlend* out) const {
+    out->count = 0;
+    if (!(fp.sigma > level_[0].sigma)) {
+      blendLevel(0, 1.0, fp, out);
+    } else if (fp.sigma >= level_[count_ - 1].sigma) {
+      blendLevel(count_ - 1, 1.0, fp, out);
+    } else {
+      int l = 0;
+      while (l + 1 < count_ && level_[l + 1].sigma <= fp.sigma) ++l;
+      const double t = (std::log(fp.sigma) - level_[l].log_sigma) * level_[l].inv_log_step;
+      blendLevel(l, 1.0 - t, fp, out);
+      blendLevel(l + 1, t, fp, out);
+    }
+  }
+
+ private:
+  struct Level {
+    BlendAxis x, y;
+    size_t grid_width = 1;
+    double sigma = 1.0, log_sigma = 0.0;
+    double inv_log_step = 0.0;  // 1 / log(sigma_{l+1} / sigma_l); 0 on the top level
+  };
+
+  // Within a level, the 4 nearest centres bilinearly (zero weights skipped).
+  void blendLevel(int l, double level_weight, const Footprint& fp, CentreBlend* out) const {
+    const Level& g = level_[l];
+    int x0, x1, y0, y1;
+    double fx, fy;
+    g.x.neighbours(fp.x, &x0, &x1, &fx);
+    g.y.neighbours(fp.y, &y0, &y1, &fy);
+    const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+    const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    for (int k = 0; k < 4; ++k) {
+      if (ws[k] <= 0.0) continue;
+      out->level[out->count] = l;
+      out->centre[out->count] = size_t(ys[k]) * g.grid_width + size_t(xs[k]);
+      out->weight[out->count] = level_weight * ws[k];
+      ++out->count;
+    }
+  }
+
+  Level level_[kMaxNdfLevels];
+  int count_ = 0;
+};
 
 }  // namespace glintbake::runtime

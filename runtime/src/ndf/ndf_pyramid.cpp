@@ -1,6 +1,7 @@
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include "../format_status.h"
+#include "../heap_array.h"
 #include "../pyramid_blend.h"
 
 #include <algorithm>
@@ -15,20 +16,6 @@ namespace {
 constexpr uint32_t kMaxResolution = 4096;
 constexpr uint32_t kMaxGridSide = 1u << 20;
 constexpr uint64_t kMaxTotalFloats = uint64_t(1) << 36;  // 256 GiB: beyond any sane asset
-
-// Heap array that reports allocation failure instead of throwing.
-template <typename T>
-struct Array {
-  T* data = nullptr;
-  size_t size = 0;
-  ~Array() { delete[] data; }
-  bool allocate(size_t n) {
-    delete[] data;
-    data = new (std::nothrow) T[n];
-    size = data ? n : 0;
-    return data != nullptr;
-  }
-};
 
 struct Level {
   NdfLevelRecord rec;
@@ -54,6 +41,7 @@ struct NdfPyramid::Impl {
   double bin = 0.0;       // 2 / R
   double bin_area = 0.0;  // (2 / R)^2
   Level levels[kMaxNdfLevels];
+  PyramidBlender blender;
 
   Status load(const format::Reader& reader);
   void blend(const Footprint& fp, Blend* b) const;
@@ -149,12 +137,13 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
   if (level_count == 0) return Status::kInvalidAsset;
   bin = 2.0 / res;
   bin_area = bin * bin;
+  blender.init(levels, level_count);
   return Status::kOk;
 }
 
 void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
   CentreBlend cb;
-  blendCentres(levels, level_count, fp, &cb);
+  blender.blend(fp, &cb);
   const size_t image_floats = size_t(res) * size_t(res);
   b->count = cb.count;
   for (int k = 0; k < cb.count; ++k) {

@@ -6,11 +6,19 @@
 
 #include <cstdint>
 
+#if defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
+#include <emmintrin.h>
+#define GLINTBAKE_RUNTIME_SSE2 1
+#else
+#define GLINTBAKE_RUNTIME_SSE2 0
+#endif
+
 namespace glintbake::runtime {
 
-// sum_{r < n} term(r), in T.
+// lanes[k] += w * sum_{r < n, r % 4 == k} term(r): the per-lane partial sums of one term set,
+// weighted, added to running lanes (several weighted sums then share one final reduction).
 template <typename T, typename Term>
-inline T laneSum(int32_t n, Term term) {
+inline void laneAccumulate(int32_t n, Term term, T w, T lanes[4]) {
   T s0 = T(0), s1 = T(0), s2 = T(0), s3 = T(0);
   int32_t r = 0;
   for (; r + 4 <= n; r += 4) {
@@ -22,7 +30,40 @@ inline T laneSum(int32_t n, Term term) {
   if (r < n) s0 += term(r);
   if (r + 1 < n) s1 += term(r + 1);
   if (r + 2 < n) s2 += term(r + 2);
-  return (s0 + s1) + (s2 + s3);
+  lanes[0] += w * s0;
+  lanes[1] += w * s1;
+  lanes[2] += w * s2;
+  lanes[3] += w * s3;
+}
+
+// lanes[k] += w * sum_{r % 4 == k} a[r] b[r] c[r] in float: laneAccumulate of the triple product,
+// with one SSE2 register as the four lanes when n is a multiple of 4 (every lane sees the same
+// additions in the same order, so both paths give the same bits).
+inline void laneAccumulateDot3(const float* a, const float* b, const float* c, int32_t n, float w, float lanes[4]) {
+#if GLINTBAKE_RUNTIME_SSE2
+  if ((n & 3) == 0) {
+    __m128 s = _mm_setzero_ps();
+    for (int32_t r = 0; r < n; r += 4)
+      s = _mm_add_ps(s, _mm_mul_ps(_mm_mul_ps(_mm_loadu_ps(a + r), _mm_loadu_ps(b + r)), _mm_loadu_ps(c + r)));
+    _mm_storeu_ps(lanes, _mm_add_ps(_mm_loadu_ps(lanes), _mm_mul_ps(_mm_set1_ps(w), s)));
+    return;
+  }
+#endif
+  laneAccumulate<float>(
+      n, [=](int32_t r) { return a[r] * b[r] * c[r]; }, w, lanes);
+}
+
+template <typename T>
+inline T laneTotal(const T lanes[4]) {
+  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+}
+
+// sum_{r < n} term(r), in T.
+template <typename T, typename Term>
+inline T laneSum(int32_t n, Term term) {
+  T lanes[4] = {T(0), T(0), T(0), T(0)};
+  laneAccumulate<T>(n, term, T(1), lanes);  // w = 1 and 0 + x are exact
+  return laneTotal(lanes);
 }
 
 // sum_r a[r] * b[r] * c[r]

@@ -21,31 +21,31 @@ double combinePdf(double block_mass, double total_mass, double bin_pdf, double b
 
 // The integral of a factor column between x0 and x1 (0 <= x0 <= x1 <= B, bin units) is
 //   P[k1] + f1 F[k1] - P[k0] - f0 F[k0]     (k = floor(x), f = x - k; P the prefix sums),
-// or (x1 - x0) F[k0] when both ends lie in one bin (no prefix-sum cancellation there).
+// or (x1 - x0) F[k0] when both ends lie in one bin (no prefix-sum cancellation there). Float, as
+// stored: the rounding of the stored prefix sums bounds the accuracy whatever the arithmetic.
 struct Span {
   int32_t k0, k1;
-  double f0, f1;
+  float f0, f1;
   bool single;
   Span(double x0, double x1, int32_t bins) {
     k0 = std::min(int32_t(x0), bins - 1);
     k1 = std::min(int32_t(x1), bins - 1);
-    f0 = x0 - k0;
-    f1 = x1 - k1;
+    f0 = float(x0 - k0);
+    f1 = float(x1 - k1);
     single = k0 == k1;
   }
   // The integrals of all `rank` columns, into out[0, rank).
-  void extents(const float* factor, const float* prefix, int32_t rank, double* out) const {
+  void extents(const float* factor, const float* prefix, int32_t rank, float* out) const {
     const float* a0 = factor + size_t(k0) * size_t(rank);
     if (single) {
-      const double w = f1 - f0;
-      for (int32_t r = 0; r < rank; ++r) out[r] = w * double(a0[r]);
+      const float w = f1 - f0;
+      for (int32_t r = 0; r < rank; ++r) out[r] = w * a0[r];
       return;
     }
     const float* a1 = factor + size_t(k1) * size_t(rank);
     const float* p0 = prefix + size_t(k0) * size_t(rank);
     const float* p1 = prefix + size_t(k1) * size_t(rank);
-    for (int32_t r = 0; r < rank; ++r)
-      out[r] = (double(p1[r]) - double(p0[r])) + f1 * double(a1[r]) - f0 * double(a0[r]);
+    for (int32_t r = 0; r < rank; ++r) out[r] = ((p1[r] - p0[r]) + f1 * a1[r]) - f0 * a0[r];
   }
 };
 
@@ -55,7 +55,7 @@ int TensorNdf::Impl::binOf(double sx, double sy) const { return ndfBinOf(sx, sy,
 
 void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
   CentreBlend cb;
-  blendCentres(levels, level_count, fp, &cb);
+  blender.blend(fp, &cb);
   b->count = cb.count;
   for (int k = 0; k < cb.count; ++k) {
     const TLevel& lv = levels[cb.level[k]];
@@ -80,13 +80,13 @@ void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const
 
 double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, double x0, double x1, double y0,
                                            double y1) const {
-  // Rank-1 terms are separable: per group, the R products of the column integrals over x and y,
-  // then one dot product with each term's C row. Terms of one group are usually adjacent in the
-  // blend, so the products are formed once per run of equal groups.
+  // Rank-1 terms are separable: per group, the R column integrals over x and over y; per term,
+  // their triple product with its C row. Terms of one group are usually adjacent in the blend, so
+  // the integrals are formed once per run of equal groups.
   const Span sx(x0, x1, bins), sy(y0, y1, bins);
   const CpGroupView* current = nullptr;
-  double ex[kCpMaxRank], ey[kCpMaxRank];
-  double sum = 0.0;
+  float ex[kCpMaxRank], ey[kCpMaxRank];
+  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup || b.weight[t] == 0.0) continue;
@@ -95,13 +95,11 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
     if (v != current) {
       sx.extents(v->a, v->a_prefix, rank, ex);
       sy.extents(v->b, v->b_prefix, rank, ey);
-      for (int32_t r = 0; r < rank; ++r) ex[r] *= ey[r];
       current = v;
     }
-    const float* c = v->c + size_t(e.row) * size_t(rank);
-    sum += b.weight[t] * laneDot(ex, c, rank);
+    laneAccumulateDot3(ex, ey, v->c + size_t(e.row) * size_t(rank), rank, float(b.weight[t]), lanes);
   }
-  return sum;
+  return double(laneTotal(lanes));
 }
 
 double TensorNdf::Impl::blockMass(const Blend& b, uint64_t block) const {
@@ -149,18 +147,18 @@ Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* valu
   m.splitBin(j, &by, &bj);
   const uint64_t block = uint64_t(by) * uint64_t(m.nb) + uint64_t(bx);
   // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
-  // first summing the terms' C rows: a point needs only R products per term).
-  float sum = 0.0f;
+  // first summing the terms' C rows: a point needs only R products per term); the terms' weighted
+  // lane sums share one final reduction.
+  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup) continue;
     const CpGroupView& v = m.groups.data[e.group].view;
-    const int32_t rank = v.rank;
-    const float* a = v.a + size_t(bi) * size_t(rank);
-    const float* bb = v.b + size_t(bj) * size_t(rank);
-    const float* c = v.c + size_t(e.row) * size_t(rank);
-    sum += float(b.weight[t]) * laneDot3(a, bb, c, rank);
+    const size_t rank = size_t(v.rank);
+    laneAccumulateDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
+                       float(b.weight[t]), lanes);
   }
+  const float sum = laneTotal(lanes);
   *value = sum > 0.0f ? double(sum) : 0.0;
   return Status::kOk;
 }

@@ -5,28 +5,14 @@
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/tensor_ndf.h>
 
+#include "../heap_array.h"
+#include "../pyramid_blend.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <new>
 
 namespace glintbake::runtime {
-
-// Heap array that reports allocation failure instead of throwing.
-template <typename T>
-struct Array {
-  T* data = nullptr;
-  size_t size = 0;
-  Array() = default;
-  Array(const Array&) = delete;
-  Array& operator=(const Array&) = delete;
-  ~Array() { delete[] data; }
-  bool allocate(size_t n) {
-    delete[] data;
-    data = new (std::nothrow) T[n];
-    size = data ? n : 0;
-    return data != nullptr;
-  }
-};
 
 struct TensorNdf::Impl {
   struct Group {
@@ -56,6 +42,7 @@ struct TensorNdf::Impl {
   double inv_bin = 0.0;              // R / 2
   int level_count = 0;
   TLevel levels[kMaxNdfLevels];
+  PyramidBlender blender;
   uint32_t group_count = 0;
   Array<Group> groups;
   uint64_t blocks_kept = 0;

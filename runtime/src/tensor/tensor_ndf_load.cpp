@@ -217,6 +217,7 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
     if (Status s = checkLevel(levels[l].rec, l, info, l > 0 ? &levels[l - 1].rec : nullptr); s != Status::kOk) return s;
   }
   level_count = int(info.level_count);
+  blender.init(levels, level_count);
 
   // Every group needs its own section, so the section count bounds the allocation.
   if (uint64_t(info.group_count) > reader.sections().size()) return Status::kInvalidAsset;
