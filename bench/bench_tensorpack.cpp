@@ -128,10 +128,11 @@ const int kRegistered = [] {
       for (bool nonneg : {false, true}) {
         const std::string name = std::string("BM_GroupCp/") + kind_name + "/" + tensor::cpMethodName(method) +
                                  (nonneg ? "/nonneg" : "/signed");
+        // The fast methods run in tens of milliseconds: ten runs per repetition steady them.
         benchmark::RegisterBenchmark(name.c_str(), BM_GroupCp, kind, method, nonneg)
             ->Unit(benchmark::kMillisecond)
-            ->Iterations(1)
-            ->Repetitions(3)
+            ->Iterations(method == tensor::CpMethod::kAlsPlain ? 1 : 10)
+            ->Repetitions(5)
             ->ReportAggregatesOnly(true);
       }
     }

@@ -182,8 +182,9 @@ double CpEngine::halsSweep(CpState& s) {
   halsUpdate(s.a, m_, gram(s.b).cwiseProduct(ctc));
   const Eigen::VectorXd norms = normaliseColumns(s.a, &s.c);
   // W = X^T C is linear in C: absorbing A's norms into C scales W's columns the same way.
+  // C^T C follows the same scaling: (D C^T C D)(i, j) = n_i n_j (C^T C)(i, j).
   for (int r = 0; r < rank_; ++r) w_.col(r) *= static_cast<float>(norms[r]);
-  ctc = gram(s.c);
+  ctc = norms.asDiagonal() * ctc * norms.asDiagonal();
 
   contractModeB(s.a, m_);
   halsUpdate(s.b, m_, gram(s.a).cwiseProduct(ctc));

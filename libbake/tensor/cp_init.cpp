@@ -89,12 +89,20 @@ MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64
       column[static_cast<size_t>(b)] = static_cast<int>((r >> 1) % static_cast<uint64_t>(basis));
       sign[static_cast<size_t>(b)] = (r & 1u) ? 1.0f : -1.0f;
     }
-    std::vector<float> row(static_cast<size_t>(basis));
+    // Four partial rows (bin b into partial b % 4): consecutive bins that hash to one column no
+    // longer wait on each other's additions.
+    const size_t width = static_cast<size_t>(basis);
+    std::vector<float> rows(4 * width);
     for (int k = 0; k < blocks; ++k) {
-      std::fill(row.begin(), row.end(), 0.0f);
+      std::fill(rows.begin(), rows.end(), 0.0f);
       const float* xk = x + static_cast<size_t>(k) * static_cast<size_t>(n);
-      for (size_t b = 0; b < static_cast<size_t>(n); ++b) row[static_cast<size_t>(column[b])] += sign[b] * xk[b];
-      for (int c = 0; c < basis; ++c) y(k, c) = row[static_cast<size_t>(c)];
+      size_t b = 0;
+      for (; b + 4 <= static_cast<size_t>(n); b += 4) {
+        for (size_t p = 0; p < 4; ++p) rows[p * width + static_cast<size_t>(column[b + p])] += sign[b + p] * xk[b + p];
+      }
+      for (; b < static_cast<size_t>(n); ++b) rows[static_cast<size_t>(column[b])] += sign[b] * xk[b];
+      for (size_t c = 0; c < width; ++c)
+        y(k, static_cast<Eigen::Index>(c)) = (rows[c] + rows[width + c]) + (rows[2 * width + c] + rows[3 * width + c]);
     }
   } else {
     MatF omega(n, basis);

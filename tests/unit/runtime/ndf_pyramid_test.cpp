@@ -169,6 +169,30 @@ TEST_F(NdfPyramidTest, TrilinearBlendOfTheBracketingLevels) {
   EXPECT_NEAR(seam, 0.5 * (at(0, 7, 0) + at(0, 0, 0)), 1e-6 * seam);
 }
 
+TEST_F(NdfPyramidTest, RepeatBlendOfFarAndSeamPositionsMatchesTheReducedPosition) {
+  // Positions many periods away (beyond 1e9 texels the blend reduces with std::floor instead of
+  // its integer path), just below a period (rounding of the reduction lands on either side of the
+  // seam) and negative ones give the image of the position reduced into [0, map) exactly (fmod
+  // is exact); the tolerance covers the rounding of the reduction at 2^31 texels.
+  const SPoint s{-1 + 9.5 * 2.0 / kRes, 1 - 6.5 * 2.0 / kRes};
+  const double positions[] = {-3.75,        -64000.0 + 5.25, 1e9 + 5.25,         64.0 * 33554432.0 + 5.25,
+                              64.0 - 1e-13, -1e-300,         -64.0 * 1e7 - 1e-9, 17.5};
+  for (double sigma : {1.0, 2.828, 8.0}) {
+    for (double x : positions) {
+      double reduced = std::fmod(x, double(kMap));
+      if (reduced < 0.0) reduced += kMap;
+      if (reduced >= kMap) reduced -= kMap;
+      double v = 0.0, expect = 0.0;
+      ASSERT_EQ(pyr_.eval(fp(x, 20.0, sigma), s, &v), Status::kOk);
+      ASSERT_EQ(pyr_.eval(fp(reduced, 20.0, sigma), s, &expect), Status::kOk);
+      EXPECT_NEAR(v, expect, 1e-6 * expect) << "x " << x << " sigma " << sigma;
+      ASSERT_EQ(pyr_.eval(fp(20.0, x, sigma), s, &v), Status::kOk);
+      ASSERT_EQ(pyr_.eval(fp(20.0, reduced, sigma), s, &expect), Status::kOk);
+      EXPECT_NEAR(v, expect, 1e-6 * expect) << "y " << x << " sigma " << sigma;
+    }
+  }
+}
+
 TEST_F(NdfPyramidTest, RangeAveragesAreExactForPiecewiseConstantImages) {
   const Footprint f = fp(20.0, 33.0, 3.0);
   std::vector<float> img(kRes * kRes);
