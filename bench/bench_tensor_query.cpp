@@ -26,8 +26,8 @@ namespace fmt = glintbake::format;
 
 struct Assets {
   rt::NdfPyramid pyramid;
-  rt::TensorNdf tensor;     // plain CP (the tensorpack default)
-  rt::TensorNdf tensor_nn;  // non-negative CP
+  rt::TensorNdf tensor;     // plain (signed) CP: tensorpack --no-nonneg
+  rt::TensorNdf tensor_nn;  // non-negative CP (the tensorpack default)
 };
 
 [[noreturn]] void fail(const char* what) {
