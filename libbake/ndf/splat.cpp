@@ -158,16 +158,45 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
   const double lo = std::max(mean_a - truncation * sd_a, -1.0);
   const double hi = std::min(mean_a + truncation * sd_a, 1.0);
   if (lo >= hi) return;
-  const int k0 = std::max(0, int(std::floor((lo + 1.0) / h)));
-  const int k1 = std::min(res - 1, int(std::floor((hi + 1.0) / h)));
+  const double inv_h = 0.5 * res;  // lo + 1 and the like are >= 0: truncation is floor below
+  const int k0 = std::max(0, int((lo + 1.0) * inv_h));
+  const int k1 = std::min(res - 1, int((hi + 1.0) * inv_h));
   const double inv_sd_a = 1.0 / sd_a;
+  const double inv_cond_sd = 1.0 / cond_sd;
 
+  // Two passes over chunks of sub-intervals: the first forms each sub-interval's conditional
+  // Gaussian (divisions, a square root, table lookups: independent across sub-intervals, so they
+  // overlap), the second integrates them over their bins. The additions into acc keep the order
+  // of a single pass.
+  struct Run {
+    double* row;  // first bin
+    int count;    // bins
+    double scale, u, du;
+  };
+  constexpr int kChunk = 64;
+  Run runs[kChunk];
+  int n = 0;
+  auto flush = [&]() {
+    for (int r = 0; r < n; ++r) {
+      const Run& run = runs[r];
+      double u = run.u;
+      double c_prev = phiCdfTable(u);
+      double* row = run.row;
+      for (int j = 0; j < run.count; ++j, row += stride_b) {
+        u += run.du;
+        const double c_next = phiCdfTable(u);
+        *row += run.scale * (c_next - c_prev);
+        c_prev = c_next;
+      }
+    }
+    n = 0;
+  };
   for (int k = k0; k <= k1; ++k) {
     const double a0 = std::max(lo, -1.0 + k * h);
     const double a1 = std::min(hi, -1.0 + (k + 1) * h);
     if (a1 <= a0) continue;
     // Sub-intervals keep the conditional mean's drift across each below one conditional std.
-    int subs = int(std::ceil(std::abs(slope) * (a1 - a0) / cond_sd));
+    int subs = int(std::ceil(std::abs(slope) * (a1 - a0) * inv_cond_sd));
     subs = std::clamp(subs, 1, kMaxSubIntervals);
     const double da = (a1 - a0) / subs;
     double z_prev = (a0 - mean_a) * inv_sd_a;
@@ -178,30 +207,24 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
       const double w = cdf_next - cdf_prev;
       if (w > 1e-300) {
         // Truncated-normal mean and variance of the primary axis on this sub-interval.
-        const double ratio = (pdf_prev - pdf_next) / w;
+        const double inv_w = 1.0 / w;
+        const double ratio = (pdf_prev - pdf_next) * inv_w;
         const double t_mean = mean_a + sd_a * ratio;
-        double t_var = caa * (1.0 + (z_prev * pdf_prev - z_next * pdf_next) / w - ratio * ratio);
+        double t_var = caa * (1.0 + (z_prev * pdf_prev - z_next * pdf_next) * inv_w - ratio * ratio);
         t_var = std::max(t_var, 0.0);
         const double m_b = mean_b + slope * (t_mean - mean_a);
         const double sd_b = std::sqrt(cond_var + slope * slope * t_var);
         const double blo = std::max(m_b - truncation * sd_b, -1.0);
         const double bhi = std::min(m_b + truncation * sd_b, 1.0);
         if (blo < bhi) {
-          const int j0 = std::max(0, int(std::floor((blo + 1.0) / h)));
-          const int j1 = std::min(res - 1, int(std::floor((bhi + 1.0) / h)));
+          const int j0 = std::max(0, int((blo + 1.0) * inv_h));
+          const int j1 = std::min(res - 1, int((bhi + 1.0) * inv_h));
           const double inv_sd_b = 1.0 / sd_b;
-          const double scale = mass * w;
           // Table coordinate of the bin boundaries, stepping by h / sd_b per bin.
-          double u = ((-1.0 + j0 * h - m_b) * inv_sd_b - NormalTable::kMin) * NormalTable::kInvStep;
-          const double du = h * inv_sd_b * NormalTable::kInvStep;
-          double c_prev = phiCdfTable(u);
-          double* row = acc + size_t(k) * stride_a + size_t(j0) * stride_b;
-          for (int j = j0; j <= j1; ++j, row += stride_b) {
-            u += du;
-            const double c_next = phiCdfTable(u);
-            *row += scale * (c_next - c_prev);
-            c_prev = c_next;
-          }
+          runs[n++] = Run{acc + size_t(k) * stride_a + size_t(j0) * stride_b, j1 - j0 + 1, mass * w,
+                          ((-1.0 + j0 * h - m_b) * inv_sd_b - NormalTable::kMin) * NormalTable::kInvStep,
+                          h * inv_sd_b * NormalTable::kInvStep};
+          if (n == kChunk) flush();
         }
       }
       z_prev = z_next;
@@ -209,6 +232,7 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
       pdf_prev = pdf_next;
     }
   }
+  flush();
 }
 
 int64_t Splatter::image(double x, double y, double sigma, float* out) {
