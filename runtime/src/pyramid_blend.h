@@ -23,26 +23,19 @@ inline bool validFootprint(const Footprint& fp) {
          std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
 }
 
-// Column i and row j of the bin of an R x R NDF image (bin side 2 / res) holding s (row 0 at
-// s_y = +1), false outside [-1, 1]^2; ndfBinOf gives the index j * res + i, or -1 outside.
-inline bool ndfBinCoords(double sx, double sy, int res, double bin, int* i, int* j) {
+// Column i and row j of the bin of an R x R NDF image (bin side 2 / res, inv_bin = res / 2)
+// holding s (row 0 at s_y = +1), false outside [-1, 1]^2; ndfBinOf gives the index j * res + i, or
+// -1 outside. Every query that locates a bin (pdf, eval, sample's own check) goes through here.
+inline bool ndfBinCoords(double sx, double sy, int res, double inv_bin, int* i, int* j) {
   if (!(sx >= -1.0 && sx <= 1.0 && sy >= -1.0 && sy <= 1.0)) return false;
-  *i = std::min(res - 1, int((sx + 1.0) / bin));
-  *j = std::min(res - 1, int((1.0 - sy) / bin));
+  *i = std::min(res - 1, int((sx + 1.0) * inv_bin));
+  *j = std::min(res - 1, int((1.0 - sy) * inv_bin));
   return true;
 }
-inline int ndfBinOf(double sx, double sy, int res, double bin) {
+inline int ndfBinOf(double sx, double sy, int res, double inv_bin) {
   int i, j;
-  return ndfBinCoords(sx, sy, res, bin, &i, &j) ? j * res + i : -1;
+  return ndfBinCoords(sx, sy, res, inv_bin, &i, &j) ? j * res + i : -1;
 }
-
-// Up to 8 (level, centre, weight) terms; centre = j * grid_width + i on its level. Weights sum to 1.
-struct CentreBlend {
-  int count = 0;
-  int level[8];
-  size_t centre[8];
-  double weight[8];
-};
 
 // One axis of a level's centre grid, with the divisions of the blend done once at load.
 struct BlendAxis {
@@ -120,20 +113,22 @@ class PyramidBlender {
     }
   }
 
-  // Level coordinate: sigma <= sigma_0 uses level 0, sigma >= the top level's sigma the top
-  // level, otherwise the two bracketing levels mixed linearly in log(sigma).
-  void blend(const Footprint& fp, CentreBlend* out) const {
-    out->count = 0;
+  // Calls emit(level, centre, weight) for each of the (at most 8) centres a footprint mixes,
+  // centre = j * grid_width + i on its level; the weights sum to 1. Level coordinate: sigma <=
+  // sigma_0 uses level 0, sigma >= the top level's sigma the top level, otherwise the two
+  // bracketing levels mixed linearly in log(sigma).
+  template <typename Emit>
+  void blend(const Footprint& fp, Emit&& emit) const {
     if (!(fp.sigma > level_[0].sigma)) {
-      blendLevel(0, 1.0, fp, out);
+      blendLevel(0, 1.0, fp, emit);
     } else if (fp.sigma >= level_[count_ - 1].sigma) {
-      blendLevel(count_ - 1, 1.0, fp, out);
+      blendLevel(count_ - 1, 1.0, fp, emit);
     } else {
       int l = 0;
       while (l + 1 < count_ && level_[l + 1].sigma <= fp.sigma) ++l;
       const double t = (std::log(fp.sigma) - level_[l].log_sigma) * level_[l].inv_log_step;
-      blendLevel(l, 1.0 - t, fp, out);
-      blendLevel(l + 1, t, fp, out);
+      blendLevel(l, 1.0 - t, fp, emit);
+      blendLevel(l + 1, t, fp, emit);
     }
   }
 
@@ -146,7 +141,8 @@ class PyramidBlender {
   };
 
   // Within a level, the 4 nearest centres bilinearly (zero weights skipped).
-  void blendLevel(int l, double level_weight, const Footprint& fp, CentreBlend* out) const {
+  template <typename Emit>
+  void blendLevel(int l, double level_weight, const Footprint& fp, Emit& emit) const {
     const Level& g = level_[l];
     int x0, x1, y0, y1;
     double fx, fy;
@@ -155,11 +151,7 @@ class PyramidBlender {
     const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
     const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
     for (int k = 0; k < 4; ++k) {
-      if (ws[k] <= 0.0) continue;
-      out->level[out->count] = l;
-      out->centre[out->count] = size_t(ys[k]) * g.grid_width + size_t(xs[k]);
-      out->weight[out->count] = level_weight * ws[k];
-      ++out->count;
+      if (ws[k] > 0.0) emit(l, size_t(ys[k]) * g.grid_width + size_t(xs[k]), level_weight * ws[k]);
     }
   }
 

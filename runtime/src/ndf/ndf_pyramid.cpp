@@ -39,6 +39,7 @@ struct NdfPyramid::Impl {
   int res = 0;
   int level_count = 0;
   double bin = 0.0;       // 2 / R
+  double inv_bin = 0.0;   // R / 2
   double bin_area = 0.0;  // (2 / R)^2
   Level levels[kMaxNdfLevels];
   PyramidBlender blender;
@@ -46,7 +47,7 @@ struct NdfPyramid::Impl {
   Status load(const format::Reader& reader);
   void blend(const Footprint& fp, Blend* b) const;
   // Bin of s, or -1 outside [-1,1]^2.
-  int binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, bin); }
+  int binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, inv_bin); }
   double blendValue(const Blend& b, int bin_index) const {
     double v = 0.0;
     for (int k = 0; k < b.count; ++k) v += b.weight[k] * double(b.image[k][bin_index]);
@@ -136,22 +137,22 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
   }
   if (level_count == 0) return Status::kInvalidAsset;
   bin = 2.0 / res;
+  inv_bin = res / 2.0;
   bin_area = bin * bin;
   blender.init(levels, level_count);
   return Status::kOk;
 }
 
 void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
-  CentreBlend cb;
-  blender.blend(fp, &cb);
   const size_t image_floats = size_t(res) * size_t(res);
-  b->count = cb.count;
-  for (int k = 0; k < cb.count; ++k) {
-    const Level& lv = levels[cb.level[k]];
-    b->weight[k] = cb.weight[k];
-    b->image[k] = lv.images.data + cb.centre[k] * image_floats;
-    b->prefix[k] = lv.prefix.data + cb.centre[k] * size_t(res + 1);
-  }
+  b->count = 0;
+  blender.blend(fp, [&](int level, size_t centre, double weight) {
+    const Level& lv = levels[level];
+    b->weight[b->count] = weight;
+    b->image[b->count] = lv.images.data + centre * image_floats;
+    b->prefix[b->count] = lv.prefix.data + centre * size_t(res + 1);
+    ++b->count;
+  });
 }
 
 NdfPyramid::NdfPyramid() = default;

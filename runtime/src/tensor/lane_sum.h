@@ -42,9 +42,15 @@ inline void laneAccumulate(int32_t n, Term term, T w, T lanes[4]) {
 inline void laneAccumulateDot3(const float* a, const float* b, const float* c, int32_t n, float w, float lanes[4]) {
 #if GLINTBAKE_RUNTIME_SSE2
   if ((n & 3) == 0) {
+    auto term = [=](int32_t r) {
+      return _mm_mul_ps(_mm_mul_ps(_mm_loadu_ps(a + r), _mm_loadu_ps(b + r)), _mm_loadu_ps(c + r));
+    };
     __m128 s = _mm_setzero_ps();
-    for (int32_t r = 0; r < n; r += 4)
-      s = _mm_add_ps(s, _mm_mul_ps(_mm_mul_ps(_mm_loadu_ps(a + r), _mm_loadu_ps(b + r)), _mm_loadu_ps(c + r)));
+    if (n == 16) {  // the default rank, unrolled (same additions, same order)
+      s = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(s, term(0)), term(4)), term(8)), term(12));
+    } else {
+      for (int32_t r = 0; r < n; r += 4) s = _mm_add_ps(s, term(r));
+    }
     _mm_storeu_ps(lanes, _mm_add_ps(_mm_loadu_ps(lanes), _mm_mul_ps(_mm_set1_ps(w), s)));
     return;
   }

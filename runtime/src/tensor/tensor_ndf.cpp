@@ -51,19 +51,18 @@ struct Span {
 
 }  // namespace
 
-int TensorNdf::Impl::binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, bin); }
+int TensorNdf::Impl::binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, inv_bin); }
 
 void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
-  CentreBlend cb;
-  blender.blend(fp, &cb);
-  b->count = cb.count;
-  for (int k = 0; k < cb.count; ++k) {
-    const TLevel& lv = levels[cb.level[k]];
-    const size_t first = cb.centre[k] * size_t(nb2);
-    b->weight[k] = cb.weight[k];
-    b->index[k] = lv.index.data + first;
-    b->mass[k] = lv.mass.data + first;
-  }
+  b->count = 0;
+  blender.blend(fp, [&](int level, size_t centre, double weight) {
+    const TLevel& lv = levels[level];
+    const size_t first = centre * size_t(nb2);
+    b->weight[b->count] = weight;
+    b->index[b->count] = lv.index.data + first;
+    b->mass[b->count] = lv.mass.data + first;
+    ++b->count;
+  });
 }
 
 void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const {
@@ -136,7 +135,7 @@ Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* valu
     return Status::kInvalidArgument;
   const Impl& m = *impl_;
   int i, j;
-  if (!ndfBinCoords(s.x, s.y, m.res, m.bin, &i, &j)) {
+  if (!ndfBinCoords(s.x, s.y, m.res, m.inv_bin, &i, &j)) {
     *value = 0.0;
     return Status::kOk;
   }
