@@ -72,16 +72,16 @@ inline T laneSum(int32_t n, Term term) {
   return laneTotal(lanes);
 }
 
-// sum_r a[r] * b[r] * c[r]
-template <typename T, typename U>
-inline T laneDot3(const T* a, const U* b, const U* c, int32_t n) {
-  return laneSum<T>(n, [=](int32_t r) { return a[r] * T(b[r]) * T(c[r]); });
+// sum_r a[r] * b[r] * c[r] (laneAccumulateDot3 with w = 1 into zero lanes: exact, same bits).
+inline float laneDot3(const float* a, const float* b, const float* c, int32_t n) {
+  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  laneAccumulateDot3(a, b, c, n, 1.0f, lanes);
+  return laneTotal(lanes);
 }
 
 // sum_r a[r] * b[r]
-template <typename T, typename U>
-inline T laneDot(const T* a, const U* b, int32_t n) {
-  return laneSum<T>(n, [=](int32_t r) { return a[r] * T(b[r]); });
+inline float laneDot(const float* a, const float* b, int32_t n) {
+  return laneSum<float>(n, [=](int32_t r) { return a[r] * b[r]; });
 }
 
 }  // namespace glintbake::runtime
