@@ -1,0 +1,163 @@
+// Latency of the runtime's exact small-footprint evaluator (FlakeNdf): point eval, sample and the
+// reference evaluator at the same footprints, on 1024^2 maps. By default three procedural maps
+// (beckmann, scratches, flakes); GLINTBAKE_BENCH_MAPS=a.png,b.png benchmarks real maps instead.
+// Queries cycle through 1024 precomputed random footprints and s-plane points drawn where the NDF
+// is not negligible (sampled from it), so that caches and branch predictors see varied queries.
+#include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/reference/pndf.h>
+#include <glintbake/runtime/flake_ndf.h>
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace bake = glintbake::bake;
+namespace rt = glintbake::runtime;
+
+class MapTexels final : public rt::TexelSource {
+ public:
+  explicit MapTexels(const bake::NormalMap& map) : map_(map) {}
+  int width() const override { return map_.width; }
+  int height() const override { return map_.height; }
+  bool repeats() const override { return map_.wrap == bake::Wrap::kRepeat; }
+  void normal(int x, int y, float out[2]) const override {
+    out[0] = map_.at(x, y)[0];
+    out[1] = map_.at(x, y)[1];
+  }
+
+ private:
+  const bake::NormalMap& map_;
+};
+
+struct Subject {
+  std::string name;
+  bake::NormalMap map;
+  rt::FlakeNdf ndf;
+  glintbake::reference::FlakeSet set;
+};
+
+std::vector<std::unique_ptr<Subject>>& subjects() {
+  static std::vector<std::unique_ptr<Subject>> all = [] {
+    std::vector<std::unique_ptr<Subject>> v;
+    const char* env = std::getenv("GLINTBAKE_BENCH_MAPS");
+    if (env && *env) {
+      std::stringstream list(env);
+      std::string path;
+      while (std::getline(list, path, ',')) {
+        auto s = std::make_unique<Subject>();
+        auto map = bake::loadNormalMap(path, bake::IngestOptions(), nullptr);
+        if (!map.ok()) {
+          std::fprintf(stderr, "bench_flakes: cannot read %s\n", path.c_str());
+          std::abort();
+        }
+        s->map = std::move(map.value());
+        s->name = path.substr(path.find_last_of('/') + 1);
+        v.push_back(std::move(s));
+      }
+    } else {
+      for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kScratches, bake::MapKind::kFlakes}) {
+        auto s = std::make_unique<Subject>();
+        bake::MapParams p;
+        p.size = 1024;
+        s->map = bake::generateMap(kind, p);
+        s->name = bake::mapKindString(kind);
+        v.push_back(std::move(s));
+      }
+    }
+    for (auto& s : v) {
+      MapTexels texels(s->map);
+      if (s->ndf.build(texels, 1, 0.005, 128) != rt::Status::kOk) std::abort();
+      s->set = glintbake::reference::buildFlakes(s->map, 1);
+    }
+    return v;
+  }();
+  return all;
+}
+
+struct Query {
+  rt::Footprint fp;
+  rt::SPoint s;
+  double u1, u2;
+};
+
+std::vector<Query> queries(const Subject& subject, double sigma) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Query> q(1024);
+  for (Query& x : q) {
+    x.fp = {u(rng) * subject.map.width, u(rng) * subject.map.height, sigma};
+    rt::NdfSample smp;
+    // A point where the NDF is not negligible: a sample of it (retry the rare rejected tail).
+    do {
+      subject.ndf.sample(x.fp, u(rng), u(rng), &smp);
+    } while (!(smp.pdf > 0.0));
+    x.s = smp.s;
+    x.u1 = u(rng);
+    x.u2 = u(rng);
+  }
+  return q;
+}
+
+void evalBench(benchmark::State& state, size_t subject, double sigma) {
+  const Subject& s = *subjects()[subject];
+  const std::vector<Query> q = queries(s, sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    double v;
+    s.ndf.eval(q[i].fp, q[i].s, &v);
+    benchmark::DoNotOptimize(v);
+    i = (i + 1) & 1023;
+  }
+}
+
+void sampleBench(benchmark::State& state, size_t subject, double sigma) {
+  const Subject& s = *subjects()[subject];
+  const std::vector<Query> q = queries(s, sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    rt::NdfSample smp;
+    s.ndf.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
+    benchmark::DoNotOptimize(smp);
+    i = (i + 1) & 1023;
+  }
+}
+
+void referenceBench(benchmark::State& state, size_t subject, double sigma) {
+  const Subject& s = *subjects()[subject];
+  const std::vector<Query> q = queries(s, sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    const double v = glintbake::reference::evalPndf(s.set, {q[i].fp.x, q[i].fp.y, std::max(sigma, 1e-6)}, q[i].s.x,
+                                                    q[i].s.y, 0.005);
+    benchmark::DoNotOptimize(v);
+    i = (i + 1) & 1023;
+  }
+}
+
+const int registered = [] {
+  for (size_t k = 0; k < subjects().size(); ++k) {
+    const std::string name = subjects()[k]->name;
+    for (double sigma : {0.0, 1.0, 4.0, 8.0, 16.0}) {
+      const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
+      benchmark::RegisterBenchmark(("flake_eval/" + tag).c_str(), evalBench, k, sigma);
+      benchmark::RegisterBenchmark(("flake_sample/" + tag).c_str(), sampleBench, k, sigma);
+    }
+    benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
+        ->Unit(benchmark::kMicrosecond);
+  }
+  return 0;
+}();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,47 @@
+// The flakes section of NDF assets (formats/SPEC.md 10.5): the normal map a pyramid was baked from,
+// stored so that the runtime evaluates small footprints exactly from its flakes (Yan et al. 2016)
+// instead of from the finest pyramid level.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace glintbake::format {
+
+// Section type of the flakes section (key 0, at most one per asset; ndf-pyramid and tensor-ndf).
+constexpr uint32_t kSectionFlakes = 80;
+
+// Header of the flakes section, 64 bytes little-endian, followed by map_width * map_height pairs
+// of float32 (n_x, n_y), row-major, row 0 at the top (SPEC.md section 9 coordinates).
+struct FlakesRecord {
+  uint32_t magic = 0x4B4C4647;  // "GFLK"
+  uint32_t version = 1;
+  uint32_t map_width = 0;   // texels
+  uint32_t map_height = 0;  // texels
+  uint32_t wrap = 0;        // 0 repeat, 1 clamp: how the map continues beyond its edges
+  uint32_t rate = 1;        // flakes per texel side (1..16)
+  uint32_t precision = 0;   // 0: float32 normals (the only value of version 1)
+  uint32_t reserved = 0;
+  double sigma_r = 0.0;          // intrinsic roughness, s-plane std of every flake (0, 1]
+  double flakes_up_to = 0.0;     // footprints with sigma <= this (texels) are answered by the flakes alone
+  double pyramid_from = 0.0;     // footprints with sigma >= this are answered by the pyramid alone;
+                                 // in between the two are blended linearly in log(sigma)
+  double reserved2 = 0.0;
+};
+static_assert(sizeof(FlakesRecord) == 64, "FlakesRecord is 64 bytes");
+
+// Limits a reader accepts (checked before any allocation).
+constexpr uint32_t kMaxFlakesMapSide = 1u << 16;
+constexpr uint32_t kMaxFlakesRate = 16;
+constexpr uint64_t kMaxFlakesCount = uint64_t(1) << 30;  // map texels x rate^2
+
+// Bytes of a flakes section holding `record` (header and normals), or 0 when the record's sizes
+// are out of range.
+uint64_t flakesSectionSize(const FlakesRecord& record);
+
+// Checks every field of a flakes record against SPEC.md 10.5 and the section's raw size: the one
+// check used by every reader and writer. Returns null when valid, otherwise a short message
+// naming the first offending field. Safe on untrusted input.
+const char* checkFlakesRecord(const FlakesRecord& record, uint64_t section_raw_size);
+
+}  // namespace glintbake::format

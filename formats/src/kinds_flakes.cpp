@@ -1,0 +1,31 @@
+// Checks of the flakes section record (see kinds/flakes.h).
+#include <glintbake/format/kinds/flakes.h>
+
+#include <cmath>
+
+namespace glintbake::format {
+
+uint64_t flakesSectionSize(const FlakesRecord& r) {
+  if (r.map_width < 1 || r.map_height < 1 || r.map_width > kMaxFlakesMapSide || r.map_height > kMaxFlakesMapSide)
+    return 0;
+  return sizeof(FlakesRecord) + uint64_t(r.map_width) * uint64_t(r.map_height) * 8u;
+}
+
+const char* checkFlakesRecord(const FlakesRecord& r, uint64_t section_raw_size) {
+  if (r.magic != FlakesRecord().magic) return "flakes record: bad magic";
+  if (r.version != 1) return "flakes record: unsupported version";
+  if (flakesSectionSize(r) == 0) return "flakes record: map size out of range";
+  if (r.wrap > 1) return "flakes record: wrap is neither repeat nor clamp";
+  if (r.rate < 1 || r.rate > kMaxFlakesRate) return "flakes record: rate out of range";
+  if (uint64_t(r.map_width) * r.map_height * r.rate * r.rate > kMaxFlakesCount) return "flakes record: too many flakes";
+  if (r.precision != 0) return "flakes record: unknown precision";
+  if (!(std::isfinite(r.sigma_r) && r.sigma_r > 0.0 && r.sigma_r <= 1.0)) return "flakes record: sigma_r out of range";
+  if (!(std::isfinite(r.flakes_up_to) && r.flakes_up_to >= 0.0 && r.flakes_up_to <= 1e6))
+    return "flakes record: flakes_up_to out of range";
+  if (!(std::isfinite(r.pyramid_from) && r.pyramid_from >= r.flakes_up_to && r.pyramid_from <= 1e6))
+    return "flakes record: pyramid_from below flakes_up_to";
+  if (section_raw_size != flakesSectionSize(r)) return "flakes record: section size does not match the map size";
+  return nullptr;
+}
+
+}  // namespace glintbake::format

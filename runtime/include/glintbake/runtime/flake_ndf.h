@@ -1,0 +1,79 @@
+// The exact P-NDF of small footprints, evaluated from the flakes of a normal map (Yan et al. 2016,
+// "Position-Normal Distributions for Efficient Rendering of Specular Microstructure", sections 4-5).
+//
+// Every texel (or rate^2 sub-samples of it) is a 4D Gaussian flake with position u_k, normal n_k
+// (bilinear interpolation of the texels at u_k) and Jacobian J_k (central differences of that
+// interpolant, one texel on each side), spatial std sigma_h = 1.5 step / sqrt(12) and area
+// step^2 (formats/SPEC.md 10.5; the reference evaluator in libbake/reference defines the same
+// model). Seen through a Gaussian footprint of std sigma_p centred at u_Q, flake k contributes the
+// closed form
+//   D_k(s) = A N(u_k; u_Q, (sigma_h^2 + sigma_p^2) I) N(s; mu_k, C_k),
+//   mu_k = n_k + J_k (sigma_h^2 / (sigma_h^2 + sigma_p^2)) (u_Q - u_k),
+//   C_k  = sigma_r^2 I + (sigma_h^2 sigma_p^2 / (sigma_h^2 + sigma_p^2)) J_k J_k^T,
+// summed over the flakes whose centre lies within 6 sqrt(sigma_h^2 + sigma_p^2) texels of u_Q
+// along each axis (a square window; the reference's disk of the same radius differs by less than
+// 1e-7 of the mass). With a repeating map every periodic image of a flake inside the window counts.
+//
+// Cost: a hierarchy bounds the flakes' normals over tiles of 16 x 16 flakes (each tile a k-d tree
+// over n with leaves of 8 flakes; every node keeps its normal box and the largest |J_k|), so a
+// point query visits only the flakes whose lobe can reach s (within 6 standard deviations). It
+// grows with sigma_p^2 times the share of flakes near s: about a microsecond at sigma_p = 1 texel
+// and tens at 16 (bench/bench_flakes.cpp). sigma_p = 0 is a point footprint.
+//
+// Queries follow the NdfSource contract: eval() is the closed form inside [-1, 1]^2 and 0 outside;
+// average() its exact mean over a rectangle (numerical integration to about 1e-10 of each lobe's
+// mass); image() the bin averages of eval, with bins whose centre lies outside the unit disk set to
+// 0 as in every stored NDF image; mass() the sum of the flakes' footprint weights (the integral of
+// the closed form over the whole plane); sample() picks a flake in proportion to its weight, then
+// a point of its Gaussian lobe, and returns pdf = eval / mass. A point drawn outside [-1, 1]^2 (a
+// lobe tail beyond the square, rare for real maps) comes back with pdf 0: treat it as a failed sample.
+// Queries never allocate, never throw and are thread-safe (const).
+#pragma once
+
+#include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/texel_source.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace glintbake::runtime {
+
+// Largest window a query accepts, in flakes per side (about sigma_p = 340 texels at rate 1);
+// larger footprints return kInvalidArgument (answer them from a pyramid).
+constexpr int64_t kMaxFlakeWindow = 4096;
+
+class FlakeNdf final : public NdfSource {
+ public:
+  FlakeNdf();
+  ~FlakeNdf() override;
+  FlakeNdf(const FlakeNdf&) = delete;
+  FlakeNdf& operator=(const FlakeNdf&) = delete;
+
+  // Builds the flakes and their hierarchy from a texel source: rate flakes per texel side (1..16),
+  // intrinsic roughness sigma_r in (0, 1], image resolution R (2..4096) reported by resolution()
+  // and used by image(). Memory: about 36 bytes per flake. kInvalidArgument for parameters out of
+  // range or a source larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
+  Status build(const TexelSource& source, int rate, double sigma_r, int resolution);
+  bool isBuilt() const;
+
+  int resolution() const override;
+  int mapWidth() const;   // texels
+  int mapHeight() const;  // texels
+  bool repeats() const;
+  double sigmaR() const;
+
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status mass(const Footprint& footprint, double* value) const override;
+  // Cost: every flake of the window (no pruning by s); a few milliseconds at sigma_p = 8 texels.
+  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glintbake::runtime
