@@ -3,6 +3,7 @@
 #include "layout.h"
 
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/flakes.h>
 
 #include <cstring>
 #include <string>
@@ -92,7 +93,8 @@ struct TypeName {
 constexpr TypeName kTypeNames[] = {
     {kSectionMetadata, "metadata"},        {kSectionNdfLevel, "ndf-level"},     {kSectionNdfChunk, "ndf-chunk"},
     {kSectionTensorIndex, "tensor-index"}, {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
-    {kSectionLtcTable, "ltc-table"},       {kSectionRoughness, "roughness"},    {kSectionImage, "image"},
+    {kSectionLtcTable, "ltc-table"},       {kSectionRoughness, "roughness"},    {kSectionFlakes, "flakes"},
+    {kSectionImage, "image"},
 };
 
 }  // namespace

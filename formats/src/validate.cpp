@@ -1,6 +1,7 @@
 // validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
 // its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
 #include <glintbake/format/validate.h>
+#include <glintbake/format/kinds/flakes.h>
 
 #include "byte_source.h"
 #include "container_parse.h"
@@ -43,7 +44,8 @@ void addWarning(std::vector<ValidationMessage>* messages, int id, std::string me
 // Section types of the registry in SPEC.md ("Section types").
 bool isRegisteredType(uint32_t type) {
   return type == kSectionMetadata || type == kSectionNdfLevel || type == kSectionNdfChunk ||
-         (type >= kSectionTensorIndex && type < kSectionRoughness + 16) || type == kSectionImage ||
+         (type >= kSectionTensorIndex && type < kSectionRoughness + 16) || type == kSectionFlakes ||
+         type == kSectionImage ||
          type >= kSectionFirstPrivate;
 }
 
@@ -74,6 +76,29 @@ bool kindTypeRange(AssetKind kind, uint32_t* first, uint32_t* last) {
 std::string describe(size_t index, const SectionInfo& s) {
   return "section " + std::to_string(index) + " (type " + std::to_string(s.type) + ", key " + std::to_string(s.key) +
          ")";
+}
+
+// The flakes section (SPEC.md 10.5): its record passes checkFlakesRecord and its normals are finite.
+void checkFlakesPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
+                        std::vector<ValidationMessage>* messages) {
+  FlakesRecord rec;
+  if (raw.size() < sizeof(rec)) {
+    addError(messages, 4008, describe(index, s) + ": shorter than the flakes record");
+    return;
+  }
+  std::memcpy(&rec, raw.data(), sizeof(rec));
+  if (const char* why = checkFlakesRecord(rec, raw.size())) {
+    addError(messages, 4008, describe(index, s) + ": " + why);
+    return;
+  }
+  for (size_t i = sizeof(rec); i + 4 <= raw.size(); i += 4) {
+    float v;
+    std::memcpy(&v, raw.data() + i, 4);
+    if (!std::isfinite(v)) {
+      addError(messages, 4008, describe(index, s) + ": non-finite normals");
+      return;
+    }
+  }
 }
 
 void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
@@ -330,7 +355,11 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       continue;
     }
     readable[i] = true;
-    if (s.type != kSectionMetadata) checkImagePayload(i, s, raw, &report.messages);
+    if (s.type == kSectionFlakes) {
+      checkFlakesPayload(i, s, raw, &report.messages);
+    } else if (s.type != kSectionMetadata) {
+      checkImagePayload(i, s, raw, &report.messages);
+    }
     if (s.type == kSectionNdfChunk) {
       ImageSectionHeader image;
       if (parseImageSection(raw.data(), raw.size(), &image) && image.width != image.height) {

@@ -540,8 +540,16 @@ Status FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* 
 
 namespace {
 
-// Adds weight * (the lobe's probability over each bin) to an R x R image (row 0 at s_y = +1):
-// the bins within 8.5 standard deviations of the mean, or the one bin holding the whole lobe.
+// Whether bin (i, j) of an R x R image has its centre inside the unit disk: the others hold 0
+// (SPEC.md section 9) and receive nothing.
+bool binInDisk(int i, int j, int res) {
+  const double cx = -1.0 + (i + 0.5) * 2.0 / res, cy = 1.0 - (j + 0.5) * 2.0 / res;
+  return cx * cx + cy * cy <= 1.0;
+}
+
+// Adds weight * (the lobe's probability over each bin) to the bins of an R x R image (row 0 at
+// s_y = +1) whose centre lies inside the unit disk: the bins within 8.5 standard deviations of the
+// mean, or the one bin holding the whole lobe.
 void splatLobe(const flakes::Lobe& g, double weight, int res, float* out) {
   const double bin = 2.0 / res, inv_bin = res / 2.0;
   const double rx = 8.5 * std::sqrt(g.cxx), ry = 8.5 * std::sqrt(g.cyy);
@@ -552,7 +560,7 @@ void splatLobe(const flakes::Lobe& g, double weight, int res, float* out) {
   if (i0 > i1 || j0 > j1) return;
   if (i0 == i1 && j0 == j1 && g.mx - rx >= -1.0 + i0 * bin && g.mx + rx <= -1.0 + (i0 + 1) * bin &&
       g.my + ry <= 1.0 - j0 * bin && g.my - ry >= 1.0 - (j0 + 1) * bin) {
-    out[size_t(j0) * res + i0] += float(weight);
+    if (binInDisk(i0, j0, res)) out[size_t(j0) * res + i0] += float(weight);
     return;
   }
   constexpr int kSpan = 32;  // bins per side integrated at once
@@ -566,7 +574,8 @@ void splatLobe(const flakes::Lobe& g, double weight, int res, float* out) {
       std::fill(acc, acc + nr * kSpan, 0.0);
       flakes::integrateLobeOverGrid(g, weight, xs, nc, ys, nr, acc, kSpan);
       for (int r = 0; r < nr; ++r)
-        for (int c = 0; c < nc; ++c) out[size_t(jb + r) * res + size_t(ib + c)] += float(acc[r * kSpan + c]);
+        for (int c = 0; c < nc; ++c)
+          if (binInDisk(ib + c, jb + r, res)) out[size_t(jb + r) * res + size_t(ib + c)] += float(acc[r * kSpan + c]);
     }
   }
 }
@@ -575,17 +584,25 @@ void splatLobe(const flakes::Lobe& g, double weight, int res, float* out) {
 
 Status FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
   if (!impl_) return Status::kInvalidArgument;
+  const int res = impl_->res;
+  const size_t n = size_t(res) * size_t(res);
+  if (!out || out_count < n) return Status::kInvalidArgument;
+  std::fill(out, out + n, 0.0f);
+  return addImage(footprint, 1.0, out, out_count);
+}
+
+Status FlakeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
+  if (!impl_) return Status::kInvalidArgument;
   const Impl& m = *impl_;
   const int res = m.res;
   const size_t n = size_t(res) * size_t(res);
-  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
+  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight)) return Status::kInvalidArgument;
   FootprintTerms t;
   if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
-  std::fill(out, out + n, 0.0f);
   const double bin = 2.0 / res;
   // Each lobe adds its probability over the bins, scaled to a density (divided by the bin area),
   // in the fixed order of the traversal.
-  const double to_density = t.wnorm / (bin * bin);
+  const double to_density = weight * t.wnorm / (bin * bin);
   auto all = [](const Node&, double, double) { return true; };
   m.forEachLeaf(t, all, [&](const LeafVisit& leaf) {
     m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {
@@ -594,14 +611,6 @@ Status FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count)
       splatLobe(g, to_density * std::exp(-spatial), res, out);
     });
   });
-  // Bins whose centre lies outside the unit disk hold 0 (SPEC.md section 9).
-  for (int j = 0; j < res; ++j) {
-    const double cy = 1.0 - (j + 0.5) * bin;
-    for (int i = 0; i < res; ++i) {
-      const double cx = -1.0 + (i + 0.5) * bin;
-      if (cx * cx + cy * cy > 1.0) out[size_t(j) * res + i] = 0.0f;
-    }
-  }
   return Status::kOk;
 }
 

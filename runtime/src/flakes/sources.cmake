@@ -1,3 +1,4 @@
 # Exact small-footprint evaluation from the flakes of a normal map, and the hand-over to a pyramid.
 list(APPEND GLINTBAKE_RUNTIME_SOURCES
-  ${CMAKE_CURRENT_LIST_DIR}/flake_ndf.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/flake_ndf.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/handover.cpp)

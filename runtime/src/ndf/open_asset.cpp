@@ -3,6 +3,7 @@
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/tensor_ndf.h>
+#include "../flakes/handover.h"
 #include "../format_status.h"
 
 #include <new>
@@ -32,6 +33,27 @@ Status openKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out, O
   }
 }
 
+// An asset with a flakes section answers small footprints from its flakes (formats/SPEC.md 10.5):
+// wraps the opened pyramid-shaped asset into the hand-over.
+Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
+  const int idx = reader.find(format::kSectionFlakes, 0);
+  if (idx < 0) return Status::kOk;
+  std::unique_ptr<FlakeNdf> flakes;
+  format::FlakesRecord rec;
+  if (Status s = loadFlakes(reader, idx, (*out)->resolution(), &flakes, &rec); s != Status::kOk) {
+    out->reset();
+    return s;
+  }
+  std::unique_ptr<NdfSource> handover(new (std::nothrow)
+                                          HandoverNdf(std::move(flakes), std::move(*out), rec.flakes_up_to, rec.pyramid_from));
+  if (!handover) {
+    out->reset();
+    return Status::kOutOfMemory;
+  }
+  *out = std::move(handover);
+  return Status::kOk;
+}
+
 }  // namespace
 
 Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
@@ -40,7 +62,8 @@ Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
   if (path == nullptr) return Status::kInvalidArgument;
   format::Reader reader;
   if (format::Status st = reader.open(path); st != format::Status::kOk) return fromFormatStatus(st);
-  return openKind(reader, out, [&](auto& asset) { return asset.open(path); });
+  if (Status s = openKind(reader, out, [&](auto& asset) { return asset.open(path); }); s != Status::kOk) return s;
+  return attachFlakes(reader, out);
 }
 
 Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out) {
@@ -49,7 +72,9 @@ Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSour
   if (data == nullptr) return Status::kInvalidArgument;
   format::Reader reader;
   if (format::Status st = reader.openMemory(data, size); st != format::Status::kOk) return fromFormatStatus(st);
-  return openKind(reader, out, [&](auto& asset) { return asset.openMemory(data, size); });
+  if (Status s = openKind(reader, out, [&](auto& asset) { return asset.openMemory(data, size); }); s != Status::kOk)
+    return s;
+  return attachFlakes(reader, out);
 }
 
 }  // namespace glintbake::runtime

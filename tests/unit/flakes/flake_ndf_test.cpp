@@ -162,7 +162,9 @@ TEST(FlakeNdf, FlatMapIsTheIntrinsicGaussianAndIntegratesToOne) {
     // Small footprints see the flake lattice: their mass is not 1, but their shape is the Gaussian.
     double mass = 0.0;
     ASSERT_EQ(f.ndf.mass(fp, &mass), Status::kOk);
-    if (sigma >= 1.0) EXPECT_NEAR(mass, 1.0, 1e-6);
+    if (sigma >= 1.0) {
+      EXPECT_NEAR(mass, 1.0, 1e-6);
+    }
     const float nx = float(0.1), ny = float(-0.2);  // the normal as the map stores it
     for (SPoint s : {SPoint{0.1, -0.2}, SPoint{0.104, -0.197}, SPoint{0.09, -0.21}}) {
       double v = 0.0;
