@@ -1,5 +1,6 @@
 // ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
 // ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md).
+#include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/ingest_options.h>
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
     if (!built) {
       throw Error(exitCodeOf(built.error().code), built.error().message);
     }
+    const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid);
 
     Json params = cli::pyramidOptionsJson(pyramid);
     params["zstd_level"] = zstd_level;
@@ -83,6 +85,10 @@ int main(int argc, char** argv) {
     for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
     asset["stop_reason"] = report.stop_reason;
     if (report.next_level_mse >= 0) asset["converged_mse"] = report.next_level_mse;
+    if (pyramid.flakes) {
+      const bake::ndf::FlakesHandover h = bake::ndf::defaultHandover(opt.sigma0);
+      asset["flakes"] = {{"up_to", h.flakes_up_to}, {"pyramid_from", h.pyramid_from}, {"bytes", flake_bytes}};
+    }
     meta["asset"] = asset;
     out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -115,6 +121,7 @@ int main(int argc, char** argv) {
       doc["stop_reason"] = report.stop_reason;
       doc["converged_mse"] = report.next_level_mse < 0 ? Json(nullptr) : Json(report.next_level_mse);
       doc["flakes"] = report.flakes;
+      doc["flakes_section_bytes"] = flake_bytes;
       doc["images"] = images;
       doc["raw_bytes"] = raw;
       doc["file_bytes"] = out.bytesWritten();

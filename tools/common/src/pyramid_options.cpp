@@ -1,5 +1,7 @@
 #include <glintbake/cli/pyramid_options.h>
 
+#include <glintbake/bake/ndf/flakes_section.h>
+
 #include <stdexcept>
 
 namespace glintbake::cli {
@@ -21,6 +23,9 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& r
           ->capture_default_str(),
       app.add_option("--rate", o.rate, "Flakes per texel side (1..16)")->capture_default_str(),
       app.add_option("--region", o.region_size, region_help)->capture_default_str(),
+      app.add_flag("!--no-flakes", p.flakes,
+                   "Leave out the flakes section (the normal map, float32) that answers footprints up to "
+                   "max(4, sigma0) texels exactly"),
   };
 }
 
@@ -53,7 +58,17 @@ Json pyramidOptionsJson(const PyramidCliOptions& p) {
   j["rate"] = o.rate;
   j["region"] = o.region_size;
   j["footprint_truncation"] = o.splat.footprint_truncation;
+  j["flakes"] = p.flakes;
   return j;
+}
+
+uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p) {
+  if (!p.flakes) return 0;
+  uint64_t bytes = 0;
+  const bake::Status s = bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r,
+                                                       bake::ndf::defaultHandover(p.options.sigma0), &bytes);
+  if (!s) throw Error(int(s.error().code), s.error().message);
+  return bytes;
 }
 
 void requireBakeableMap(const bake::NormalMap& map, const std::string& path) {

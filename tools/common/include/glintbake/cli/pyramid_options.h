@@ -6,6 +6,7 @@
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/tool.h>
+#include <glintbake/format/container.h>
 
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@ namespace glintbake::cli {
 struct PyramidCliOptions {
   bake::ndf::PyramidOptions options;
   std::string levels_text = "auto";  // "auto" or a positive integer; resolvePyramidOptions fills options.levels
+  bool flakes = true;                // write the flakes section (formats/SPEC.md 10.5); --no-flakes
   std::vector<CLI::Option*> flags;   // the registered options (to reject them where they do not apply)
 };
 
@@ -27,6 +29,10 @@ void resolvePyramidOptions(PyramidCliOptions& pyramid);
 
 // Canonical JSON form of the options (for provenance metadata and --json reports).
 Json pyramidOptionsJson(const PyramidCliOptions& pyramid);
+
+// Writes the flakes section of the map (unless --no-flakes) with the default hand-over for the
+// pyramid's sigma0; returns its raw size in bytes (0 when left out). Error exit 4 on failure.
+uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& pyramid);
 
 // Rejects maps too small to bake (exit 3, naming the file and its size).
 void requireBakeableMap(const bake::NormalMap& map, const std::string& path);
