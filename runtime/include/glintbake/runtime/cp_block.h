@@ -1,5 +1,6 @@
 // Constant-cost queries on CP-compressed angular NDF blocks (Deng et al. 2022, "Constant-Cost
-// Spatially-Varying Glints", sec. 4.3), the core that the tensor-ndf asset wraps.
+// Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG, sec. 4.3), the core that the
+// tensor-ndf asset wraps.
 //
 // A group holds K blocks of B x B bins as a rank-R CP model (bake/tensor/cp_decomposition.h):
 //     value(k, i, j) = sum_r A(i, r) B(j, r) C(k, r)        (bin column i, row j, block k)

@@ -1,6 +1,7 @@
 // Runtime-lite reader of tensor-ndf assets (written by tensorpack): the footprint pyramid of
 // ndf-pyramid assets with every NDF image cut into B x B angular blocks stored as rank-R CP models
-// per group (Deng et al. 2022, "Constant-Cost Spatially-Varying Glints", sec. 4). Layout:
+// per group (Deng et al. 2022, "Constant-Cost Spatio-Angular Prefiltering of Glinty Appearance
+// Using Tensor Decomposition", ACM TOG, sec. 4). Layout:
 // formats/SPEC.md section 10.4 and tensor_ndf_layout.h.
 //
 // Geometry and blending are exactly those of NdfPyramid (ndf_pyramid.h): level coordinate
