@@ -1,5 +1,5 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -133,7 +133,12 @@ LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions&
   return g;
 }
 
-Status WriterPyramidSink::addLevel(const runtime::NdfLevelRecord& record) {
+Status WriterPyramidSink::addLevel(const format::NdfLevelRecord& record) {
+  if (format::RecordCheck c = format::checkNdfLevelRecord(record, record.level, record.level > 0 ? &below_ : nullptr);
+      !c) {
+    return makeError(ErrorCode::kRuntime, std::string("level descriptor fails its check: ") + c.detail);
+  }
+  below_ = record;
   if (format::Status st = writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
       st != format::Status::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
@@ -142,7 +147,7 @@ Status WriterPyramidSink::addLevel(const runtime::NdfLevelRecord& record) {
 }
 
 Status WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
-  const uint64_t key = (uint64_t(chunk.level) << 32) | uint64_t(chunk.region);
+  const uint64_t key = format::ndfChunkKey(uint32_t(chunk.level), uint64_t(chunk.region));
   if (format::Status st = writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
       st != format::Status::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
@@ -268,7 +273,7 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
       return nullptr;
     };
 
-    runtime::NdfLevelRecord rec;
+    format::NdfLevelRecord rec;
     rec.level = uint32_t(level);
     rec.ndf_res = uint32_t(res);
     rec.grid_width = uint32_t(geo.grid_width);

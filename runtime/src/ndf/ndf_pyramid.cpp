@@ -13,8 +13,6 @@
 namespace glintbake::runtime {
 namespace {
 
-constexpr uint32_t kMaxResolution = 4096;
-constexpr uint32_t kMaxGridSide = 1u << 20;
 constexpr uint64_t kMaxTotalFloats = uint64_t(1) << 36;  // 256 GiB: beyond any sane asset
 
 struct Level {
@@ -30,8 +28,6 @@ struct Blend {
   const float* image[8];
   const double* prefix[8];
 };
-
-bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
 }  // namespace
 
@@ -71,19 +67,9 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     NdfLevelRecord rec;
     if (Status s = fromFormatStatus(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
     // Descriptor sanity: everything the queries index with is checked here.
-    if (rec.magic != NdfLevelRecord().magic) return Status::kInvalidAsset;
-    if (rec.version != 1) return Status::kUnsupportedVersion;
-    if (rec.level != uint32_t(l) || rec.ndf_res < 2 || rec.ndf_res > kMaxResolution) return Status::kInvalidAsset;
-    if (l > 0 && rec.ndf_res != uint32_t(res)) return Status::kInvalidAsset;
-    if (rec.grid_width < 1 || rec.grid_height < 1 || rec.grid_width > kMaxGridSide || rec.grid_height > kMaxGridSide)
-      return Status::kInvalidAsset;
-    if (rec.region_size < 1 || rec.regions_x != (rec.grid_width + rec.region_size - 1) / rec.region_size ||
-        rec.regions_y != (rec.grid_height + rec.region_size - 1) / rec.region_size)
-      return Status::kInvalidAsset;
-    if (rec.wrap > 1 || !finitePositive(rec.stride_x) || !finitePositive(rec.stride_y) ||
-        !std::isfinite(rec.origin_x) || !std::isfinite(rec.origin_y) || !finitePositive(rec.sigma_texels))
-      return Status::kInvalidAsset;
-    if (l > 0 && !(rec.sigma_texels > levels[l - 1].rec.sigma_texels)) return Status::kInvalidAsset;
+    if (Status s = fromRecordCheck(format::checkNdfLevelRecord(rec, uint32_t(l), l > 0 ? &levels[l - 1].rec : nullptr));
+        s != Status::kOk)
+      return s;
     res = int(rec.ndf_res);
     Level& lv = levels[l];
     lv.rec = rec;
@@ -98,7 +84,7 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
       for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
         const uint64_t region = uint64_t(ry) * rec.regions_x + rx;
-        const int cidx = reader.find(format::kSectionNdfChunk, (uint64_t(l) << 32) | region);
+        const int cidx = reader.find(format::kSectionNdfChunk, format::ndfChunkKey(uint32_t(l), region));
         if (cidx < 0) return Status::kInvalidAsset;
         const uint32_t cx0 = rx * rec.region_size, cy0 = ry * rec.region_size;
         const uint32_t cw = std::min(rec.region_size, rec.grid_width - cx0);

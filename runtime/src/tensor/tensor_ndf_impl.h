@@ -18,7 +18,6 @@ struct TensorNdf::Impl {
   struct Group {
     Array<float> data;  // A, B, C, A prefix, B prefix (float32)
     CpGroupView view;
-    uint32_t level = 0, region = 0;
   };
   struct TLevel {
     NdfLevelRecord rec;
@@ -42,9 +41,11 @@ struct TensorNdf::Impl {
   double inv_bin = 0.0;              // R / 2
   int level_count = 0;
   TLevel levels[kMaxNdfLevels];
+  NdfLevelRecord level_records[kMaxNdfLevels];  // levels[l].rec, contiguous for the record checks
   PyramidBlender blender;
   uint32_t group_count = 0;
   Array<Group> groups;
+  Array<TensorGroupHeader> group_headers;  // as stored, for the index-entry checks
   uint64_t blocks_kept = 0;
   uint64_t memory_bytes = 0;
 

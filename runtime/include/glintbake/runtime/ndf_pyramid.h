@@ -3,7 +3,8 @@
 // interpolation.
 //
 // Asset layout (formats/SPEC.md, "ndf-pyramid"):
-//  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord;
+//  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord
+//    (glintbake/format/kinds/ndf_pyramid.h, with its check);
 //  - one kSectionNdfChunk section per level and spatial region (key = l << 32 | region, region =
 //    ry * regions_x + rx) holding a format::ImageSectionHeader (width = height = R, channels = 1,
 //    layers = centres in the region) and the region's images, centres in row-major order within the
@@ -28,6 +29,7 @@
 // every size is checked against the container and against the descriptor before use.
 #pragma once
 
+#include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 
 #include <cstddef>
@@ -36,34 +38,9 @@
 
 namespace glintbake::runtime {
 
-// Level descriptor, stored as the raw bytes of this struct (little-endian, 112 bytes).
-struct NdfLevelRecord {
-  uint32_t magic = 0x4C444E47;  // "GNDL"
-  uint32_t version = 1;
-  uint32_t level = 0;
-  uint32_t ndf_res = 0;      // R: bins per side of every image
-  uint32_t grid_width = 0;   // footprint centres per row
-  uint32_t grid_height = 0;  // footprint centres per column
-  uint32_t region_size = 0;  // centres per side of a spatial region (chunk)
-  uint32_t regions_x = 0;    // ceil(grid_width / region_size)
-  uint32_t regions_y = 0;    // ceil(grid_height / region_size)
-  uint32_t wrap = 0;         // 0 = repeat, 1 = clamp
-  uint32_t map_width = 0;    // texels of the source map
-  uint32_t map_height = 0;
-  uint32_t rate = 1;  // flakes per texel side used to bake
-  uint32_t reserved = 0;
-  double stride_x = 0.0;  // texels between centres along x (= map_width / grid_width)
-  double stride_y = 0.0;  // texels between centres along y (= map_height / grid_height)
-  double origin_x = 0.0;  // position of centre (0, 0), texels (= stride / 2)
-  double origin_y = 0.0;
-  double sigma_texels = 0.0;  // footprint std of this level
-  double sigma_r = 0.0;       // intrinsic roughness used to bake
-  double reserved2 = 0.0;
-};
-static_assert(sizeof(NdfLevelRecord) == 112, "NdfLevelRecord is 112 bytes");
-
-// Most levels a pyramid may have.
-constexpr int kMaxNdfLevels = 32;
+// The level descriptor is the container's record (formats/SPEC.md 10.1, kinds/ndf_pyramid.h).
+using format::kMaxNdfLevels;
+using format::NdfLevelRecord;
 
 class NdfPyramid final : public NdfSource {
  public:
