@@ -26,7 +26,7 @@ class Bytes {
  private:
   Bytes& put(size_t at, const void* v, size_t n) {
     // The file is little-endian; so are the hosts this project builds on.
-    std::memcpy(&bytes_[at], v, n);
+    if (at + n <= bytes_.size()) std::memcpy(bytes_.data() + at, v, n);
     return *this;
   }
   std::vector<uint8_t> bytes_;

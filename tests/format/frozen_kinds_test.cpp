@@ -36,7 +36,9 @@ std::vector<uint8_t> section(const Reader& reader, uint32_t type, uint64_t key) 
   std::vector<uint8_t> bytes;
   const int index = reader.find(type, key);
   EXPECT_GE(index, 0) << "type " << type << " key " << key;
-  if (index >= 0) EXPECT_EQ(reader.readSection(size_t(index), &bytes), Status::kOk);
+  if (index >= 0) {
+    EXPECT_EQ(reader.readSection(size_t(index), &bytes), Status::kOk);
+  }
   return bytes;
 }
 

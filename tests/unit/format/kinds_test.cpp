@@ -53,7 +53,9 @@ TEST(KindRegistry, NamesRoundTrip) {
 TEST(KindRegistry, RangesAreDisjointAndOwned) {
   for (size_t i = 0; i < std::size(kSectionRanges); ++i) {
     EXPECT_LE(kSectionRanges[i].first, kSectionRanges[i].last);
-    if (i > 0) EXPECT_GT(kSectionRanges[i].first, kSectionRanges[i - 1].last);
+    if (i > 0) {
+      EXPECT_GT(kSectionRanges[i].first, kSectionRanges[i - 1].last);
+    }
   }
   for (const KindInfo& k : kKindRegistry) {
     if (k.last_type == 0) continue;
@@ -88,7 +90,9 @@ TEST(KindRegistry, SpecTablesAgree) {
       EXPECT_NE(line.find(" " + std::to_string(k.first_type) + "-" + std::to_string(k.last_type)), std::string::npos)
           << line;
     }
-    if (k.tool[0] != '\0') EXPECT_NE(line.find(std::string("| ") + k.tool + " |"), std::string::npos) << line;
+    if (k.tool[0] != '\0') {
+      EXPECT_NE(line.find(std::string("| ") + k.tool + " |"), std::string::npos) << line;
+    }
   }
   const std::string types = specSection(spec, "## 3. Section types");
   for (const SectionRange& r : kSectionRanges) {
