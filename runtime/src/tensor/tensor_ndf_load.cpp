@@ -124,7 +124,6 @@ Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uin
 }
 
 Status TensorNdf::Impl::load(const format::Reader& reader) {
-  if (reader.kind() != format::AssetKind::kTensorNdf) return Status::kWrongKind;
   Array<uint8_t> scratch;
   const int info_idx = reader.find(format::kSectionTensorInfo, 0);
   if (Status s = readExact(reader, info_idx, sizeof(TensorInfoRecord), &scratch); s != Status::kOk) return s;
@@ -154,7 +153,7 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
       return s;
   }
   level_count = int(info.level_count);
-  blender.init(levels, level_count);
+  blender.init(level_records, level_count);
 
   // Every group needs its own section, so the section count bounds the allocation.
   if (uint64_t(info.group_count) > reader.sections().size()) return Status::kInvalidAsset;
@@ -173,11 +172,7 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
 TensorNdf::TensorNdf() = default;
 TensorNdf::~TensorNdf() = default;
 
-Status TensorNdf::open(const char* path) {
-  impl_.reset();
-  if (!path) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
+Status TensorNdf::loadKind(const format::Reader& reader) {
   std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
   if (!impl) return Status::kOutOfMemory;
   if (Status s = impl->load(reader); s != Status::kOk) return s;
@@ -185,30 +180,18 @@ Status TensorNdf::open(const char* path) {
   return Status::kOk;
 }
 
-Status TensorNdf::openMemory(const void* data, size_t size) {
-  impl_.reset();
-  if (!data) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
-  std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->load(reader); s != Status::kOk) return s;
-  impl_ = std::move(impl);
-  return Status::kOk;
+void TensorNdf::reset() { impl_.reset(); }
+
+const NdfLevelRecord* TensorNdf::levelRecords(int* count) const {
+  if (!impl_) return nullptr;
+  *count = impl_->level_count;
+  return impl_->level_records;
 }
 
-bool TensorNdf::isOpen() const { return impl_ != nullptr; }
-int TensorNdf::resolution() const { return impl_ ? impl_->res : 0; }
-int TensorNdf::levelCount() const { return impl_ ? impl_->level_count : 0; }
 const TensorInfoRecord* TensorNdf::info() const { return impl_ ? &impl_->info : nullptr; }
 int TensorNdf::groupCount() const { return impl_ ? int(impl_->group_count) : 0; }
 uint64_t TensorNdf::blocksKept() const { return impl_ ? impl_->blocks_kept : 0; }
 uint64_t TensorNdf::memoryBytes() const { return impl_ ? impl_->memory_bytes : 0; }
-
-const NdfLevelRecord* TensorNdf::level(int l) const {
-  if (!impl_ || l < 0 || l >= impl_->level_count) return nullptr;
-  return &impl_->levels[l].rec;
-}
 
 const CpGroupView* TensorNdf::group(int g) const {
   if (!impl_ || g < 0 || uint32_t(g) >= impl_->group_count) return nullptr;

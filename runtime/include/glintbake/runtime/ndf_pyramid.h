@@ -31,6 +31,7 @@
 
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/pyramid_ndf.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -38,46 +39,41 @@
 
 namespace glintbake::runtime {
 
-// The level descriptor is the container's record (formats/SPEC.md 10.1, kinds/ndf_pyramid.h).
-using format::kMaxNdfLevels;
-using format::NdfLevelRecord;
-
-class NdfPyramid final : public NdfSource {
+class NdfPyramid : public PyramidNdf {
  public:
   NdfPyramid();
   ~NdfPyramid() override;
   NdfPyramid(const NdfPyramid&) = delete;
   NdfPyramid& operator=(const NdfPyramid&) = delete;
 
-  // Loads an ndf-pyramid container (all images). kIoError, kInvalidAsset, kWrongKind,
-  // kUnsupportedVersion, kOutOfMemory. Safe on untrusted input.
-  Status open(const char* path);
-  // Same, from a caller buffer (only needed during the call).
-  Status openMemory(const void* data, size_t size);
-  bool isOpen() const;
+  // open(), openMemory(), load(), isOpen(), levelCount(), level() and the argument checks of the
+  // queries: pyramid_ndf.h. open() loads all images.
+  format::AssetKind kind() const override { return format::AssetKind::kNdfPyramid; }
 
-  int resolution() const override;  // R
-  int levelCount() const;
-  // Descriptor of level l in [0, levelCount()), or null.
-  const NdfLevelRecord* level(int l) const;
   // Stored image of centre (i, j) of level l (R * R floats), or null when out of range.
   const float* centreImage(int l, int i, int j) const;
 
-  // Value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  // Exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2 count as 0).
-  // Cost grows with the number of bins the rectangle covers.
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  // Samples s from the blended P-NDF with two uniforms in [0, 1); sample->pdf == pdf(footprint, s).
-  // kInvalidArgument if the blend has no mass.
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  // Density of sample(): eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for
-  // footprints away from the edges of clamp maps, so pdf == eval there).
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  // Total mass of the blend (integral over the s-plane).
-  Status mass(const Footprint& footprint, double* value) const override;
-  // The blended image the runtime sees: out must hold R * R floats (out_count >= R * R).
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+ protected:
+  Status loadKind(const format::Reader& reader) override;
+  void reset() override;
+  bool loaded() const override { return impl_ != nullptr; }
+  const NdfLevelRecord* levelRecords(int* count) const override;
+
+  // eval: value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
+  // average: exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2
+  // count as 0); cost grows with the number of bins the rectangle covers.
+  // sample: s from the blended P-NDF; sample->pdf == pdf(footprint, s); kInvalidArgument if the
+  // blend has no mass.
+  // pdf: eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for footprints away from
+  // the edges of clamp maps, so pdf == eval there).
+  // mass: total mass of the blend (integral over the s-plane).
+  // image: the blended image the runtime sees (R * R floats).
+  Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status massChecked(const Footprint& footprint, double* value) const override;
+  Status imageChecked(const Footprint& footprint, float* out) const override;
 
  private:
   struct Impl;
