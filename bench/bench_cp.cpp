@@ -1,6 +1,6 @@
 // CP tensor compression and its runtime queries: one sweep against the GEMM-bound floor, full
 // decompositions per method (time and error), and blended point / range / sample latency.
-// Targets (algorithms.md sec. 2, issue 4): sweep on 32x32x2048 rank 16 within 1.3x of the floor
+// Targets: sweep on 32x32x2048 rank 16 within 1.3x of the floor
 // (about 2.0-2.5 ms); default method at most 1/5 of the time of 500 plain sweeps at an error within
 // 1%; queries on an 8-way blend at rank 16: point 150 ns, range 300 ns, sample 1.5 us.
 #include <glintbake/bake/tensor/cp_decomposition.h>

@@ -1,9 +1,9 @@
-// Stable names of status codes, asset kinds and codecs (used in messages, JSON and metadata), and
-// the magic test.
+// Stable names of status codes, asset kinds, section types and codecs (used in messages, JSON and
+// metadata; kind and type names come from the registry, kinds.h), and the magic test.
 #include "layout.h"
 
 #include <glintbake/format/container.h>
-#include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/kinds.h>
 
 #include <cstring>
 #include <string>
@@ -40,31 +40,13 @@ const char* statusString(Status status) {
   return "unknown status";
 }
 
-namespace {
-
-struct KindName {
-  AssetKind kind;
-  const char* name;
-};
-
-constexpr KindName kKindNames[] = {
-    {AssetKind::kNdfPyramid, "ndf-pyramid"}, {AssetKind::kTensorNdf, "tensor-ndf"},
-    {AssetKind::kLtcTable, "ltc-table"},     {AssetKind::kRoughness, "roughness"},
-    {AssetKind::kWangTiles, "wang-tiles"},   {AssetKind::kTinyExample, "tiny-example"},
-    {AssetKind::kGlitter, "glitter"},        {AssetKind::kTest, "test"},
-};
-
-}  // namespace
-
 const char* assetKindString(AssetKind kind) {
-  for (const KindName& entry : kKindNames) {
-    if (entry.kind == kind) return entry.name;
-  }
-  return "unknown";
+  const KindInfo* entry = findKind(kind);
+  return entry ? entry->name : "unknown";
 }
 
 bool assetKindFromString(const std::string& name, AssetKind* kind) {
-  for (const KindName& entry : kKindNames) {
+  for (const KindInfo& entry : kKindRegistry) {
     if (name == entry.name) {
       if (kind) *kind = entry.kind;
       return true;
@@ -83,31 +65,15 @@ const char* codecString(Codec codec) {
   return "unknown";
 }
 
-namespace {
-
-struct TypeName {
-  uint32_t type;
-  const char* name;
-};
-
-constexpr TypeName kTypeNames[] = {
-    {kSectionMetadata, "metadata"},        {kSectionNdfLevel, "ndf-level"},     {kSectionNdfChunk, "ndf-chunk"},
-    {kSectionTensorIndex, "tensor-index"}, {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
-    {kSectionLtcTable, "ltc-table"},       {kSectionRoughness, "roughness"},    {kSectionFlakes, "flakes"},
-    {kSectionImage, "image"},
-};
-
-}  // namespace
-
 const char* sectionTypeString(uint32_t type) {
-  for (const TypeName& entry : kTypeNames) {
+  for (const SectionTypeInfo& entry : kSectionTypeRegistry) {
     if (entry.type == type) return entry.name;
   }
   return type >= kSectionFirstPrivate ? "private" : "unknown";
 }
 
 bool sectionTypeFromString(const std::string& name, uint32_t* type) {
-  for (const TypeName& entry : kTypeNames) {
+  for (const SectionTypeInfo& entry : kSectionTypeRegistry) {
     if (name == entry.name) {
       if (type) *type = entry.type;
       return true;

@@ -1,5 +1,6 @@
 // validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
 // its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
+#include <glintbake/format/kinds.h>
 #include <glintbake/format/validate.h>
 #include <glintbake/format/kinds/flakes.h>
 
@@ -41,36 +42,14 @@ void addWarning(std::vector<ValidationMessage>* messages, int id, std::string me
   messages->push_back({id, Severity::kWarning, std::move(message)});
 }
 
-// Section types of the registry in SPEC.md ("Section types").
-bool isRegisteredType(uint32_t type) {
-  return type == kSectionMetadata || type == kSectionNdfLevel || type == kSectionNdfChunk ||
-         (type >= kSectionTensorIndex && type < kSectionRoughness + 16) || type == kSectionFlakes ||
-         type == kSectionImage ||
-         type >= kSectionFirstPrivate;
-}
-
-// The range of section types owned by an asset kind, if it has one.
+// The range of section types owned by an asset kind that a tool writes (kinds.h): such an asset
+// must hold at least one of them.
 bool kindTypeRange(AssetKind kind, uint32_t* first, uint32_t* last) {
-  switch (kind) {
-    case AssetKind::kNdfPyramid:
-      *first = kSectionNdfLevel;
-      *last = kSectionNdfChunk;
-      return true;
-    case AssetKind::kTensorNdf:
-      *first = kSectionTensorIndex;
-      *last = kSectionTensorIndex + 15;
-      return true;
-    case AssetKind::kLtcTable:
-      *first = kSectionLtcTable;
-      *last = kSectionLtcTable + 15;
-      return true;
-    case AssetKind::kRoughness:
-      *first = kSectionRoughness;
-      *last = kSectionRoughness + 15;
-      return true;
-    default:
-      return false;
-  }
+  const KindInfo* info = findKind(kind);
+  if (!info || info->tool[0] == '\0' || info->last_type == 0) return false;
+  *first = info->first_type;
+  *last = info->last_type;
+  return true;
 }
 
 std::string describe(size_t index, const SectionInfo& s) {
@@ -235,8 +214,7 @@ void validateMetadata(const std::string& text, AssetKind kind, std::vector<Valid
   auto asset_kind = doc.find("asset_kind");
   if (asset_kind == doc.end() || !asset_kind->is_string()) {
     addError(messages, 5006, "metadata \"asset_kind\" is missing or not a string");
-  } else if (std::strcmp(assetKindString(kind), "unknown") != 0 &&
-             asset_kind->get<std::string>() != assetKindString(kind)) {
+  } else if (findKind(kind) != nullptr && asset_kind->get<std::string>() != assetKindString(kind)) {
     addError(messages, 5007,
              "metadata asset_kind \"" + asset_kind->get<std::string>() + "\" does not match the header's \"" +
                  assetKindString(kind) + "\"");
@@ -336,7 +314,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   std::vector<bool> readable(sections.size(), false);
   for (size_t i = 0; i < sections.size(); ++i) {
     const SectionInfo& s = sections[i];
-    if (!isRegisteredType(s.type)) {
+    if (!isRegisteredSectionType(s.type)) {
       addWarning(&report.messages, 3011, describe(i, s) + ": unknown section type, skipped by readers");
     }
     const bool known_codec = s.codec == uint32_t(Codec::kRaw) || s.codec == uint32_t(Codec::kZstd);
@@ -388,7 +366,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   }
 
   // 6xxx: kind-specific.
-  if (std::strcmp(assetKindString(kind), "unknown") == 0) {
+  if (findKind(kind) == nullptr) {
     addWarning(&report.messages, 6001,
                "asset kind " + std::to_string(parsed.header.asset_kind) + " is not known to this version");
   }

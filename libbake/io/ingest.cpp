@@ -1,6 +1,6 @@
 // Reading normal maps and height fields from image files through OpenImageIO.
 //
-// Decoding follows algorithms.md section 1: integer files store n = 2 c / max - 1; float files are
+// Decoding: integer files store n = 2 c / max - 1; float files are
 // either signed ([-1, 1]) or encoded like integers ([0, 1]), told apart by the presence of negative
 // values unless the caller forces an encoding. Height fields become normals by central differences
 // with the map's wrap mode.

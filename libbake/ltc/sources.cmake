@@ -9,5 +9,6 @@ list(APPEND GLINTBAKE_BAKE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/table_io.cpp
   ${CMAKE_CURRENT_LIST_DIR}/exr_writer.cpp
   ${CMAKE_CURRENT_LIST_DIR}/multiscale.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/roughness.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/roughness.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/sections.cpp)
 list(APPEND GLINTBAKE_BAKE_DEPS Ceres::ceres OpenEXR::OpenEXR)

@@ -1,5 +1,5 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/format/kinds/ndf_pyramid_blend.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -35,7 +35,7 @@ double relativeMse(const float* a, const double* b, size_t n) {
 }
 
 // A convergence sample: one centre of a level and the runtime's prediction of its image from the
-// level below (the bilinear blend of up to 4 centres of that level, as NdfPyramid blends them).
+// level below (the bilinear blend of up to 4 centres of that level, format::NdfPyramidBlend).
 struct Sample {
   int centre = 0;                   // index j * grid_width + i on its own level
   int below[4] = {-1, -1, -1, -1};  // centres of the level below
@@ -43,31 +43,35 @@ struct Sample {
   std::vector<double> prediction;  // R * R, accumulated while the level below is written
 };
 
-// Bilinear neighbours along one axis, with the runtime's wrap rules (ndf_pyramid.h).
-void axisNeighbours(double pos, double size, double stride, int n, Wrap wrap, int* i0, int* i1, double* f) {
-  const double g = (pos - 0.5 * stride) / stride;
-  if (wrap == Wrap::kRepeat) {
-    const double fl = std::floor(g);
-    *f = g - fl;
-    *i0 = ((int(fl) % n) + n) % n;
-    *i1 = (*i0 + 1) % n;
-  } else if (!(g > 0.0)) {
-    *i0 = *i1 = 0;
-    *f = 0.0;
-  } else if (g >= double(n - 1)) {
-    *i0 = *i1 = n - 1;
-    *f = 0.0;
-  } else {
-    *i0 = int(std::floor(g));
-    *i1 = *i0 + 1;
-    *f = g - std::floor(g);
-  }
-  (void)size;
+// The level record of level `level` (its geometry from levelGeometry).
+format::NdfLevelRecord levelRecord(const NormalMap& map, const PyramidOptions& options, int level,
+                                   const LevelGeometry& geo) {
+  format::NdfLevelRecord rec;
+  rec.level = uint32_t(level);
+  rec.ndf_res = uint32_t(options.splat.ndf_res);
+  rec.grid_width = uint32_t(geo.grid_width);
+  rec.grid_height = uint32_t(geo.grid_height);
+  rec.region_size = uint32_t(options.region_size);
+  rec.regions_x = uint32_t(geo.regions_x);
+  rec.regions_y = uint32_t(geo.regions_y);
+  rec.wrap = map.wrap == Wrap::kRepeat ? 0u : 1u;
+  rec.map_width = uint32_t(map.width);
+  rec.map_height = uint32_t(map.height);
+  rec.rate = uint32_t(options.rate);
+  rec.stride_x = geo.stride_x;
+  rec.stride_y = geo.stride_y;
+  rec.origin_x = 0.5 * geo.stride_x;
+  rec.origin_y = 0.5 * geo.stride_y;
+  rec.sigma_texels = geo.sigma;
+  rec.sigma_r = options.splat.sigma_r;
+  return rec;
 }
 
 // Up to kConvergenceSamplesPerAxis^2 evenly spread centres of level `geo`, with their neighbours
-// on the level below (`below`).
-std::vector<Sample> planSamples(const LevelGeometry& geo, const LevelGeometry& below, Wrap wrap, size_t image_floats) {
+// on the level below (`below`), weighted as the runtime's footprint blend weighs them.
+std::vector<Sample> planSamples(const LevelGeometry& geo, const format::NdfLevelRecord& below, size_t image_floats) {
+  format::NdfPyramidBlend blend;
+  blend.init(&below, 1);
   int nsx = std::min(geo.grid_width, kConvergenceSamplesPerAxis);
   int nsy = std::min(geo.grid_height, kConvergenceSamplesPerAxis);
   // At most a quarter of the level's centres (at least one): the level is probed before it is
@@ -85,16 +89,13 @@ std::vector<Sample> planSamples(const LevelGeometry& geo, const LevelGeometry& b
     const int i = int((k % nsx + 0.5) * geo.grid_width / nsx);
     const int j = int((k / nsx + 0.5) * geo.grid_height / nsy);
     s.centre = j * geo.grid_width + i;
-    int x0, x1, y0, y1;
-    double fx, fy;
-    axisNeighbours((i + 0.5) * geo.stride_x, 0, below.stride_x, below.grid_width, wrap, &x0, &x1, &fx);
-    axisNeighbours((j + 0.5) * geo.stride_y, 0, below.stride_y, below.grid_height, wrap, &y0, &y1, &fy);
-    const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-    const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-    for (int q = 0; q < 4; ++q) {
-      s.below[q] = ys[q] * below.grid_width + xs[q];
-      s.weight[q] = ws[q];
-    }
+    int q = 0;
+    auto emit = [&](int, size_t centre, double weight) {
+      s.below[q] = int(centre);
+      s.weight[q] = weight;
+      ++q;
+    };
+    blend.blendLevel(0, 1.0, (i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, emit);
     s.prediction.assign(image_floats, 0.0);
   }
   return samples;
@@ -133,7 +134,12 @@ LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions&
   return g;
 }
 
-Status WriterPyramidSink::addLevel(const runtime::NdfLevelRecord& record) {
+Status WriterPyramidSink::addLevel(const format::NdfLevelRecord& record) {
+  if (format::RecordCheck c = format::checkNdfLevelRecord(record, record.level, record.level > 0 ? &below_ : nullptr);
+      !c) {
+    return makeError(ErrorCode::kRuntime, std::string("level descriptor fails its check: ") + c.detail);
+  }
+  below_ = record;
   if (format::Status st = writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
       st != format::Status::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
@@ -142,7 +148,7 @@ Status WriterPyramidSink::addLevel(const runtime::NdfLevelRecord& record) {
 }
 
 Status WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
-  const uint64_t key = (uint64_t(chunk.level) << 32) | uint64_t(chunk.region);
+  const uint64_t key = format::ndfChunkKey(uint32_t(chunk.level), uint64_t(chunk.region));
   if (format::Status st = writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
       st != format::Status::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
@@ -203,7 +209,8 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
     // runtime makes from the level below (bilinear blend of that level's images, collected while it
     // was written). Samples of the NEXT level: collect the prediction from this level's images.
     std::vector<Sample> samples = std::move(next_samples);
-    next_samples = planSamples(levelGeometry(map.width, map.height, options, level + 1), geo, map.wrap, image_floats);
+    const format::NdfLevelRecord rec = levelRecord(map, options, level, geo);
+    next_samples = planSamples(levelGeometry(map.width, map.height, options, level + 1), rec, image_floats);
     double mse_sum = 0.0;
 
     // Footprints with very many flakes (the top levels: few images, each costing up to several
@@ -268,24 +275,6 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, Pyra
       return nullptr;
     };
 
-    runtime::NdfLevelRecord rec;
-    rec.level = uint32_t(level);
-    rec.ndf_res = uint32_t(res);
-    rec.grid_width = uint32_t(geo.grid_width);
-    rec.grid_height = uint32_t(geo.grid_height);
-    rec.region_size = uint32_t(options.region_size);
-    rec.regions_x = uint32_t(geo.regions_x);
-    rec.regions_y = uint32_t(geo.regions_y);
-    rec.wrap = map.wrap == Wrap::kRepeat ? 0u : 1u;
-    rec.map_width = uint32_t(map.width);
-    rec.map_height = uint32_t(map.height);
-    rec.rate = uint32_t(options.rate);
-    rec.stride_x = geo.stride_x;
-    rec.stride_y = geo.stride_y;
-    rec.origin_x = 0.5 * geo.stride_x;
-    rec.origin_y = 0.5 * geo.stride_y;
-    rec.sigma_texels = geo.sigma;
-    rec.sigma_r = options.splat.sigma_r;
     if (Status s = sink.addLevel(rec); !s) return s;
 
     const int region_count = geo.regions_x * geo.regions_y;

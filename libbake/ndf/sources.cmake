@@ -4,5 +4,3 @@ list(APPEND GLINTBAKE_BAKE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/splat.cpp
   ${CMAKE_CURRENT_LIST_DIR}/pyramid_builder.cpp
   ${CMAKE_CURRENT_LIST_DIR}/flakes_section.cpp)
-# The pyramid's level descriptor is the runtime's binary struct (runtime/ndf_pyramid.h).
-list(APPEND GLINTBAKE_BAKE_DEPS glintbake::runtime)

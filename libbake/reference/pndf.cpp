@@ -15,7 +15,7 @@ constexpr double kTwoPi = 6.283185307179586476925286766559;
 FlakeLobe flakeLobe(const FlakeSet& set, const Flake& flake, double ux, double uy, const Footprint& fp,
                     double sigma_r) {
   // Yan et al. 2016: the product of the footprint Gaussian and the flake's 4D Gaussian, integrated
-  // over u, is a spatial Gaussian in u_k times a normal Gaussian in s (algorithm notes, section 1).
+  // over u, is a spatial Gaussian in u_k times a normal Gaussian in s (closed form in pndf.h).
   const double sh2 = set.sigma_h * set.sigma_h;
   const double sp2 = fp.sigma * fp.sigma;
   const double v = sh2 + sp2;

@@ -8,7 +8,9 @@ namespace glintbake::bake::render {
 
 using runtime::Status;
 
-ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r) {
+ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r)
+    : map_size_{flakes.width, flakes.height},
+      wrap_(flakes.wrap == bake::Wrap::kRepeat ? runtime::MapWrap::kRepeat : runtime::MapWrap::kClamp) {
   reference::Footprint fp;
   fp.x = footprint.x;
   fp.y = footprint.y;
@@ -35,6 +37,12 @@ double ReferencePndf::evalSum(double sx, double sy) const {
   double sum = 0.0;
   for (const Lobe& l : lobes_) sum += reference::lobeDensity(l.lobe, sx, sy);
   return sum;
+}
+
+runtime::FootprintRange ReferencePndf::footprintRange() const {
+  runtime::FootprintRange range;
+  range.exact_max_sigma = std::numeric_limits<double>::infinity();
+  return range;
 }
 
 Status ReferencePndf::eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {

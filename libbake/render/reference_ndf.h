@@ -13,6 +13,7 @@
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/ndf_source.h>
 
+#include <limits>
 #include <vector>
 
 namespace glintbake::bake::render {
@@ -21,7 +22,12 @@ class ReferencePndf final : public runtime::NdfSource {
  public:
   ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r);
 
+  // Not a container asset: kind kUnknown; every footprint is answered exactly.
+  format::AssetKind kind() const override { return format::AssetKind::kUnknown; }
   int resolution() const override { return 0; }
+  runtime::FootprintRange footprintRange() const override;
+  runtime::MapSize mapSize() const override { return map_size_; }
+  runtime::MapWrap wrap() const override { return wrap_; }
   runtime::Status eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
   runtime::Status average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const override;
   runtime::Status sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const override;
@@ -39,6 +45,8 @@ class ReferencePndf final : public runtime::NdfSource {
   std::vector<Lobe> lobes_;
   std::vector<double> cdf_;  // running weight sums
   double total_ = 0.0;
+  runtime::MapSize map_size_;
+  runtime::MapWrap wrap_ = runtime::MapWrap::kRepeat;
   double evalSum(double sx, double sy) const;
 };
 

@@ -1,7 +1,7 @@
 // Entry points of the tensor-ndf packer: option checks, packing while the pyramid is built from a
 // normal map, and packing an ndf-pyramid container chunk by chunk.
 #include <glintbake/bake/tensor/tensor_pack.h>
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
 
 #include "tensor/tensor_pack_internal.h"
 
@@ -39,26 +39,15 @@ Error readError(const std::string& what, format::Status st) {
   return makeError(code, "cannot read " + what + ": " + format::statusString(st));
 }
 
-// Checks a level record read from an untrusted container against itself and level 0.
-Status checkLevelRecord(const runtime::NdfLevelRecord& rec, int level, int first_res) {
+// Checks a level record read from an untrusted container (the format's record check, against the
+// level below), plus the packer's own limits on the grid and the region.
+Status checkLevelRecord(const format::NdfLevelRecord& rec, int level, const format::NdfLevelRecord* below) {
   const std::string where = "ndf-level " + std::to_string(level) + ": ";
-  if (rec.magic != runtime::NdfLevelRecord{}.magic || rec.version != 1) return invalid(where + "bad magic or version");
-  if (rec.level != uint32_t(level)) return invalid(where + "key and level field disagree");
-  if (rec.ndf_res < 2 || rec.ndf_res > 4096) return invalid(where + "NDF resolution out of range");
-  if (first_res > 0 && int(rec.ndf_res) != first_res) return invalid(where + "NDF resolution differs from level 0");
-  if (rec.grid_width < 1 || rec.grid_height < 1 || uint64_t(rec.grid_width) * rec.grid_height > (uint64_t(1) << 26)) {
+  if (format::RecordCheck c = format::checkNdfLevelRecord(rec, uint32_t(level), below); !c)
+    return invalid(where + c.detail);
+  if (uint64_t(rec.grid_width) * rec.grid_height > (uint64_t(1) << 26))
     return invalid(where + "centre grid out of range");
-  }
-  if (rec.region_size < 1 || rec.region_size > 256 ||
-      rec.regions_x != (rec.grid_width + rec.region_size - 1) / rec.region_size ||
-      rec.regions_y != (rec.grid_height + rec.region_size - 1) / rec.region_size) {
-    return invalid(where + "region layout inconsistent with the grid");
-  }
-  if (rec.wrap > 1) return invalid(where + "unknown wrap mode");
-  const double values[] = {rec.stride_x, rec.stride_y, rec.origin_x, rec.origin_y, rec.sigma_texels, rec.sigma_r};
-  for (double v : values) {
-    if (!std::isfinite(v)) return invalid(where + "non-finite geometry");
-  }
+  if (rec.region_size > 256) return invalid(where + "region layout inconsistent with the grid");
   return okStatus();
 }
 
@@ -115,23 +104,24 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
     detail::TensorPackSink sink(writer, options, rep, cancel);
     std::vector<uint8_t> bytes;
     std::vector<float> chunk_buffer;
-    int first_res = 0;
+    format::NdfLevelRecord below;
     int level = 0;
     for (;; ++level) {
       const int li = reader.find(format::kSectionNdfLevel, uint64_t(level));
       if (li < 0) break;
       if (level >= ndf::kMaxPyramidLevels)
         return invalid("more than " + std::to_string(ndf::kMaxPyramidLevels) + " levels");
-      if (reader.sections()[size_t(li)].raw_size != sizeof(runtime::NdfLevelRecord)) {
+      if (reader.sections()[size_t(li)].raw_size != sizeof(format::NdfLevelRecord)) {
         return invalid("ndf-level " + std::to_string(level) + ": wrong section size");
       }
       if (format::Status st = reader.readSection(size_t(li), &bytes); st != format::Status::kOk) {
         return readError("ndf-level " + std::to_string(level), st);
       }
-      runtime::NdfLevelRecord rec;
+      format::NdfLevelRecord rec;
       std::memcpy(&rec, bytes.data(), sizeof(rec));
-      if (Status s = checkLevelRecord(rec, level, first_res); !s) return s;
-      first_res = int(rec.ndf_res);
+      if (Status s = checkLevelRecord(rec, level, level > 0 ? &below : nullptr); !s) return s;
+      below = rec;
+      const int first_res = int(rec.ndf_res);
       if (first_res % options.block != 0) {
         return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options.block) +
                                                       " must divide the pyramid's NDF resolution " +
@@ -152,7 +142,7 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
         chunk.height = std::min(int(rec.region_size), int(rec.grid_height) - chunk.y0);
         chunk.ndf_res = int(rec.ndf_res);
         const std::string what = "ndf-chunk " + std::to_string(r) + " of level " + std::to_string(level);
-        const int ci = reader.find(format::kSectionNdfChunk, (uint64_t(level) << 32) | uint64_t(r));
+        const int ci = reader.find(format::kSectionNdfChunk, format::ndfChunkKey(uint32_t(level), uint64_t(r)));
         if (ci < 0) return invalid("missing " + what);
         const size_t layers = size_t(chunk.width) * size_t(chunk.height);
         const size_t expected = sizeof(format::ImageSectionHeader) + layers * image_floats * sizeof(float);

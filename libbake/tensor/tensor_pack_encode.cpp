@@ -11,47 +11,6 @@
 
 namespace glintbake::bake::tensor {
 
-uint16_t floatToHalf(float value) {
-  uint32_t x;
-  std::memcpy(&x, &value, sizeof(x));
-  const uint32_t sign = (x >> 16) & 0x8000u;
-  const uint32_t mag = x & 0x7FFFFFFFu;
-  if (mag >= 0x7F800000u) return uint16_t(sign | (mag > 0x7F800000u ? 0x7E00u : 0x7C00u));  // NaN, infinity
-  if (mag >= 0x477FF000u) return uint16_t(sign | 0x7C00u);  // >= 65520 rounds to infinity
-  if (mag < 0x38800000u) {
-    // Below 2^-14: a subnormal half, an integer multiple of 2^-24. Scaling by 2^24 is exact, and
-    // nearbyint rounds half to even in the default rounding mode.
-    float magnitude;
-    std::memcpy(&magnitude, &mag, sizeof(magnitude));
-    return uint16_t(sign | uint32_t(std::nearbyint(magnitude * 16777216.0f)));
-  }
-  // Normal: rebias the exponent, keep 10 mantissa bits, round the 13 dropped bits to nearest even
-  // (a carry out of the mantissa correctly bumps the exponent).
-  uint32_t h = (((mag >> 23) - 127u + 15u) << 10) | ((mag & 0x7FFFFFu) >> 13);
-  const uint32_t rest = mag & 0x1FFFu;
-  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
-  return uint16_t(sign | h);
-}
-
-float halfToFloat(uint16_t bits) {
-  const uint32_t sign = uint32_t(bits & 0x8000u) << 16;
-  const uint32_t e = (bits >> 10) & 0x1Fu;
-  const uint32_t m = bits & 0x3FFu;
-  uint32_t x;
-  if (e == 0) {
-    const float v = float(m) * (1.0f / 16777216.0f);  // subnormal or zero, exact
-    std::memcpy(&x, &v, sizeof(x));
-    x |= sign;
-  } else if (e == 31) {
-    x = sign | 0x7F800000u | (m << 13);
-  } else {
-    x = sign | ((e - 15u + 127u) << 23) | (m << 13);
-  }
-  float out;
-  std::memcpy(&out, &x, sizeof(out));
-  return out;
-}
-
 namespace detail {
 namespace {
 
@@ -149,9 +108,7 @@ void retryDeadColumns(const GroupTensor& tensor, const CpOptions& options, CpFac
 }  // namespace
 
 size_t groupSectionBytes(int bins, int rank, int blocks, int precision) {
-  const size_t e = precision == 1 ? 2 : 4;
-  return sizeof(runtime::TensorGroupHeader) + e * size_t(2 * bins + blocks) * size_t(rank) +
-         4 * 2 * size_t(bins + 1) * size_t(rank);
+  return size_t(format::tensorGroupSectionBytes(uint64_t(bins), uint64_t(rank), uint64_t(blocks), uint32_t(precision)));
 }
 
 Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options) {
@@ -168,7 +125,7 @@ Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int reg
   EncodedGroup g;
   g.rank = rank;
   g.section.reserve(groupSectionBytes(bins, rank, blocks, options.precision));
-  runtime::TensorGroupHeader header;
+  format::TensorGroupHeader header;
   header.bins = uint32_t(bins);
   header.rank = uint32_t(rank);
   header.blocks = uint32_t(blocks);

@@ -4,7 +4,7 @@
 
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
-#include <glintbake/runtime/tensor_ndf_layout.h>
+#include <glintbake/format/kinds/tensor_ndf.h>
 
 #include <tbb/task_group.h>
 
@@ -46,7 +46,7 @@ class TensorPackSink final : public ndf::PyramidSink {
                  const std::atomic<bool>* cancel);
   ~TensorPackSink() override;
 
-  Status addLevel(const runtime::NdfLevelRecord& record) override;
+  Status addLevel(const format::NdfLevelRecord& record) override;
   Status addChunk(const ndf::PyramidChunk& chunk) override;
   Status endLevel(int level) override;
   uint64_t storedBytes() const override { return writer_.bytesWritten(); }
@@ -76,9 +76,10 @@ class TensorPackSink final : public ndf::PyramidSink {
   int ndf_res_ = 0;
   int blocks_per_side_ = 0;
   int level_ = -1;
+  format::NdfLevelRecord below_;  // the last level added (when level_ >= 0)
   int grid_width_ = 0, grid_height_ = 0;
   uint64_t level_bytes_before_ = 0;
-  std::vector<runtime::TensorIndexEntry> index_;  // of the current level
+  std::vector<format::TensorIndexEntry> index_;  // of the current level
   uint32_t next_group_ = 0;
   std::deque<std::unique_ptr<Pending>> pending_;
   double seconds_inside_ = 0.0;

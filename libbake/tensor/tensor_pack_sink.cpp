@@ -3,7 +3,7 @@
 // the level indexes and the info record in a fixed order.
 #include "tensor/tensor_pack_internal.h"
 
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
 
 #include <tbb/task_arena.h>
 
@@ -57,7 +57,7 @@ Status TensorPackSink::writeSection(uint32_t type, uint64_t key, const void* dat
   return okStatus();
 }
 
-Status TensorPackSink::addLevel(const runtime::NdfLevelRecord& record) {
+Status TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   ScopedTimer inside(seconds_inside_);
   if (cancel_ && cancel_->load(std::memory_order_relaxed)) return cancelledError();
   const int res = int(record.ndf_res);
@@ -74,13 +74,17 @@ Status TensorPackSink::addLevel(const runtime::NdfLevelRecord& record) {
     return makeError(ErrorCode::kInvalidInput,
                      "level " + std::to_string(record.level) + " has a different NDF resolution than level 0");
   }
+  if (format::RecordCheck c = format::checkNdfLevelRecord(record, record.level, level_ >= 0 ? &below_ : nullptr); !c) {
+    return makeError(ErrorCode::kRuntime, std::string("level descriptor fails its check: ") + c.detail);
+  }
+  below_ = record;
   level_ = int(record.level);
   grid_width_ = int(record.grid_width);
   grid_height_ = int(record.grid_height);
   level_bytes_before_ = writer_.bytesWritten();
   try {
     index_.assign(size_t(grid_width_) * size_t(grid_height_) * size_t(blocks_per_side_) * size_t(blocks_per_side_),
-                  runtime::TensorIndexEntry{});
+                  format::TensorIndexEntry{});
   } catch (const std::bad_alloc&) {
     return makeError(ErrorCode::kRuntime, "out of memory allocating the index of level " + std::to_string(level_));
   }
@@ -157,7 +161,7 @@ Status TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
         std::memcpy(dst + size_t(j) * bins, image + size_t(by * bins + j) * size_t(res) + size_t(bx * bins),
                     size_t(bins) * sizeof(float));
       }
-      index_[centre * size_t(nb) * size_t(nb) + size_t(b)] = runtime::TensorIndexEntry{group, row};
+      index_[centre * size_t(nb) * size_t(nb) + size_t(b)] = format::TensorIndexEntry{group, row};
       ++row;
     }
   }
@@ -216,7 +220,7 @@ Status TensorPackSink::endLevel(int level) {
     if (Status s = writeFront(); !s) return s;
   }
   if (Status s = writeSection(format::kSectionTensorIndex, uint64_t(level), index_.data(),
-                              index_.size() * sizeof(runtime::TensorIndexEntry));
+                              index_.size() * sizeof(format::TensorIndexEntry));
       !s) {
     return s;
   }
@@ -235,7 +239,7 @@ Status TensorPackSink::finish() {
     return makeError(ErrorCode::kInvalidInput, "every NDF block is blank (block mass below the blank threshold " +
                                                    std::to_string(options_.blank_threshold) + "): nothing to compress");
   }
-  runtime::TensorInfoRecord info;
+  format::TensorInfoRecord info;
   info.ndf_res = uint32_t(ndf_res_);
   info.block = uint32_t(options_.block);
   info.blocks_per_side = uint32_t(blocks_per_side_);
@@ -243,8 +247,11 @@ Status TensorPackSink::finish() {
   info.group_count = uint32_t(report_.groups);
   info.max_rank = uint32_t(report_.max_rank);
   info.precision = uint32_t(options_.precision);
-  info.flags = options_.cp.nonneg ? runtime::kTensorFlagNonNegative : 0u;
+  info.flags = options_.cp.nonneg ? format::kTensorFlagNonNegative : 0u;
   info.blank_threshold = options_.blank_threshold;
+  if (format::RecordCheck c = format::checkTensorInfoRecord(info); !c) {
+    return makeError(ErrorCode::kRuntime, std::string("tensor-info record fails its check: ") + c.detail);
+  }
   if (Status s = writeSection(format::kSectionTensorInfo, 0, &info, sizeof(info)); !s) return s;
 
   double error_squared = 0.0, norm_squared = 0.0;

@@ -1,12 +1,61 @@
-// Writes v1_0_minimal.gbk and v1_0_image.gbk. Run ONCE, when a format version is introduced;
-// never to "update" existing files (see README.md). Not part of the build:
+// Writes the frozen containers. Run ONCE per set, when the set is introduced; never to "update"
+// existing files (see README.md). Not part of the build:
 //   c++ -std=c++17 -I formats/include generate_frozen.cpp -L<build>/formats -lglintbake_format ...
+//   ./a.out v1_0        v1_0_minimal.gbk, v1_0_image.gbk
+//   ./a.out v1_0_kinds  one container per asset kind (frozen_kinds.h)
 #include "frozen_content.h"
+#include "frozen_kinds.h"
 
 #include <cstdio>
+#include <cstring>
 
-int main() {
-  using namespace glintbake::format;
+namespace {
+
+using namespace glintbake::format;
+
+struct Section {
+  uint32_t type;
+  uint64_t key;
+  std::vector<uint8_t> bytes;
+  Codec codec;
+};
+
+bool writeKind(const char* path, AssetKind kind, const char* name, const char* tool,
+               const std::vector<Section>& sections) {
+  Writer writer;
+  if (writer.open(path, kind, 9) != Status::kOk) return false;
+  if (writer.addMetadata(frozen::kindMetadata(name, tool)) != Status::kOk) return false;
+  for (const Section& s : sections) {
+    if (writer.addSection(s.type, s.key, s.bytes.data(), s.bytes.size(), s.codec) != Status::kOk) return false;
+  }
+  return writer.finish() == Status::kOk;
+}
+
+int writeKinds() {
+  using frozen::ltcSection;
+  const bool ok = writeKind("v1_0_ndf_pyramid.gbk", AssetKind::kNdfPyramid, "ndf-pyramid", "ndfgen",
+                            {{kSectionNdfLevel, 0, frozen::pyramidLevel(0), Codec::kRaw},
+                             {kSectionNdfChunk, 0, frozen::pyramidChunk(0), Codec::kZstd},
+                             {kSectionNdfLevel, 1, frozen::pyramidLevel(1), Codec::kRaw},
+                             {kSectionNdfChunk, uint64_t(1) << 32, frozen::pyramidChunk(1), Codec::kZstd}}) &&
+                  writeKind("v1_0_tensor_ndf.gbk", AssetKind::kTensorNdf, "tensor-ndf", "tensorpack",
+                            {{kSectionNdfLevel, 0, frozen::tensorLevel(), Codec::kRaw},
+                             {kSectionTensorGroup, 0, frozen::tensorGroup(), Codec::kRaw},
+                             {kSectionTensorIndex, 0, frozen::tensorIndex(), Codec::kRaw},
+                             {kSectionTensorInfo, 0, frozen::tensorInfo(), Codec::kRaw}}) &&
+                  writeKind("v1_0_ltc_table.gbk", AssetKind::kLtcTable, "ltc-table", "ltcfit",
+                            {{kSectionLtcTable, 0, ltcSection(0), Codec::kZstd},
+                             {kSectionLtcTable, 1, ltcSection(1), Codec::kZstd}}) &&
+                  writeKind("v1_0_roughness.gbk", AssetKind::kRoughness, "roughness", "ltcfit",
+                            {{kSectionRoughness, 0, frozen::roughnessMip(0), Codec::kRaw},
+                             {kSectionRoughness, 1, frozen::roughnessMip(1), Codec::kRaw},
+                             {kSectionRoughness, 2, frozen::roughnessMip(2), Codec::kRaw}});
+  if (!ok) return 1;
+  std::puts("wrote v1_0_ndf_pyramid.gbk, v1_0_tensor_ndf.gbk, v1_0_ltc_table.gbk and v1_0_roughness.gbk");
+  return 0;
+}
+
+int writeV1_0() {
   {
     Writer writer;
     if (writer.open("v1_0_minimal.gbk", AssetKind::kTest) != Status::kOk) return 1;
@@ -28,4 +77,13 @@ int main() {
   }
   std::puts("wrote v1_0_minimal.gbk and v1_0_image.gbk");
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 2 && std::strcmp(argv[1], "v1_0") == 0) return writeV1_0();
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_kinds") == 0) return writeKinds();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds\n", stderr);
+  return 2;
 }

@@ -50,9 +50,7 @@ Asset openAsset(cli::Tool& tool, const std::string& path) {
   Asset asset;
   const rt::Status s = rt::openNdfAsset(path.c_str(), &asset.source);
   if (s == rt::Status::kOk) {
-    glintbake::format::Reader reader;  // header and index only: the kind for the JSON summaries
-    asset.kind = reader.open(path) == glintbake::format::Status::kOk ? glintbake::format::assetKindString(reader.kind())
-                                                                     : "unknown";
+    asset.kind = glintbake::format::assetKindString(asset.source->kind());
     return asset;
   }
   throw Error(cli::exitCodeOfRuntime(s), "cannot open " + path + ": " + rt::statusString(s));

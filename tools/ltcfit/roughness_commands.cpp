@@ -60,7 +60,7 @@ int runRoughness(cli::Tool& tool, const RoughnessArgs& args) {
                           {"filter", "box2x2"},
                           {"ingest", cli::ingestOptionsJson(args.ingest)}};
   if (!args.container.empty()) {
-    cli::Json metadata = tool.makeMetadata("roughness", parameters);
+    cli::Json metadata = tool.makeMetadata(format::AssetKind::kRoughness, parameters);
     metadata["asset"] = {{"width", map.width},
                          {"height", map.height},
                          {"levels", int(levels.size())},
@@ -68,8 +68,7 @@ int runRoughness(cli::Tool& tool, const RoughnessArgs& args) {
                          {"quantity", "overall GGX alpha per texel (Tao et al. 2021)"},
                          {"section", {{"type", format::kSectionRoughness}, {"key", "mip level"}}}};
     cli::ContainerOutput out(tool, args.container, format::AssetKind::kRoughness);
-    for (size_t i = 0; i < levels.size(); ++i)
-      out.addImageSection(format::kSectionRoughness, i, levels[i].width, levels[i].height, 1, levels[i].alpha.data());
+    check(bake::ltc::writeRoughnessSections(levels, out.writer()));
     out.finish(metadata);
   }
   const bake::Status status = bake::ltc::writeRoughnessExr(levels, args.output);

@@ -57,7 +57,7 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
                           {"samples", args.samples},
                           {"method", args.method},
                           {"columns", args.columns}};
-  cli::Json metadata = tool.makeMetadata("ltc-table", parameters);
+  cli::Json metadata = tool.makeMetadata(format::AssetKind::kLtcTable, parameters);
   metadata["asset"] = {{"layout", "heitz2016"},
                        {"brdf", args.brdf},
                        {"size", args.size},
@@ -70,8 +70,7 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
 
   {
     cli::ContainerOutput out(tool, args.output, format::AssetKind::kLtcTable);
-    out.addImageSection(format::kSectionLtcTable, 0, args.size, args.size, 4, published.ltc1.data());
-    out.addImageSection(format::kSectionLtcTable, 1, args.size, args.size, 4, published.ltc2.data());
+    check(bake::ltc::writeLtcTableSections(published, out.writer()));
     out.finish(metadata);
   }
   cli::Json files = cli::Json::array();

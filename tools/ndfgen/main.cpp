@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     Json params = cli::pyramidOptionsJson(pyramid);
     params["zstd_level"] = zstd_level;
     params["ingest"] = cli::ingestOptionsJson(ingest);
-    Json meta = t.makeMetadata("ndf-pyramid", params);
+    Json meta = out.makeMetadata(params);
     Json asset;
     asset["ndf_res"] = opt.splat.ndf_res;
     asset["sigma_r"] = opt.splat.sigma_r;

@@ -314,8 +314,8 @@ bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
   t->ux = fp.x;
   t->uy = fp.y;
   if (repeat) {  // the flakes repeat with the map: reduce the centre into it
-    t->ux -= BlendAxis::floorOf(t->ux / width) * width;
-    t->uy -= BlendAxis::floorOf(t->uy / height) * height;
+    t->ux -= format::NdfBlendAxis::floorOf(t->ux / width) * width;
+    t->uy -= format::NdfBlendAxis::floorOf(t->uy / height) * height;
   }
   const double reach = kWindowSigmas * std::sqrt(t->v);
   const double fx0 = std::ceil((t->ux - reach) * rate - 0.5), fx1 = std::floor((t->ux + reach) * rate - 0.5);
@@ -472,9 +472,15 @@ Status FlakeNdf::build(const TexelSource& source, int rate, double sigma_r, int 
 
 bool FlakeNdf::isBuilt() const { return impl_ != nullptr; }
 int FlakeNdf::resolution() const { return impl_ ? impl_->res : 0; }
-int FlakeNdf::mapWidth() const { return impl_ ? impl_->width : 0; }
-int FlakeNdf::mapHeight() const { return impl_ ? impl_->height : 0; }
-bool FlakeNdf::repeats() const { return impl_ ? impl_->repeat : false; }
+MapSize FlakeNdf::mapSize() const { return impl_ ? MapSize{impl_->width, impl_->height} : MapSize{}; }
+MapWrap FlakeNdf::wrap() const { return impl_ && !impl_->repeat ? MapWrap::kClamp : MapWrap::kRepeat; }
+
+FootprintRange FlakeNdf::footprintRange() const {
+  FootprintRange r;
+  // The largest footprint whose window (12 sqrt(v) texels across) fits kMaxFlakeWindow flakes.
+  if (impl_) r.exact_max_sigma = std::floor(double(kMaxFlakeWindow - 2) / (2.0 * kWindowSigmas * impl_->rate));
+  return r;
+}
 double FlakeNdf::sigmaR() const { return impl_ ? impl_->sigma_r : 0.0; }
 
 namespace {

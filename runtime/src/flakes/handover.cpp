@@ -67,6 +67,13 @@ HandoverNdf::HandoverNdf(std::unique_ptr<FlakeNdf> flakes, std::unique_ptr<NdfSo
       pyramid_from_(pyramid_from),
       inv_log_band_(pyramid_from > flakes_up_to ? 1.0 / std::log(pyramid_from / flakes_up_to) : 0.0) {}
 
+FootprintRange HandoverNdf::footprintRange() const {
+  FootprintRange r = pyramid_->footprintRange();
+  r.exact_max_sigma = flakes_up_to_;
+  r.handover_max_sigma = pyramid_from_;
+  return r;
+}
+
 double HandoverNdf::pyramidWeight(double sigma) const {
   if (sigma <= flakes_up_to_) return 0.0;
   if (sigma >= pyramid_from_) return 1.0;

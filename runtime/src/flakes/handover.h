@@ -28,7 +28,12 @@ class HandoverNdf final : public NdfSource {
   HandoverNdf(std::unique_ptr<FlakeNdf> flakes, std::unique_ptr<NdfSource> pyramid, double flakes_up_to,
               double pyramid_from);
 
+  format::AssetKind kind() const override { return pyramid_->kind(); }
   int resolution() const override { return pyramid_->resolution(); }
+  // The pyramid's range, with the flakes exact up to flakes_up_to and the band up to pyramid_from.
+  FootprintRange footprintRange() const override;
+  MapSize mapSize() const override { return pyramid_->mapSize(); }
+  MapWrap wrap() const override { return pyramid_->wrap(); }
   Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
   Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
   Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;

@@ -1,9 +1,11 @@
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds.h>
 #include <glintbake/runtime/glintbake_c.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 
 #include <memory>
+#include <string_view>
 
 #include <new>
 
@@ -46,33 +48,26 @@ int32_t openWith(gb_ndf_pyramid** out, OpenFn&& fn) {
   *out = p;
   return GB_OK;
 }
-// Opens any NDF asset kind; `reader` has already been opened on the same bytes and gives the kind.
-template <typename OpenFn>
-int32_t openAsset(gb_ndf_asset** out, const glintbake::format::Reader& reader, OpenFn&& fn) {
+// Wraps an opened NDF source in a handle; the kind code is the source's container kind.
+int32_t wrapAsset(gb_ndf_asset** out, Status opened, std::unique_ptr<glintbake::runtime::NdfSource> source) {
+  if (opened != Status::kOk) return code(opened);
   gb_ndf_asset* a = new (std::nothrow) gb_ndf_asset();
   if (!a) return GB_OUT_OF_MEMORY;
-  const Status s = fn(&a->source);
-  if (s != Status::kOk) {
-    delete a;
-    return code(s);
-  }
-  a->kind = int32_t(reader.kind());
+  a->kind = int32_t(source->kind());
+  a->source = std::move(source);
   *out = a;
   return GB_OK;
 }
 
-int32_t fromFormat(glintbake::format::Status s) {
-  switch (s) {
-    case glintbake::format::Status::kOk:
-      return GB_OK;
-    case glintbake::format::Status::kIoError:
-      return GB_IO_ERROR;
-    case glintbake::format::Status::kUnsupportedVersion:
-      return GB_UNSUPPORTED_VERSION;
-    default:
-      return GB_INVALID_ASSET;
-  }
-}
+// The C kind codes are the registry's asset kinds (formats/include/glintbake/format/kinds.h).
+static_assert(GB_KIND_NDF_PYRAMID == int(glintbake::format::AssetKind::kNdfPyramid) &&
+                  std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kNdfPyramid)->name) ==
+                      "ndf-pyramid",
+              "GB_KIND_NDF_PYRAMID is the registry's ndf-pyramid");
+static_assert(GB_KIND_TENSOR_NDF == int(glintbake::format::AssetKind::kTensorNdf) &&
+                  std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kTensorNdf)->name) ==
+                      "tensor-ndf",
+              "GB_KIND_TENSOR_NDF is the registry's tensor-ndf");
 }  // namespace
 
 extern "C" {
@@ -143,18 +138,18 @@ int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {
   if (!out) return GB_INVALID_ARGUMENT;
   *out = nullptr;
   if (!path) return GB_INVALID_ARGUMENT;
-  glintbake::format::Reader reader;
-  if (int32_t st = fromFormat(reader.open(path)); st != GB_OK) return st;
-  return openAsset(out, reader, [&](auto* src) { return glintbake::runtime::openNdfAsset(path, src); });
+  std::unique_ptr<glintbake::runtime::NdfSource> source;
+  const Status opened = glintbake::runtime::openNdfAsset(path, &source);
+  return wrapAsset(out, opened, std::move(source));
 }
 
 int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out) {
   if (!out) return GB_INVALID_ARGUMENT;
   *out = nullptr;
   if (!data) return GB_INVALID_ARGUMENT;
-  glintbake::format::Reader reader;
-  if (int32_t st = fromFormat(reader.openMemory(data, size)); st != GB_OK) return st;
-  return openAsset(out, reader, [&](auto* src) { return glintbake::runtime::openNdfAssetMemory(data, size, src); });
+  std::unique_ptr<glintbake::runtime::NdfSource> source;
+  const Status opened = glintbake::runtime::openNdfAssetMemory(data, size, &source);
+  return wrapAsset(out, opened, std::move(source));
 }
 
 void gb_ndf_asset_close(gb_ndf_asset* asset) { delete asset; }

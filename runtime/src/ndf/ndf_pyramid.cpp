@@ -13,8 +13,6 @@
 namespace glintbake::runtime {
 namespace {
 
-constexpr uint32_t kMaxResolution = 4096;
-constexpr uint32_t kMaxGridSide = 1u << 20;
 constexpr uint64_t kMaxTotalFloats = uint64_t(1) << 36;  // 256 GiB: beyond any sane asset
 
 struct Level {
@@ -23,15 +21,13 @@ struct Level {
   Array<double> prefix;  // per image R + 1 cumulative row masses
 };
 
-// Up to 8 weighted images (2 levels x 4 centres).
+// The weighted images of the footprint blend (format::NdfPyramidBlend).
 struct Blend {
   int count = 0;
-  double weight[8];
-  const float* image[8];
-  const double* prefix[8];
+  double weight[format::kMaxBlendCentres];
+  const float* image[format::kMaxBlendCentres];
+  const double* prefix[format::kMaxBlendCentres];
 };
-
-bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
 }  // namespace
 
@@ -42,6 +38,7 @@ struct NdfPyramid::Impl {
   double inv_bin = 0.0;   // R / 2
   double bin_area = 0.0;  // (2 / R)^2
   Level levels[kMaxNdfLevels];
+  NdfLevelRecord records[kMaxNdfLevels];  // levels[l].rec, contiguous (PyramidNdf::levelRecords)
   PyramidBlender blender;
 
   Status load(const format::Reader& reader);
@@ -61,7 +58,6 @@ struct NdfPyramid::Impl {
 };
 
 Status NdfPyramid::Impl::load(const format::Reader& reader) {
-  if (reader.kind() != format::AssetKind::kNdfPyramid) return Status::kWrongKind;
   std::vector<uint8_t> bytes;
   level_count = 0;
   for (int l = 0; l < kMaxNdfLevels; ++l) {
@@ -71,22 +67,13 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     NdfLevelRecord rec;
     if (Status s = fromFormatStatus(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
     // Descriptor sanity: everything the queries index with is checked here.
-    if (rec.magic != NdfLevelRecord().magic) return Status::kInvalidAsset;
-    if (rec.version != 1) return Status::kUnsupportedVersion;
-    if (rec.level != uint32_t(l) || rec.ndf_res < 2 || rec.ndf_res > kMaxResolution) return Status::kInvalidAsset;
-    if (l > 0 && rec.ndf_res != uint32_t(res)) return Status::kInvalidAsset;
-    if (rec.grid_width < 1 || rec.grid_height < 1 || rec.grid_width > kMaxGridSide || rec.grid_height > kMaxGridSide)
-      return Status::kInvalidAsset;
-    if (rec.region_size < 1 || rec.regions_x != (rec.grid_width + rec.region_size - 1) / rec.region_size ||
-        rec.regions_y != (rec.grid_height + rec.region_size - 1) / rec.region_size)
-      return Status::kInvalidAsset;
-    if (rec.wrap > 1 || !finitePositive(rec.stride_x) || !finitePositive(rec.stride_y) ||
-        !std::isfinite(rec.origin_x) || !std::isfinite(rec.origin_y) || !finitePositive(rec.sigma_texels))
-      return Status::kInvalidAsset;
-    if (l > 0 && !(rec.sigma_texels > levels[l - 1].rec.sigma_texels)) return Status::kInvalidAsset;
+    if (Status s = fromRecordCheck(format::checkNdfLevelRecord(rec, uint32_t(l), l > 0 ? &levels[l - 1].rec : nullptr));
+        s != Status::kOk)
+      return s;
     res = int(rec.ndf_res);
     Level& lv = levels[l];
     lv.rec = rec;
+    records[l] = rec;
     const uint64_t image_floats = uint64_t(res) * uint64_t(res);
     const uint64_t centres = uint64_t(rec.grid_width) * uint64_t(rec.grid_height);
     if (centres * image_floats > kMaxTotalFloats) return Status::kInvalidAsset;
@@ -98,7 +85,7 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
       for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
         const uint64_t region = uint64_t(ry) * rec.regions_x + rx;
-        const int cidx = reader.find(format::kSectionNdfChunk, (uint64_t(l) << 32) | region);
+        const int cidx = reader.find(format::kSectionNdfChunk, format::ndfChunkKey(uint32_t(l), region));
         if (cidx < 0) return Status::kInvalidAsset;
         const uint32_t cx0 = rx * rec.region_size, cy0 = ry * rec.region_size;
         const uint32_t cw = std::min(rec.region_size, rec.grid_width - cx0);
@@ -139,14 +126,14 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
   bin = 2.0 / res;
   inv_bin = res / 2.0;
   bin_area = bin * bin;
-  blender.init(levels, level_count);
+  blender.init(records, level_count);
   return Status::kOk;
 }
 
 void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
   const size_t image_floats = size_t(res) * size_t(res);
   b->count = 0;
-  blender.blend(fp, [&](int level, size_t centre, double weight) {
+  blender.blend(fp.x, fp.y, fp.sigma, [&](int level, size_t centre, double weight) {
     const Level& lv = levels[level];
     b->weight[b->count] = weight;
     b->image[b->count] = lv.images.data + centre * image_floats;
@@ -158,11 +145,7 @@ void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
 NdfPyramid::NdfPyramid() = default;
 NdfPyramid::~NdfPyramid() = default;
 
-Status NdfPyramid::open(const char* path) {
-  impl_.reset();
-  if (!path) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
+Status NdfPyramid::loadKind(const format::Reader& reader) {
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
   if (!impl) return Status::kOutOfMemory;
   if (Status s = impl->load(reader); s != Status::kOk) return s;
@@ -170,25 +153,12 @@ Status NdfPyramid::open(const char* path) {
   return Status::kOk;
 }
 
-Status NdfPyramid::openMemory(const void* data, size_t size) {
-  impl_.reset();
-  if (!data) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
-  auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->load(reader); s != Status::kOk) return s;
-  impl_ = std::move(impl);
-  return Status::kOk;
-}
+void NdfPyramid::reset() { impl_.reset(); }
 
-bool NdfPyramid::isOpen() const { return impl_ != nullptr; }
-int NdfPyramid::resolution() const { return impl_ ? impl_->res : 0; }
-int NdfPyramid::levelCount() const { return impl_ ? impl_->level_count : 0; }
-
-const NdfLevelRecord* NdfPyramid::level(int l) const {
-  if (!impl_ || l < 0 || l >= impl_->level_count) return nullptr;
-  return &impl_->levels[l].rec;
+const NdfLevelRecord* NdfPyramid::levelRecords(int* count) const {
+  if (!impl_) return nullptr;
+  *count = impl_->level_count;
+  return impl_->records;
 }
 
 const float* NdfPyramid::centreImage(int l, int i, int j) const {
@@ -198,10 +168,7 @@ const float* NdfPyramid::centreImage(int l, int i, int j) const {
   return impl_->levels[l].images.data + (size_t(j) * r->grid_width + size_t(i)) * image_floats;
 }
 
-Status NdfPyramid::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
-    return Status::kInvalidArgument;
+Status NdfPyramid::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   const int bin = impl_->binOf(s.x, s.y);
@@ -209,11 +176,7 @@ Status NdfPyramid::eval(const Footprint& footprint, const SPoint& s, double* val
   return Status::kOk;
 }
 
-Status NdfPyramid::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
-      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return Status::kInvalidArgument;
+Status NdfPyramid::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
   const Impl& m = *impl_;
   Blend b;
   m.blend(footprint, &b);
@@ -239,19 +202,14 @@ Status NdfPyramid::average(const Footprint& footprint, const SRect& rect, double
   return Status::kOk;
 }
 
-Status NdfPyramid::mass(const Footprint& footprint, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint)) return Status::kInvalidArgument;
+Status NdfPyramid::massChecked(const Footprint& footprint, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   *value = impl_->blendMass(b);
   return Status::kOk;
 }
 
-Status NdfPyramid::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
-    return Status::kInvalidArgument;
+Status NdfPyramid::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   const double total = impl_->blendMass(b);
@@ -260,10 +218,7 @@ Status NdfPyramid::pdf(const Footprint& footprint, const SPoint& s, double* valu
   return Status::kOk;
 }
 
-Status NdfPyramid::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return Status::kInvalidArgument;
+Status NdfPyramid::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
   Blend b;
   m.blend(footprint, &b);
@@ -309,10 +264,8 @@ Status NdfPyramid::sample(const Footprint& footprint, double u1, double u2, NdfS
   return Status::kOk;
 }
 
-Status NdfPyramid::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+Status NdfPyramid::imageChecked(const Footprint& footprint, float* out) const {
   const size_t n = size_t(impl_->res) * size_t(impl_->res);
-  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
   Blend b;
   impl_->blend(footprint, &b);
   for (size_t i = 0; i < n; ++i) {

@@ -1,4 +1,5 @@
-// Opening any NDF asset kind through the NdfSource interface, chosen by the container's kind.
+// Opening any NDF asset kind through the NdfSource interface, chosen by the container's kind; the
+// file is opened once and the chosen kind loads from the same reader.
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -11,23 +12,22 @@
 namespace glintbake::runtime {
 namespace {
 
-template <typename Asset, typename OpenFn>
-Status openAs(std::unique_ptr<NdfSource>* out, OpenFn&& open) {
+template <typename Asset>
+Status loadAs(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   std::unique_ptr<Asset> asset(new (std::nothrow) Asset());
   if (!asset) return Status::kOutOfMemory;
-  if (Status st = open(*asset); st != Status::kOk) return st;
+  if (Status st = asset->load(reader); st != Status::kOk) return st;
   *out = std::move(asset);
   return Status::kOk;
 }
 
-// Dispatches on the kind of an opened reader; `open` loads the chosen asset class.
-template <typename OpenFn>
-Status openKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out, OpenFn&& open) {
+// The NDF asset classes, by the kind of an opened reader.
+Status loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   switch (reader.kind()) {
     case format::AssetKind::kNdfPyramid:
-      return openAs<NdfPyramid>(out, open);
+      return loadAs<NdfPyramid>(reader, out);
     case format::AssetKind::kTensorNdf:
-      return openAs<TensorNdf>(out, open);
+      return loadAs<TensorNdf>(reader, out);
     default:
       return Status::kWrongKind;
   }
@@ -40,7 +40,13 @@ Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* ou
   if (idx < 0) return Status::kOk;
   std::unique_ptr<FlakeNdf> flakes;
   format::FlakesRecord rec;
-  if (Status s = loadFlakes(reader, idx, (*out)->resolution(), &flakes, &rec); s != Status::kOk) {
+  Status s = loadFlakes(reader, idx, (*out)->resolution(), &flakes, &rec);
+  // The flakes must be those of the pyramid's map.
+  const MapSize size = (*out)->mapSize();
+  if (s == Status::kOk && (int64_t(rec.map_width) != size.width || int64_t(rec.map_height) != size.height ||
+                           rec.wrap != uint32_t((*out)->wrap())))
+    s = Status::kInvalidAsset;
+  if (s != Status::kOk) {
     out->reset();
     return s;
   }
@@ -62,7 +68,7 @@ Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
   if (path == nullptr) return Status::kInvalidArgument;
   format::Reader reader;
   if (format::Status st = reader.open(path); st != format::Status::kOk) return fromFormatStatus(st);
-  if (Status s = openKind(reader, out, [&](auto& asset) { return asset.open(path); }); s != Status::kOk) return s;
+  if (Status s = loadKind(reader, out); s != Status::kOk) return s;
   return attachFlakes(reader, out);
 }
 
@@ -72,8 +78,7 @@ Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSour
   if (data == nullptr) return Status::kInvalidArgument;
   format::Reader reader;
   if (format::Status st = reader.openMemory(data, size); st != format::Status::kOk) return fromFormatStatus(st);
-  if (Status s = openKind(reader, out, [&](auto& asset) { return asset.openMemory(data, size); }); s != Status::kOk)
-    return s;
+  if (Status s = loadKind(reader, out); s != Status::kOk) return s;
   return attachFlakes(reader, out);
 }
 

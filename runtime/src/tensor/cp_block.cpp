@@ -33,6 +33,7 @@ Status CpMix::init(const CpBlendTerm* terms, int32_t count) {
     while (g < group_count_ && groups_[g] != term.group) ++g;
     const int32_t rank = term.group->rank;
     if (g == group_count_) {
+      if (group_count_ == kCpMaxGroups) continue;
       groups_[g] = term.group;
       for (int32_t r = 0; r < rank; ++r) coef_[g][r] = 0.0f;
       ++group_count_;

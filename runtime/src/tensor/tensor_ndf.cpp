@@ -55,7 +55,7 @@ int TensorNdf::Impl::binOf(double sx, double sy) const { return ndfBinOf(sx, sy,
 
 void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
   b->count = 0;
-  blender.blend(fp, [&](int level, size_t centre, double weight) {
+  blender.blend(fp.x, fp.y, fp.sigma, [&](int level, size_t centre, double weight) {
     const TLevel& lv = levels[level];
     const size_t first = centre * size_t(nb2);
     b->weight[b->count] = weight;
@@ -64,6 +64,8 @@ void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
     ++b->count;
   });
 }
+
+static_assert(kCpMaxBlend >= format::kMaxBlendCentres, "a CpMix holds every centre of a footprint blend");
 
 void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const {
   CpBlendTerm terms[kCpMaxBlend];
@@ -129,10 +131,7 @@ double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
 
 // ---------------------------------------------------------------------------------------------
 
-Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
-    return Status::kInvalidArgument;
+Status TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   const Impl& m = *impl_;
   int i, j;
   if (!ndfBinCoords(s.x, s.y, m.res, m.inv_bin, &i, &j)) {
@@ -162,11 +161,7 @@ Status TensorNdf::eval(const Footprint& footprint, const SPoint& s, double* valu
   return Status::kOk;
 }
 
-Status TensorNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
-      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return Status::kInvalidArgument;
+Status TensorNdf::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
   const Impl& m = *impl_;
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
@@ -205,19 +200,14 @@ Status TensorNdf::average(const Footprint& footprint, const SRect& rect, double*
   return Status::kOk;
 }
 
-Status TensorNdf::mass(const Footprint& footprint, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint)) return Status::kInvalidArgument;
+Status TensorNdf::massChecked(const Footprint& footprint, double* value) const {
   Impl::Blend b;
   impl_->blend(footprint, &b);
   *value = impl_->totalMass(b);
   return Status::kOk;
 }
 
-Status TensorNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!value || !validFootprint(footprint) || !std::isfinite(s.x) || !std::isfinite(s.y))
-    return Status::kInvalidArgument;
+Status TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   const Impl& m = *impl_;
   const int bin = m.binOf(s.x, s.y);
   if (bin < 0) {
@@ -230,10 +220,7 @@ Status TensorNdf::pdf(const Footprint& footprint, const SPoint& s, double* value
   return Status::kOk;
 }
 
-Status TensorNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
-  if (!impl_) return Status::kInvalidArgument;
-  if (!out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return Status::kInvalidArgument;
+Status TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
   Impl::Blend b;
   m.blend(footprint, &b);
@@ -285,11 +272,8 @@ Status TensorNdf::sample(const Footprint& footprint, double u1, double u2, NdfSa
   return Status::kOk;
 }
 
-Status TensorNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+Status TensorNdf::imageChecked(const Footprint& footprint, float* out) const {
   const Impl& m = *impl_;
-  const size_t n = size_t(m.res) * size_t(m.res);
-  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
   Impl::Blend b;
   m.blend(footprint, &b);
   CpMix mix;

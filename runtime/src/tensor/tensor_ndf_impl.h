@@ -18,19 +18,18 @@ struct TensorNdf::Impl {
   struct Group {
     Array<float> data;  // A, B, C, A prefix, B prefix (float32)
     CpGroupView view;
-    uint32_t level = 0, region = 0;
   };
   struct TLevel {
     NdfLevelRecord rec;
     Array<TensorIndexEntry> index;  // [centre * nb2 + block]
     Array<double> mass;             // raw block integral over its s-plane area (0 for blank blocks)
   };
-  // Up to 8 weighted centres (2 levels x 4 centres), as NdfPyramid blends them.
+  // The weighted centres of the footprint blend (format::NdfPyramidBlend), as NdfPyramid blends them.
   struct Blend {
     int count = 0;
-    double weight[8];
-    const TensorIndexEntry* index[8];  // the centre's nb2 entries
-    const double* mass[8];             // the centre's nb2 raw masses
+    double weight[format::kMaxBlendCentres];
+    const TensorIndexEntry* index[format::kMaxBlendCentres];  // the centre's nb2 entries
+    const double* mass[format::kMaxBlendCentres];             // the centre's nb2 raw masses
   };
 
   TensorInfoRecord info;
@@ -42,9 +41,11 @@ struct TensorNdf::Impl {
   double inv_bin = 0.0;              // R / 2
   int level_count = 0;
   TLevel levels[kMaxNdfLevels];
+  NdfLevelRecord level_records[kMaxNdfLevels];  // levels[l].rec, contiguous for the record checks
   PyramidBlender blender;
   uint32_t group_count = 0;
   Array<Group> groups;
+  Array<TensorGroupHeader> group_headers;  // as stored, for the index-entry checks
   uint64_t blocks_kept = 0;
   uint64_t memory_bytes = 0;
 

@@ -5,80 +5,21 @@
 
 #include "../format_status.h"
 
+#include <glintbake/format/binary16.h>
+
 #include <cmath>
 #include <cstring>
 
 namespace glintbake::runtime {
 namespace {
 
-constexpr uint32_t kMaxResolution = 4096;
-constexpr uint32_t kMaxGridSide = 1u << 20;
 constexpr uint64_t kMaxIndexEntries = uint64_t(1) << 32;
-
-bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
-
-// IEEE 754 binary16 to binary32 (exact: every half value is a float).
-float halfToFloat(uint16_t h) {
-  const uint32_t sign = uint32_t(h & 0x8000u) << 16;
-  const uint32_t exponent = (h >> 10) & 0x1Fu;
-  uint32_t mantissa = h & 0x3FFu;
-  uint32_t bits;
-  if (exponent == 0) {
-    if (mantissa == 0) {
-      bits = sign;
-    } else {  // subnormal: normalise
-      int e = -1;
-      do {
-        ++e;
-        mantissa <<= 1;
-      } while ((mantissa & 0x400u) == 0);
-      bits = sign | (uint32_t(127 - 15 - e) << 23) | ((mantissa & 0x3FFu) << 13);
-    }
-  } else if (exponent == 0x1F) {
-    bits = sign | 0x7F800000u | (mantissa << 13);  // Inf or NaN
-  } else {
-    bits = sign | ((exponent + 127 - 15) << 23) | (mantissa << 13);
-  }
-  float f;
-  std::memcpy(&f, &bits, sizeof(f));
-  return f;
-}
 
 // Reads a whole section of exactly `size` bytes (kInvalidAsset on a size mismatch).
 Status readExact(const format::Reader& reader, int idx, uint64_t size, Array<uint8_t>* out) {
   if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return Status::kInvalidAsset;
   if (size > SIZE_MAX || !out->allocate(size_t(size))) return Status::kOutOfMemory;
   return fromFormatStatus(reader.readSectionInto(size_t(idx), out->data, out->size));
-}
-
-// The same level-record checks as ndf-pyramid assets (SPEC 10.1), plus agreement with the info.
-Status checkLevel(const NdfLevelRecord& rec, int l, const TensorInfoRecord& info, const NdfLevelRecord* below) {
-  if (rec.magic != NdfLevelRecord().magic) return Status::kInvalidAsset;
-  if (rec.version != 1) return Status::kUnsupportedVersion;
-  if (rec.level != uint32_t(l) || rec.ndf_res != info.ndf_res) return Status::kInvalidAsset;
-  if (rec.grid_width < 1 || rec.grid_height < 1 || rec.grid_width > kMaxGridSide || rec.grid_height > kMaxGridSide)
-    return Status::kInvalidAsset;
-  if (rec.region_size < 1 || rec.regions_x != (rec.grid_width + rec.region_size - 1) / rec.region_size ||
-      rec.regions_y != (rec.grid_height + rec.region_size - 1) / rec.region_size)
-    return Status::kInvalidAsset;
-  if (rec.wrap > 1 || !finitePositive(rec.stride_x) || !finitePositive(rec.stride_y) || !std::isfinite(rec.origin_x) ||
-      !std::isfinite(rec.origin_y) || !finitePositive(rec.sigma_texels))
-    return Status::kInvalidAsset;
-  if (below && !(rec.sigma_texels > below->sigma_texels)) return Status::kInvalidAsset;
-  return Status::kOk;
-}
-
-Status checkInfo(const TensorInfoRecord& info) {
-  if (info.magic != TensorInfoRecord().magic) return Status::kInvalidAsset;
-  if (info.version != 1) return Status::kUnsupportedVersion;
-  if (info.ndf_res < 2 || info.ndf_res > kMaxResolution) return Status::kInvalidAsset;
-  if (info.block < 1 || info.block > uint32_t(kCpMaxBins) || info.ndf_res % info.block != 0 ||
-      info.blocks_per_side != info.ndf_res / info.block)
-    return Status::kInvalidAsset;
-  if (info.level_count < 1 || info.level_count > uint32_t(kMaxNdfLevels)) return Status::kInvalidAsset;
-  if (info.max_rank < 1 || info.max_rank > uint32_t(kCpMaxRank) || info.precision > 1) return Status::kInvalidAsset;
-  if ((info.flags & ~kTensorFlagNonNegative) != 0 || !std::isfinite(info.blank_threshold)) return Status::kInvalidAsset;
-  return Status::kOk;
 }
 
 }  // namespace
@@ -93,18 +34,12 @@ Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Arra
   // decide the exact size the section must have.
   if (Status s = readExact(reader, idx, raw_size, scratch); s != Status::kOk) return s;
   std::memcpy(&h, scratch->data, sizeof(h));
-  if (h.magic != TensorGroupHeader().magic || h.bins != info.block || h.rank < 1 || h.rank > info.max_rank ||
-      h.blocks < 1 || h.level >= info.level_count || h.precision != info.precision || h.reserved != 0)
-    return Status::kInvalidAsset;
-  const NdfLevelRecord& lr = levels[h.level].rec;
-  if (uint64_t(h.region) >= uint64_t(lr.regions_x) * lr.regions_y) return Status::kInvalidAsset;
-  // A group holds the blocks of at most region_size^2 centres.
-  if (uint64_t(h.blocks) > uint64_t(lr.region_size) * lr.region_size * nb2) return Status::kInvalidAsset;
+  if (!format::checkTensorGroupHeader(h, info, level_records)) return Status::kInvalidAsset;
   const uint64_t rank = h.rank, b = h.bins, k = h.blocks;
   const uint64_t factor_values = (2 * b + k) * rank;
   const uint64_t prefix_values = 2 * (b + 1) * rank;
   const uint64_t elem = info.precision == 1 ? 2 : 4;
-  if (raw_size != sizeof(TensorGroupHeader) + factor_values * elem + prefix_values * 4) return Status::kInvalidAsset;
+  if (raw_size != format::tensorGroupSectionBytes(b, rank, k, info.precision)) return Status::kInvalidAsset;
 
   Group& group = groups.data[g];
   if (!group.data.allocate(size_t(factor_values + prefix_values))) return Status::kOutOfMemory;
@@ -115,7 +50,7 @@ Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Arra
     if (elem == 2) {
       uint16_t bits;
       std::memcpy(&bits, src + v * 2, 2);
-      f = halfToFloat(bits);
+      f = format::halfToFloat(bits);
     } else {
       std::memcpy(&f, src + v * 4, 4);
     }
@@ -127,8 +62,7 @@ Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Arra
   for (uint64_t v = 0; v < prefix_values; ++v) {
     if (!(std::fabs(dst[factor_values + v]) <= kTensorMaxPrefix)) return Status::kInvalidAsset;
   }
-  group.level = h.level;
-  group.region = h.region;
+  group_headers.data[g] = h;
   CpGroupView& view = group.view;
   view.bins = int32_t(b);
   view.rank = int32_t(rank);
@@ -169,10 +103,9 @@ Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uin
         lv.mass.data[e_index] = 0.0;
         continue;
       }
-      if (e.group >= group_count) return Status::kInvalidAsset;
-      const Group& g = groups.data[e.group];
-      if (e.row >= uint32_t(g.view.blocks) || g.level != uint32_t(l) || g.region != region)
+      if (!format::checkTensorIndexEntry(e, group_headers.data, group_count, uint32_t(l), region))
         return Status::kInvalidAsset;
+      const Group& g = groups.data[e.group];
       // Raw (unclamped) integral of the block over its s-plane area, from the prefix sums exactly
       // as CpMix::rawRangeSum forms it, in double.
       const int32_t rank = g.view.rank;
@@ -191,12 +124,11 @@ Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uin
 }
 
 Status TensorNdf::Impl::load(const format::Reader& reader) {
-  if (reader.kind() != format::AssetKind::kTensorNdf) return Status::kWrongKind;
   Array<uint8_t> scratch;
   const int info_idx = reader.find(format::kSectionTensorInfo, 0);
   if (Status s = readExact(reader, info_idx, sizeof(TensorInfoRecord), &scratch); s != Status::kOk) return s;
   std::memcpy(&info, scratch.data, sizeof(info));
-  if (Status s = checkInfo(info); s != Status::kOk) return s;
+  if (Status s = fromRecordCheck(format::checkTensorInfoRecord(info)); s != Status::kOk) return s;
   res = int(info.ndf_res);
   bins = int(info.block);
   bins_shift = -1;
@@ -214,15 +146,20 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
     const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));
     if (Status s = readExact(reader, idx, sizeof(NdfLevelRecord), &scratch); s != Status::kOk) return s;
     std::memcpy(&levels[l].rec, scratch.data, sizeof(NdfLevelRecord));
-    if (Status s = checkLevel(levels[l].rec, l, info, l > 0 ? &levels[l - 1].rec : nullptr); s != Status::kOk) return s;
+    level_records[l] = levels[l].rec;
+    const NdfLevelRecord* below = l > 0 ? &levels[l - 1].rec : nullptr;
+    if (Status s = fromRecordCheck(format::checkTensorLevelRecord(levels[l].rec, uint32_t(l), info, below));
+        s != Status::kOk)
+      return s;
   }
   level_count = int(info.level_count);
-  blender.init(levels, level_count);
+  blender.init(level_records, level_count);
 
   // Every group needs its own section, so the section count bounds the allocation.
   if (uint64_t(info.group_count) > reader.sections().size()) return Status::kInvalidAsset;
   group_count = info.group_count;
-  if (group_count > 0 && !groups.allocate(group_count)) return Status::kOutOfMemory;
+  if (group_count > 0 && (!groups.allocate(group_count) || !group_headers.allocate(group_count)))
+    return Status::kOutOfMemory;
   for (uint32_t g = 0; g < group_count; ++g) {
     if (Status s = loadGroup(reader, g, &scratch); s != Status::kOk) return s;
   }
@@ -235,11 +172,7 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
 TensorNdf::TensorNdf() = default;
 TensorNdf::~TensorNdf() = default;
 
-Status TensorNdf::open(const char* path) {
-  impl_.reset();
-  if (!path) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
+Status TensorNdf::loadKind(const format::Reader& reader) {
   std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
   if (!impl) return Status::kOutOfMemory;
   if (Status s = impl->load(reader); s != Status::kOk) return s;
@@ -247,30 +180,18 @@ Status TensorNdf::open(const char* path) {
   return Status::kOk;
 }
 
-Status TensorNdf::openMemory(const void* data, size_t size) {
-  impl_.reset();
-  if (!data) return Status::kInvalidArgument;
-  format::Reader reader;
-  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
-  std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->load(reader); s != Status::kOk) return s;
-  impl_ = std::move(impl);
-  return Status::kOk;
+void TensorNdf::reset() { impl_.reset(); }
+
+const NdfLevelRecord* TensorNdf::levelRecords(int* count) const {
+  if (!impl_) return nullptr;
+  *count = impl_->level_count;
+  return impl_->level_records;
 }
 
-bool TensorNdf::isOpen() const { return impl_ != nullptr; }
-int TensorNdf::resolution() const { return impl_ ? impl_->res : 0; }
-int TensorNdf::levelCount() const { return impl_ ? impl_->level_count : 0; }
 const TensorInfoRecord* TensorNdf::info() const { return impl_ ? &impl_->info : nullptr; }
 int TensorNdf::groupCount() const { return impl_ ? int(impl_->group_count) : 0; }
 uint64_t TensorNdf::blocksKept() const { return impl_ ? impl_->blocks_kept : 0; }
 uint64_t TensorNdf::memoryBytes() const { return impl_ ? impl_->memory_bytes : 0; }
-
-const NdfLevelRecord* TensorNdf::level(int l) const {
-  if (!impl_ || l < 0 || l >= impl_->level_count) return nullptr;
-  return &impl_->levels[l].rec;
-}
 
 const CpGroupView* TensorNdf::group(int g) const {
   if (!impl_ || g < 0 || uint32_t(g) >= impl_->group_count) return nullptr;

@@ -17,7 +17,7 @@ double gaussian2d(double dx, double dy, double sigma) {
 }
 
 // The lobe formula against a direct numerical integral over u of G_P(u) G_k(u, s) (Yan et al.
-// 2016: the element G_k and the footprint G_P as written in the algorithm notes, section 1).
+// 2016: the element G_k and the footprint G_P as written in glintbake/reference/pndf.h).
 TEST(ReferencePndf, ClosedFormEqualsIntegralOverPosition) {
   FlakeSet set;
   set.width = set.height = 1;

@@ -117,7 +117,7 @@ TEST(CpDecomposition, DeterministicAcrossRunsAndThreadCounts) {
   }
 }
 
-// The default method must stay within 1% of the error of 500 plain sweeps (algorithms.md sec. 2).
+// The default method must stay within 1% of the error of 500 plain sweeps.
 TEST(CpDecomposition, DefaultWithinOnePercentOfFiveHundredPlainSweeps) {
   for (uint64_t seed : {31u, 32u}) {
     const GroupTensor t = makeNdfLikeGroup(32, 512, seed);

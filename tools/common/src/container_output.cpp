@@ -6,7 +6,7 @@
 namespace glintbake::cli {
 
 ContainerOutput::ContainerOutput(Tool& tool, const std::string& path, format::AssetKind kind, int zstd_level)
-    : path_(path) {
+    : tool_(tool), kind_(kind), path_(path) {
   const format::Status status = writer_.open(path, kind, zstd_level);
   if (status != format::Status::kOk) {
     throw Error(kExitIo, "cannot create " + path + ": " + format::statusString(status));

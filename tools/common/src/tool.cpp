@@ -292,6 +292,10 @@ void Tool::finishDepfile() const {
   depfile_written_ = true;
 }
 
+Json Tool::makeMetadata(format::AssetKind kind, const Json& parameters) const {
+  return makeMetadata(std::string(format::assetKindString(kind)), parameters);
+}
+
 Json Tool::makeMetadata(const std::string& asset_kind, const Json& parameters) const {
   Json meta;
   meta["schema"] = "glintbake.container-metadata/1";

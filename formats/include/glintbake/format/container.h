@@ -81,6 +81,7 @@ enum SectionType : uint32_t {
   kSectionTensorGroup = 34,        // tensor-ndf: CP factors of one group (key = group id)
   kSectionLtcTable = 48,           // ltc-table sections (48-63)
   kSectionRoughness = 64,          // roughness mips (64-79)
+  kSectionFlakes = 80,             // NDF assets: the source normal map for exact small footprints (key = 0)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
   kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
 };

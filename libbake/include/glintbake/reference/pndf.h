@@ -1,6 +1,6 @@
 // The reference P-NDF: the position-normal distribution of a normal map seen through a Gaussian
 // pixel footprint, evaluated by summing the closed-form contribution of every flake
-// (Yan et al. 2016, section 5; formulas in the project's algorithm notes, section 1).
+// (Yan et al. 2016, section 5; the closed form is written out below).
 //
 // This is the DEFINITION every fast path is checked against: double precision throughout, a plain
 // sum over flakes in a fixed order, no normalisation over the truncated flakes, nothing shared
@@ -34,12 +34,12 @@ constexpr double kTruncationSigmas = 6.0;
 // Default intrinsic roughness (std of every flake's normal lobe in the s-plane).
 constexpr double kDefaultSigmaR = 0.005;
 
-// Closed form of one flake seen through the footprint (algorithm notes, section 1):
+// Closed form of one flake seen through the footprint:
 //   D_k(s) = A_k N(u_k; u_Q, (sigma_h^2 + sigma_p^2) I) N(s; mu_k, C_k)
 //   mu_k   = n_k + J_k (sigma_h^2 / (sigma_h^2 + sigma_p^2)) (u_Q - u_k)
 //   C_k    = sigma_r^2 I + (sigma_h^2 sigma_p^2 / (sigma_h^2 + sigma_p^2)) J_k J_k^T
 struct FlakeLobe {
-  double weight;  // A_k N(u_k; u_Q, (sigma_h^2 + sigma_p^2) I): the mass of the lobe (unitless)
+  double weight;   // A_k N(u_k; u_Q, (sigma_h^2 + sigma_p^2) I): the mass of the lobe (unitless)
   double mean[2];  // mu_k in the s-plane
   double cov[3];   // C_k as {c_xx, c_xy, c_yy}; positive definite (eigenvalues >= sigma_r^2)
 };
@@ -47,8 +47,7 @@ struct FlakeLobe {
 // The lobe of `flake` placed at position (ux, uy) (its own position, or a periodic image of it
 // with wrap=repeat) for footprint `fp` and intrinsic roughness sigma_r. The one place the closed
 // form is written. Requires fp.sigma > 0, sigma_r > 0. Thread-safe, pure.
-FlakeLobe flakeLobe(const FlakeSet& set, const Flake& flake, double ux, double uy, const Footprint& fp,
-                    double sigma_r);
+FlakeLobe flakeLobe(const FlakeSet& set, const Flake& flake, double ux, double uy, const Footprint& fp, double sigma_r);
 
 // Density of a lobe at s: weight * N(s; mean, cov). Thread-safe, pure.
 double lobeDensity(const FlakeLobe& lobe, double sx, double sy);
@@ -74,8 +73,7 @@ double evalPndf(const FlakeSet& set, const Footprint& fp, double sx, double sy, 
 // on panels no wider than one standard deviation of the integrand's y-dependence, over the part
 // of [y0, y1] within 9 std of the mean. Relative error below 1e-10 of the lobe's mass.
 // Requires x0 <= x1, y0 <= y1. Thread-safe, pure.
-double gaussianRectangleIntegral(const double mean[2], const double cov[3], double x0, double x1, double y0,
-                                 double y1);
+double gaussianRectangleIntegral(const double mean[2], const double cov[3], double x0, double x1, double y0, double y1);
 
 // The bin-averaged NDF image of the footprint: res x res bins over s in [-1, 1]^2, row-major, row 0
 // at the top (s_y = +1), column 0 at the left (s_x = -1). Each bin holds the EXACT average of D

@@ -19,7 +19,7 @@
 //   f(wi, wo) = F(wi . h) D(h) G2(wi, wo) / (4 cos(theta_i) cos(theta_o)),  h = normalize(wi + wo),
 // with G2 the height-correlated Smith term 1 / (1 + Lambda(wi) + Lambda(wo)) of a smooth GGX or
 // Beckmann surface of the material's base roughness alpha (the shadowing comes from the base
-// roughness, not from the map: algorithm notes, section 1). f = 0 when either direction is at or
+// roughness, not from the map). f = 0 when either direction is at or
 // below the horizon.
 //
 // Thread safety and cost: every function is pure or const, never allocates, never throws; the

@@ -1,5 +1,6 @@
 // Constant-cost queries on CP-compressed angular NDF blocks (Deng et al. 2022, "Constant-Cost
-// Spatially-Varying Glints", sec. 4.3), the core that the tensor-ndf asset wraps.
+// Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG, sec. 4.3), the core that the
+// tensor-ndf asset wraps.
 //
 // A group holds K blocks of B x B bins as a rank-R CP model (bake/tensor/cp_decomposition.h):
 //     value(k, i, j) = sum_r A(i, r) B(j, r) C(k, r)        (bin column i, row j, block k)
@@ -41,7 +42,10 @@ namespace glintbake::runtime {
 
 constexpr int32_t kCpMaxRank = 64;
 constexpr int32_t kCpMaxBins = 256;
-constexpr int32_t kCpMaxBlend = 8;
+// Most terms of a blend (the footprint blend's centres, format::kMaxBlendCentres) and most
+// distinct groups among them (the blend's centres lie in a few spatial regions of two levels).
+constexpr int32_t kCpMaxBlend = 392;
+constexpr int32_t kCpMaxGroups = 64;
 
 // A non-owning view of one compressed group (float32, row-major, rank entries per row):
 //   a, b:                 B x R factors;  c: K x R (scales folded in);
@@ -77,7 +81,8 @@ struct CpBlockSample {
 class CpMix {
  public:
   // Builds the blend of `count` terms (count in [0, kCpMaxBlend]). Terms with weight 0 are
-  // skipped; all groups must share B and hold valid views (validateCpGroupView) and the block
+  // skipped, and so are terms of groups beyond the first kCpMaxGroups distinct ones (only assets
+  // baked with spatial regions of fewer than 4 centres per side reach that); all groups must share B and hold valid views (validateCpGroupView) and the block
   // index must be in [0, K). Returns kInvalidArgument otherwise (the mix is then empty: every query
   // returns 0). Zero terms give an empty mix.
   Status init(const CpBlendTerm* terms, int32_t count);
@@ -116,8 +121,8 @@ class CpMix {
 
   int32_t bins_ = 0;
   int32_t group_count_ = 0;
-  const CpGroupView* groups_[kCpMaxBlend] = {};
-  float coef_[kCpMaxBlend][kCpMaxRank] = {};
+  const CpGroupView* groups_[kCpMaxGroups] = {};
+  float coef_[kCpMaxGroups][kCpMaxRank] = {};
 };
 
 }  // namespace glintbake::runtime

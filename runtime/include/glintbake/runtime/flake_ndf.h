@@ -57,10 +57,13 @@ class FlakeNdf final : public NdfSource {
   Status build(const TexelSource& source, int rate, double sigma_r, int resolution);
   bool isBuilt() const;
 
+  // kUnknown: the flakes are a part of an asset (openNdfAsset wraps them with its pyramid).
+  format::AssetKind kind() const override { return format::AssetKind::kUnknown; }
   int resolution() const override;
-  int mapWidth() const;   // texels
-  int mapHeight() const;  // texels
-  bool repeats() const;
+  // Exact at every footprint up to the window limit (exact_max_sigma; no pyramid).
+  FootprintRange footprintRange() const override;
+  MapSize mapSize() const override;
+  MapWrap wrap() const override;
   double sigmaR() const;
 
   Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;

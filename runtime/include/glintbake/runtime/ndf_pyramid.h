@@ -3,7 +3,8 @@
 // interpolation.
 //
 // Asset layout (formats/SPEC.md, "ndf-pyramid"):
-//  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord;
+//  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord
+//    (glintbake/format/kinds/ndf_pyramid.h, with its check);
 //  - one kSectionNdfChunk section per level and spatial region (key = l << 32 | region, region =
 //    ry * regions_x + rx) holding a format::ImageSectionHeader (width = height = R, channels = 1,
 //    layers = centres in the region) and the region's images, centres in row-major order within the
@@ -28,7 +29,9 @@
 // every size is checked against the container and against the descriptor before use.
 #pragma once
 
+#include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/pyramid_ndf.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -36,71 +39,41 @@
 
 namespace glintbake::runtime {
 
-// Level descriptor, stored as the raw bytes of this struct (little-endian, 112 bytes).
-struct NdfLevelRecord {
-  uint32_t magic = 0x4C444E47;  // "GNDL"
-  uint32_t version = 1;
-  uint32_t level = 0;
-  uint32_t ndf_res = 0;      // R: bins per side of every image
-  uint32_t grid_width = 0;   // footprint centres per row
-  uint32_t grid_height = 0;  // footprint centres per column
-  uint32_t region_size = 0;  // centres per side of a spatial region (chunk)
-  uint32_t regions_x = 0;    // ceil(grid_width / region_size)
-  uint32_t regions_y = 0;    // ceil(grid_height / region_size)
-  uint32_t wrap = 0;         // 0 = repeat, 1 = clamp
-  uint32_t map_width = 0;    // texels of the source map
-  uint32_t map_height = 0;
-  uint32_t rate = 1;  // flakes per texel side used to bake
-  uint32_t reserved = 0;
-  double stride_x = 0.0;  // texels between centres along x (= map_width / grid_width)
-  double stride_y = 0.0;  // texels between centres along y (= map_height / grid_height)
-  double origin_x = 0.0;  // position of centre (0, 0), texels (= stride / 2)
-  double origin_y = 0.0;
-  double sigma_texels = 0.0;  // footprint std of this level
-  double sigma_r = 0.0;       // intrinsic roughness used to bake
-  double reserved2 = 0.0;
-};
-static_assert(sizeof(NdfLevelRecord) == 112, "NdfLevelRecord is 112 bytes");
-
-// Most levels a pyramid may have.
-constexpr int kMaxNdfLevels = 32;
-
-class NdfPyramid final : public NdfSource {
+class NdfPyramid : public PyramidNdf {
  public:
   NdfPyramid();
   ~NdfPyramid() override;
   NdfPyramid(const NdfPyramid&) = delete;
   NdfPyramid& operator=(const NdfPyramid&) = delete;
 
-  // Loads an ndf-pyramid container (all images). kIoError, kInvalidAsset, kWrongKind,
-  // kUnsupportedVersion, kOutOfMemory. Safe on untrusted input.
-  Status open(const char* path);
-  // Same, from a caller buffer (only needed during the call).
-  Status openMemory(const void* data, size_t size);
-  bool isOpen() const;
+  // open(), openMemory(), load(), isOpen(), levelCount(), level() and the argument checks of the
+  // queries: pyramid_ndf.h. open() loads all images.
+  format::AssetKind kind() const override { return format::AssetKind::kNdfPyramid; }
 
-  int resolution() const override;  // R
-  int levelCount() const;
-  // Descriptor of level l in [0, levelCount()), or null.
-  const NdfLevelRecord* level(int l) const;
   // Stored image of centre (i, j) of level l (R * R floats), or null when out of range.
   const float* centreImage(int l, int i, int j) const;
 
-  // Value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  // Exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2 count as 0).
-  // Cost grows with the number of bins the rectangle covers.
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  // Samples s from the blended P-NDF with two uniforms in [0, 1); sample->pdf == pdf(footprint, s).
-  // kInvalidArgument if the blend has no mass.
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  // Density of sample(): eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for
-  // footprints away from the edges of clamp maps, so pdf == eval there).
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  // Total mass of the blend (integral over the s-plane).
-  Status mass(const Footprint& footprint, double* value) const override;
-  // The blended image the runtime sees: out must hold R * R floats (out_count >= R * R).
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+ protected:
+  Status loadKind(const format::Reader& reader) override;
+  void reset() override;
+  bool loaded() const override { return impl_ != nullptr; }
+  const NdfLevelRecord* levelRecords(int* count) const override;
+
+  // eval: value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
+  // average: exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2
+  // count as 0); cost grows with the number of bins the rectangle covers.
+  // sample: s from the blended P-NDF; sample->pdf == pdf(footprint, s); kInvalidArgument if the
+  // blend has no mass.
+  // pdf: eval(s) divided by the blend's total mass (the mass is 1 to 1e-3 for footprints away from
+  // the edges of clamp maps, so pdf == eval there).
+  // mass: total mass of the blend (integral over the s-plane).
+  // image: the blended image the runtime sees (R * R floats).
+  Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status massChecked(const Footprint& footprint, double* value) const override;
+  Status imageChecked(const Footprint& footprint, float* out) const override;
 
  private:
   struct Impl;

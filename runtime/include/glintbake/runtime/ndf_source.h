@@ -15,19 +15,52 @@
 //    or non-positive sigma, non-finite s) returns kInvalidArgument and leaves outputs untouched.
 #pragma once
 
+#include <glintbake/format/container.h>
 #include <glintbake/runtime/runtime.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 
 namespace glintbake::runtime {
+
+// The footprint sizes (sigma, texels) an NDF source answers, and how. Pyramid-shaped assets blend
+// their stored levels for sigma in [pyramid_min_sigma, pyramid_max_sigma]; above pyramid_max_sigma
+// they clamp to the top level. Footprints with sigma <= exact_max_sigma are evaluated exactly
+// (from stored flakes, or the reference evaluator); below pyramid_min_sigma and above
+// exact_max_sigma an asset answers with its level 0 as is (a clamp: the NDF of a larger footprint).
+struct FootprintRange {
+  double pyramid_min_sigma = 0.0;  // sigma of level 0 (0: no pyramid)
+  double pyramid_max_sigma = 0.0;  // sigma of the top level (0: no pyramid)
+  double exact_max_sigma = 0.0;    // largest sigma answered exactly (0: no exact path)
+  // Between exact_max_sigma and this the exact path and the pyramid are blended (linearly in
+  // log sigma); from here on the pyramid answers alone (0: no hand-over band).
+  double handover_max_sigma = 0.0;
+};
+
+// Texels of the source normal map, and how positions outside it are read (formats/SPEC.md 9).
+struct MapSize {
+  int width = 0;
+  int height = 0;
+};
+enum class MapWrap : uint32_t {
+  kRepeat = 0,  // the map tiles the plane
+  kClamp = 1,   // positions outside the map read its edge
+};
 
 class NdfSource {
  public:
   virtual ~NdfSource() = default;
 
+  // The container asset kind the source was read from (kUnknown for sources that are not assets).
+  virtual format::AssetKind kind() const = 0;
   // Bins per side of the NDF images the asset represents.
   virtual int resolution() const = 0;
+  // Which footprints the source answers and how (see FootprintRange).
+  virtual FootprintRange footprintRange() const = 0;
+  // Size of the source map in texels ({0, 0} when not open) and its wrap mode.
+  virtual MapSize mapSize() const = 0;
+  virtual MapWrap wrap() const = 0;
 
   virtual Status eval(const Footprint& footprint, const SPoint& s, double* value) const = 0;
   virtual Status average(const Footprint& footprint, const SRect& rect, double* value) const = 0;

@@ -1,6 +1,7 @@
 // Runtime-lite reader of tensor-ndf assets (written by tensorpack): the footprint pyramid of
 // ndf-pyramid assets with every NDF image cut into B x B angular blocks stored as rank-R CP models
-// per group (Deng et al. 2022, "Constant-Cost Spatially-Varying Glints", sec. 4). Layout:
+// per group (Deng et al. 2022, "Constant-Cost Spatio-Angular Prefiltering of Glinty Appearance
+// Using Tensor Decomposition", ACM TOG, sec. 4). Layout:
 // formats/SPEC.md section 10.4 and tensor_ndf_layout.h.
 //
 // Geometry and blending are exactly those of NdfPyramid (ndf_pyramid.h): level coordinate
@@ -38,8 +39,8 @@
 #pragma once
 
 #include <glintbake/runtime/cp_block.h>
-#include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/pyramid_ndf.h>
 #include <glintbake/runtime/tensor_ndf_layout.h>
 
 #include <cstddef>
@@ -53,24 +54,17 @@ namespace glintbake::runtime {
 constexpr float kTensorMaxFactor = 1e9f;
 constexpr float kTensorMaxPrefix = 1e12f;
 
-class TensorNdf final : public NdfSource {
+class TensorNdf : public PyramidNdf {
  public:
   TensorNdf();
   ~TensorNdf() override;
   TensorNdf(const TensorNdf&) = delete;
   TensorNdf& operator=(const TensorNdf&) = delete;
 
-  // Loads a tensor-ndf container (all groups). kIoError, kInvalidAsset, kWrongKind,
-  // kUnsupportedVersion, kOutOfMemory. Safe on untrusted input.
-  Status open(const char* path);
-  // Same, from a caller buffer (only needed during the call).
-  Status openMemory(const void* data, size_t size);
-  bool isOpen() const;
+  // open(), openMemory(), load(), isOpen(), levelCount(), level() and the argument checks of the
+  // queries: pyramid_ndf.h. open() loads all groups.
+  format::AssetKind kind() const override { return format::AssetKind::kTensorNdf; }
 
-  int resolution() const override;  // R
-  int levelCount() const;
-  // Descriptor of level l in [0, levelCount()), or null.
-  const NdfLevelRecord* level(int l) const;
   // The asset descriptor, or null when not open.
   const TensorInfoRecord* info() const;
   int groupCount() const;
@@ -83,12 +77,18 @@ class TensorNdf final : public NdfSource {
   // Bytes held in memory (factors, prefix sums, index, masses).
   uint64_t memoryBytes() const;
 
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status mass(const Footprint& footprint, double* value) const override;
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+ protected:
+  Status loadKind(const format::Reader& reader) override;
+  void reset() override;
+  bool loaded() const override { return impl_ != nullptr; }
+  const NdfLevelRecord* levelRecords(int* count) const override;
+
+  Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status massChecked(const Footprint& footprint, double* value) const override;
+  Status imageChecked(const Footprint& footprint, float* out) const override;
 
  private:
   struct Impl;

@@ -1,68 +1,16 @@
-// On-disk records of tensor-ndf assets (written by tensorpack, read by the runtime), formats/SPEC.md
-// section 10.4. All records are stored as their raw little-endian bytes.
-//
-// A tensor-ndf asset is an ndf-pyramid whose NDF images are cut into B x B angular blocks and
-// compressed per group (one spatial region of one level) by a rank-R CP decomposition:
-//  - section 16 `ndf-level` (key = level): the pyramid geometry, an NdfLevelRecord as in
-//    ndf-pyramid assets (ndf_pyramid.h); region_size there is the grouping region;
-//  - section 33 `tensor-info` (key 0): one TensorInfoRecord;
-//  - section 32 `tensor-index` (key = level): for every centre of the level (row-major over the
-//    level's grid) and every block of its image (row-major, block (bx, by) = by * nb + bx, bx from
-//    the left at s_x = -1, by from the top at s_y = +1, nb = R / B), a TensorIndexEntry;
-//  - section 34 `tensor-group` (key = group id, 0 .. group_count - 1): a TensorGroupHeader followed
-//    by the factors (see TensorGroupHeader).
+// The on-disk records of tensor-ndf assets, as the runtime names them. The records and their
+// checks live in the container library (glintbake/format/kinds/tensor_ndf.h, formats/SPEC.md
+// section 10.4); this header keeps the runtime's names.
 #pragma once
 
-#include <cstdint>
+#include <glintbake/format/kinds/tensor_ndf.h>
 
 namespace glintbake::runtime {
 
-// Asset descriptor (64 bytes).
-struct TensorInfoRecord {
-  uint32_t magic = 0x494E5447;  // "GTNI"
-  uint32_t version = 1;
-  uint32_t ndf_res = 0;          // R, bins per side of the NDF images (equal to every level's ndf_res)
-  uint32_t block = 0;            // B, bins per side of a block; divides R
-  uint32_t blocks_per_side = 0;  // nb = R / B
-  uint32_t level_count = 0;      // levels (ndf-level and tensor-index sections 0 .. level_count - 1)
-  uint32_t group_count = 0;      // tensor-group sections 0 .. group_count - 1
-  uint32_t max_rank = 0;         // largest rank of any group, [1, 64]
-  uint32_t precision = 0;        // factor storage: 0 = float32, 1 = float16 (prefix sums are float32)
-  uint32_t flags = 0;            // bit 0: non-negative factors (every range sum >= 0)
-  double blank_threshold = 0.0;  // blocks whose mass (integral over the block) was below this were dropped
-  uint64_t reserved[2] = {0, 0};
-};
-static_assert(sizeof(TensorInfoRecord) == 64, "TensorInfoRecord is 64 bytes");
-
-constexpr uint32_t kTensorFlagNonNegative = 1u;
-constexpr uint32_t kTensorBlankGroup = 0xFFFFFFFFu;  // TensorIndexEntry::group of a dropped (all-zero) block
-
-// Where one block of one centre's image lives (8 bytes).
-struct TensorIndexEntry {
-  uint32_t group = kTensorBlankGroup;  // group id, or kTensorBlankGroup: the block is 0 everywhere
-  uint32_t row = 0;                    // row of the group's C matrix, [0, blocks)
-};
-static_assert(sizeof(TensorIndexEntry) == 8, "TensorIndexEntry is 8 bytes");
-
-// Header of a tensor-group section (32 bytes). It is followed by, with E = 4 bytes (precision 0)
-// or 2 bytes (precision 1, IEEE binary16):
-//   A          bins x rank values (E each), row-major: A(i, r) at [i * rank + r]  (bin column i)
-//   B          bins x rank values (E each): B(j, r) (bin row j, top row j = 0)
-//   C          blocks x rank values (E each): C(k, r), column scales folded in
-//   A_prefix   (bins + 1) x rank float32: A_prefix[t][r] = sum_{i < t} A(i, r) (of the stored values)
-//   B_prefix   (bins + 1) x rank float32
-// The density of bin (i, j) of the block at row k is sum_r A(i, r) B(j, r) C(k, r), in the units
-// of NDF images (density per unit s-plane area, formats/SPEC.md section 3.1).
-struct TensorGroupHeader {
-  uint32_t magic = 0x474E5447;  // "GTNG"
-  uint32_t bins = 0;            // B (equals TensorInfoRecord::block)
-  uint32_t rank = 0;            // R of this group, [1, TensorInfoRecord::max_rank]
-  uint32_t blocks = 0;          // K, rows of C, >= 1
-  uint32_t level = 0;           // pyramid level of the group's centres
-  uint32_t region = 0;          // ry * regions_x + rx on that level
-  uint32_t precision = 0;       // equals TensorInfoRecord::precision
-  uint32_t reserved = 0;
-};
-static_assert(sizeof(TensorGroupHeader) == 32, "TensorGroupHeader is 32 bytes");
+using format::kTensorBlankGroup;
+using format::kTensorFlagNonNegative;
+using format::TensorGroupHeader;
+using format::TensorIndexEntry;
+using format::TensorInfoRecord;
 
 }  // namespace glintbake::runtime

@@ -3,15 +3,15 @@
 // instead of from the finest pyramid level.
 #pragma once
 
+#include <glintbake/format/container.h>
+
 #include <cstddef>
 #include <cstdint>
 
 namespace glintbake::format {
 
-// Section type of the flakes section (key 0, at most one per asset; ndf-pyramid and tensor-ndf).
-constexpr uint32_t kSectionFlakes = 80;
-
-// Header of the flakes section, 64 bytes little-endian, followed by map_width * map_height pairs
+// Header of the flakes section (kSectionFlakes, key 0, at most one per ndf-pyramid or tensor-ndf
+// asset), 64 bytes little-endian, followed by map_width * map_height pairs
 // of float32 (n_x, n_y), row-major, row 0 at the top (SPEC.md section 9 coordinates).
 struct FlakesRecord {
   uint32_t magic = 0x4B4C4647;  // "GFLK"

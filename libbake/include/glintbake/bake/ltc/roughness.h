@@ -6,6 +6,7 @@
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/ltc/multiscale.h>
 #include <glintbake/bake/result.h>
+#include <glintbake/format/container.h>
 
 #include <string>
 #include <vector>
@@ -30,6 +31,10 @@ struct RoughnessLevel {
 // filter of the unnormalised averaged normals (odd edges average the texels that exist), down to
 // 1 x 1. Thread-safe; levels are computed in parallel, bit-identically for any thread count.
 Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const RoughnessOptions& options);
+
+// Adds one section per level to an open writer of a roughness asset (formats/SPEC.md 10.3: type
+// 64, key = level, width x height x 1 image sections). kIo on a writer failure.
+Status writeRoughnessSections(const std::vector<RoughnessLevel>& levels, format::Writer& writer);
 
 // Writes the levels as one tiled, mipmapped single-channel float EXR (channel "Y"), atomically and
 // byte-reproducibly (no capture date).

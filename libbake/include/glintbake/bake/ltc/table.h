@@ -10,6 +10,7 @@
 
 #include <glintbake/bake/ltc/ltc.h>
 #include <glintbake/bake/result.h>
+#include <glintbake/format/container.h>
 
 #include <atomic>
 #include <cstdint>
@@ -83,6 +84,10 @@ struct PublishedTable {
   std::vector<float> ltc2;  // size * size * 4
 };
 PublishedTable packPublished(const FittedTable& table);
+
+// Adds the two sections of an ltc-table asset (formats/SPEC.md 10.2: type 48, keys 0 and 1,
+// size x size x 4 image sections) to an open writer of that kind. kIo on a writer failure.
+Status writeLtcTableSections(const PublishedTable& table, format::Writer& writer);
 
 // The horizon-clipped, cosine-weighted solid angle of a spherical cap divided by that of the
 // unclipped cap (Snyder 1996 / Heitz et al. 2017 "sphere" table): rows j (len = j/(N-1), the length

@@ -1,5 +1,6 @@
 // Streams a multi-level pyramid of footprint NDF images (Deng et al. 2022, "Constant-Cost
-// Spatially-Varying Glints") into an ndf-pyramid container, or into any PyramidSink.
+// Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG) into an ndf-pyramid container,
+// or into any PyramidSink.
 //
 // Level l: footprint std sigma_l = sigma0 * 2^l texels; grid_width = max(1, round(map_width /
 // (stride0 * 2^l))) centres per row (likewise per column), actual stride = map size / grid size
@@ -15,8 +16,8 @@
 // of flakes) are instead split into 16 interleaved row sets computed in parallel and summed in a
 // fixed order (still independent of the thread count). Peak memory: the flakes (24 bytes per
 // flake) plus two chunks (2 * region_size^2 * R^2 * 4 bytes; 32 MiB at the defaults) plus scratch
-// (R^2 * 8 bytes per thread and 16 R^2 * 8 for split footprints), plus what the sink keeps.
-// Measured: 4096^2 map, 1.15 GB peak RSS in ndfgen (ingest + flakes dominate).
+// (R^2 * 8 bytes per thread and 16 R^2 * 8 for split footprints), plus what the sink keeps
+// (README.md, "Figures", has measured peaks).
 //
 // Automatic level count (levels = 0): before level l >= 1 is computed, its images at up to 4 x 4
 // evenly spread centres (at most a quarter of the level's centres, at least one) are computed and compared with what
@@ -27,15 +28,14 @@
 // computing it (stop reason "converged"; the probe's MSE is reported). Otherwise the probed images
 // are reused when their regions are computed, so the probe costs nothing extra. The pyramid also
 // stops after the first level whose grid is 1 x 1 (the stride reached the map size), or at
-// kMaxPyramidLevels. Measured on the 1024^2 maps of the demo data: skipping the converged level
-// saves a third to a half of the bake time (each level costs about the same: a quarter of the
-// footprints, each with four times the flakes).
+// kMaxPyramidLevels (README.md, "Figures": what skipping the converged level saves).
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/ndf/splat.h>
 #include <glintbake/bake/result.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
 
 #include <atomic>
 #include <cstddef>
@@ -43,10 +43,6 @@
 #include <functional>
 #include <string>
 #include <vector>
-
-namespace glintbake::runtime {
-struct NdfLevelRecord;  // glintbake/runtime/ndf_pyramid.h: the on-disk level descriptor
-}
 
 namespace glintbake::bake::ndf {
 
@@ -118,7 +114,7 @@ struct PyramidChunk {
 class PyramidSink {
  public:
   virtual ~PyramidSink() = default;
-  virtual Status addLevel(const runtime::NdfLevelRecord& record) = 0;
+  virtual Status addLevel(const format::NdfLevelRecord& record) = 0;
   virtual Status addChunk(const PyramidChunk& chunk) = 0;
   virtual Status endLevel(int level) { return (void)level, okStatus(); }
   // Bytes the sink has written so far (for PyramidLevelReport::stored_bytes; 0 if it writes none).
@@ -126,16 +122,18 @@ class PyramidSink {
 };
 
 // The sink of ndf-pyramid assets: level records as kSectionNdfLevel, chunks as kSectionNdfChunk
-// sections of an open writer.
+// sections of an open writer. Every level record must pass format::checkNdfLevelRecord against the
+// level before it (kRuntime otherwise).
 class WriterPyramidSink final : public PyramidSink {
  public:
   explicit WriterPyramidSink(format::Writer& writer) : writer_(writer) {}
-  Status addLevel(const runtime::NdfLevelRecord& record) override;
+  Status addLevel(const format::NdfLevelRecord& record) override;
   Status addChunk(const PyramidChunk& chunk) override;
   uint64_t storedBytes() const override { return writer_.bytesWritten(); }
 
  private:
   format::Writer& writer_;
+  format::NdfLevelRecord below_;  // the last level added
 };
 
 // Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an

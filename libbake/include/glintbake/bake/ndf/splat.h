@@ -1,5 +1,5 @@
 // Fast P-NDF images of Gaussian footprints by splatting flakes into bins (Yan et al. 2016, the
-// per-element closed form of algorithms.md section 1).
+// per-element closed form of glintbake/reference/pndf.h).
 //
 // For a footprint N(u; u_Q, sigma_p^2 I) every flake k within the truncation radius contributes
 //   D_k(s) = A_k N(u_k; u_Q, (sigma_h^2 + sigma_p^2) I) N(s; mu_k, C_k)

@@ -1,8 +1,9 @@
 // Packs a footprint pyramid of NDF images into a tensor-ndf asset (formats/SPEC.md section 10.4):
 // every image is cut into B x B angular blocks, the non-blank blocks of all centres of one region
 // of one level are stacked into a B x B x K group tensor, and each group is stored as a rank-R CP
-// model with per-block prefix sums of A and B (Deng et al. 2022, "Constant-Cost Spatially-Varying
-// Glints", sec. 4), so that a renderer evaluates any bin range of any block in O(R).
+// model with per-block prefix sums of A and B (Deng et al. 2022, "Constant-Cost
+// Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG, sec. 4), so that a renderer
+// evaluates any bin range of any block in O(R).
 //
 // Streaming: the pyramid is consumed one region at a time (straight from the builder, or one chunk
 // at a time from an ndf-pyramid container); a region's blocks are copied into its group tensor and
@@ -20,10 +21,8 @@
 // Blank blocks: a block whose mass (the integral of its density over its s-plane area, in [0, 1]
 // for a normalised NDF image) is below blank_threshold is dropped: its index entry says "blank"
 // and it reconstructs to 0. All-zero blocks (e.g. outside the unit disk) always go. The default
-// 1e-5 bounds the mass lost per image by nb^2 * 1e-5 (1.6e-4 at R = 128, B = 32). Measured on
-// 256^2 mapgen maps at the default pyramid and rank 16: against threshold 0 (only all-zero blocks
-// dropped) it drops 5-25% more blocks and makes files 3-22% smaller with no change of the relative
-// L2 error in the 4th digit; 1e-3 saves up to 30% but may lose 1.6% of an image's mass.
+// 1e-5 bounds the mass lost per image by nb^2 * 1e-5 (1.6e-4 at R = 128, B = 32); README.md,
+// "Figures", compares thresholds.
 //
 // Stored factors: the CP columns are rebalanced so that A, B and C columns have equal norms (the
 // product is unchanged); this keeps float16 factors far from overflow and underflow. Prefix sums
@@ -47,6 +46,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/result.h>
 #include <glintbake/bake/tensor/cp_decomposition.h>
+#include <glintbake/format/binary16.h>
 #include <glintbake/format/container.h>
 
 #include <atomic>
@@ -121,9 +121,8 @@ Status packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyr
 Status packTensorNdfFromPyramid(const format::Reader& pyramid, const TensorPackOptions& options, format::Writer& writer,
                                 TensorPackReport* report, const std::atomic<bool>* cancel = nullptr);
 
-// IEEE 754 binary16 conversion with round-to-nearest-even (overflow gives infinity); exposed for
-// tests and for readers of precision-1 assets.
-uint16_t floatToHalf(float value);
-float halfToFloat(uint16_t bits);
+// IEEE 754 binary16 conversion (the container library's codec, glintbake/format/binary16.h).
+using format::floatToHalf;
+using format::halfToFloat;
 
 }  // namespace glintbake::bake::tensor

@@ -24,6 +24,8 @@ class ContainerOutput {
   // An image section (format::ImageSectionHeader + width*height*channels*layers floats).
   void addImageSection(uint32_t type, uint64_t key, int width, int height, int channels, const float* data,
                        int layers = 1);
+  // Container metadata for this output's asset kind (Tool::makeMetadata).
+  Json makeMetadata(const Json& parameters) const { return tool_.makeMetadata(kind_, parameters); }
   // Adds the metadata section, writes index and header, renames into place.
   void finish(const Json& metadata);
 
@@ -32,6 +34,8 @@ class ContainerOutput {
   uint64_t bytesWritten() const { return writer_.bytesWritten(); }
 
  private:
+  Tool& tool_;
+  format::AssetKind kind_;
   format::Writer writer_;
   std::string path_, temporary_;
   bool finished_ = false;

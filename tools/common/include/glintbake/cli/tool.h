@@ -11,6 +11,8 @@
 // "<tool>: error: <message>" as one line on stderr and returns the code.
 #pragma once
 
+#include <glintbake/format/container.h>
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -123,7 +125,9 @@ class Tool {
   void finishDepfile() const;
   // Container metadata with provenance (schemas/container-metadata.schema.json): tool, version,
   // asset kind, canonical parameters and the name and content hash of every input added so far.
-  // Never an absolute path or a timestamp.
+  // Never an absolute path or a timestamp. The asset kind's name comes from the kind registry
+  // (glintbake/format/kinds.h); the string form is kept for callers that still pass the name.
+  Json makeMetadata(format::AssetKind kind, const Json& parameters) const;
   Json makeMetadata(const std::string& asset_kind, const Json& parameters) const;
   const std::vector<std::string>& inputs() const { return inputs_; }
   // Effective thread count (resolved -j).

@@ -1,0 +1,79 @@
+// The shared surface of pyramid-shaped NDF assets (ndf-pyramid, tensor-ndf, and kinds built on
+// the same footprint pyramid, formats/SPEC.md 10.1): opening a container once, the level records,
+// the footprint range and map geometry, and the argument checks of every query. A kind implements
+// only what differs: loading its sections and answering checked queries.
+//
+// Extending a kind: a subclass (or a wrapper holding a PyramidNdf) can answer some footprints
+// from another source, e.g. footprints below footprintRange().pyramid_min_sigma exactly from
+// stored flakes, by overriding the checked queries (eval, average, ...Checked) and forwarding the
+// others to the base kind, and by overriding loadKind() to read its extra sections from the same
+// reader after the base kind's.
+#pragma once
+
+#include <glintbake/format/container.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
+#include <glintbake/runtime/ndf_source.h>
+
+#include <cstddef>
+
+namespace glintbake::runtime {
+
+// The level descriptor is the container's record (formats/SPEC.md 10.1, kinds/ndf_pyramid.h).
+using format::kMaxNdfLevels;
+using format::NdfLevelRecord;
+
+class PyramidNdf : public NdfSource {
+ public:
+  // Loads a container of this kind. kIoError, kInvalidAsset, kWrongKind, kUnsupportedVersion,
+  // kOutOfMemory. Safe on untrusted input.
+  Status open(const char* path);
+  // Same, from a caller buffer (only needed during the call).
+  Status openMemory(const void* data, size_t size);
+  // Same, from a reader opened by the caller (one open for a caller that reads other sections of
+  // the file too); kWrongKind when the reader's kind is not kind(). On failure the asset is empty.
+  Status load(const format::Reader& reader);
+  bool isOpen() const { return loaded(); }
+
+  int levelCount() const;
+  // Descriptor of level l in [0, levelCount()), or null.
+  const NdfLevelRecord* level(int l) const;
+
+  // NdfSource, from the level records.
+  int resolution() const override;
+  FootprintRange footprintRange() const override;
+  MapSize mapSize() const override;
+  MapWrap wrap() const override;
+
+  // NdfSource queries: the shared argument checks (ndf_source.h: kInvalidArgument when the asset
+  // is not open, an output pointer is null, the footprint or s is not finite, sigma < 0, a
+  // rectangle is empty, a uniform is outside [0, 1), or out_count < R * R), then the kind's
+  // checked query.
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const final;
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const final;
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const final;
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const final;
+  Status mass(const Footprint& footprint, double* value) const final;
+  Status image(const Footprint& footprint, float* out, size_t out_count) const final;
+
+ protected:
+  PyramidNdf() = default;
+
+  // Loads the kind's sections from a reader of the right kind into fresh state; on failure the
+  // caller resets. Called by open(), openMemory() and load().
+  virtual Status loadKind(const format::Reader& reader) = 0;
+  // Drops everything loaded (after this loaded() is false).
+  virtual void reset() = 0;
+  virtual bool loaded() const = 0;
+  // The loaded level records, contiguous (count of them), or null when not loaded.
+  virtual const NdfLevelRecord* levelRecords(int* count) const = 0;
+
+  // Queries on checked arguments (the asset is loaded, pointers are valid, the footprint is valid).
+  virtual Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const = 0;
+  virtual Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
+  virtual Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual Status massChecked(const Footprint& footprint, double* value) const = 0;
+  virtual Status imageChecked(const Footprint& footprint, float* out) const = 0;
+};
+
+}  // namespace glintbake::runtime

@@ -1,0 +1,114 @@
+// The shared surface of pyramid-shaped NDF assets: opening, level records, footprint range and
+// map geometry, and the argument checks of every query (pyramid_ndf.h).
+#include <glintbake/runtime/pyramid_ndf.h>
+
+#include "format_status.h"
+#include "pyramid_blend.h"
+
+#include <cmath>
+
+namespace glintbake::runtime {
+namespace {
+
+bool finitePoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+
+bool validRect(const SRect& r) {
+  return std::isfinite(r.x0) && std::isfinite(r.x1) && std::isfinite(r.y0) && std::isfinite(r.y1) && r.x1 > r.x0 &&
+         r.y1 > r.y0;
+}
+
+}  // namespace
+
+Status PyramidNdf::load(const format::Reader& reader) {
+  reset();
+  if (reader.kind() != kind()) return Status::kWrongKind;
+  const Status status = loadKind(reader);
+  if (status != Status::kOk) reset();
+  return status;
+}
+
+Status PyramidNdf::open(const char* path) {
+  reset();
+  if (!path) return Status::kInvalidArgument;
+  format::Reader reader;
+  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
+  return load(reader);
+}
+
+Status PyramidNdf::openMemory(const void* data, size_t size) {
+  reset();
+  if (!data) return Status::kInvalidArgument;
+  format::Reader reader;
+  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
+  return load(reader);
+}
+
+int PyramidNdf::levelCount() const {
+  int count = 0;
+  return levelRecords(&count) ? count : 0;
+}
+
+const NdfLevelRecord* PyramidNdf::level(int l) const {
+  int count = 0;
+  const NdfLevelRecord* records = levelRecords(&count);
+  return records && l >= 0 && l < count ? &records[l] : nullptr;
+}
+
+int PyramidNdf::resolution() const {
+  const NdfLevelRecord* first = level(0);
+  return first ? int(first->ndf_res) : 0;
+}
+
+FootprintRange PyramidNdf::footprintRange() const {
+  FootprintRange range;
+  const int count = levelCount();
+  if (count == 0) return range;
+  range.pyramid_min_sigma = level(0)->sigma_texels;
+  range.pyramid_max_sigma = level(count - 1)->sigma_texels;
+  return range;
+}
+
+MapSize PyramidNdf::mapSize() const {
+  const NdfLevelRecord* first = level(0);
+  return first ? MapSize{int(first->map_width), int(first->map_height)} : MapSize{};
+}
+
+MapWrap PyramidNdf::wrap() const {
+  const NdfLevelRecord* first = level(0);
+  return first && first->wrap == 1 ? MapWrap::kClamp : MapWrap::kRepeat;
+}
+
+Status PyramidNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return Status::kInvalidArgument;
+  return evalChecked(footprint, s, value);
+}
+
+Status PyramidNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !validRect(rect)) return Status::kInvalidArgument;
+  return averageChecked(footprint, rect, value);
+}
+
+Status PyramidNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+  if (!loaded() || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return Status::kInvalidArgument;
+  return sampleChecked(footprint, u1, u2, out);
+}
+
+Status PyramidNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return Status::kInvalidArgument;
+  return pdfChecked(footprint, s, value);
+}
+
+Status PyramidNdf::mass(const Footprint& footprint, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint)) return Status::kInvalidArgument;
+  return massChecked(footprint, value);
+}
+
+Status PyramidNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!loaded()) return Status::kInvalidArgument;
+  const size_t n = size_t(resolution()) * size_t(resolution());
+  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
+  return imageChecked(footprint, out);
+}
+
+}  // namespace glintbake::runtime

@@ -1,0 +1,146 @@
+// The exact content of the frozen version-1.0 containers of every asset kind (one file per kind,
+// formats/SPEC.md section 10): their records are spelt out here byte by byte from the SPEC's
+// tables (offsets and widths), not from the structs, so a change of a record's layout fails the
+// test. Shared by the generator (generate_frozen.cpp, run once) and by frozen_kinds_test.cpp.
+#pragma once
+
+#include <glintbake/format/container.h>
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace glintbake::format::frozen {
+
+// Little-endian record bytes, field by field at the SPEC's offsets.
+class Bytes {
+ public:
+  explicit Bytes(size_t size) : bytes_(size, 0) {}
+  Bytes& u16(size_t at, uint16_t v) { return put(at, &v, 2); }
+  Bytes& u32(size_t at, uint32_t v) { return put(at, &v, 4); }
+  Bytes& f32(size_t at, float v) { return put(at, &v, 4); }
+  Bytes& f64(size_t at, double v) { return put(at, &v, 8); }
+  const std::vector<uint8_t>& bytes() const { return bytes_; }
+
+ private:
+  Bytes& put(size_t at, const void* v, size_t n) {
+    // The file is little-endian; so are the hosts this project builds on.
+    if (at + n <= bytes_.size()) std::memcpy(bytes_.data() + at, v, n);
+    return *this;
+  }
+  std::vector<uint8_t> bytes_;
+};
+
+inline std::string kindMetadata(const char* kind, const char* tool) {
+  return std::string(R"({"schema":"glintbake.container-metadata/1","asset_kind":")") + kind +
+         R"(","generator":{"tool":")" + tool + R"(","version":"0.1.0"},"parameters":{"frozen":true},)" +
+         R"("inputs":[{"name":"frozen.png","hash":"xxh3-128:00112233445566778899aabbccddeeff"}]})";
+}
+
+// An image section (SPEC 3.1) whose value (x, y, c, l) is value(x, y, c, l).
+template <typename Value>
+std::vector<uint8_t> imageSection(uint32_t w, uint32_t h, uint32_t c, uint32_t layers, Value value) {
+  Bytes b(32 + 4 * size_t(w) * h * c * layers);
+  b.u32(0, 0x474D4947).u32(4, w).u32(8, h).u32(12, c).u32(16, layers);
+  size_t at = 32;
+  for (uint32_t l = 0; l < layers; ++l)
+    for (uint32_t y = 0; y < h; ++y)
+      for (uint32_t x = 0; x < w; ++x)
+        for (uint32_t ch = 0; ch < c; ++ch, at += 4) b.f32(at, value(x, y, ch, l));
+  return b.bytes();
+}
+
+// --- ndf-pyramid (SPEC 10.1): an 8 x 8 repeating map, R = 4, two levels (2 x 2 and 1 x 1 centres,
+// one region each). ---------------------------------------------------------------------------
+
+constexpr uint32_t kPyramidRes = 4;
+
+// ndf-level record of level 0 or 1 (112 bytes).
+inline std::vector<uint8_t> pyramidLevel(uint32_t level) {
+  const uint32_t grid = level == 0 ? 2 : 1;
+  const double stride = level == 0 ? 4.0 : 8.0;
+  Bytes b(112);
+  b.u32(0, 0x4C444E47).u32(4, 1).u32(8, level).u32(12, kPyramidRes);
+  b.u32(16, grid).u32(20, grid).u32(24, 2).u32(28, 1).u32(32, 1);
+  b.u32(36, 0).u32(40, 8).u32(44, 8).u32(48, 1).u32(52, 0);
+  b.f64(56, stride).f64(64, stride).f64(72, stride / 2).f64(80, stride / 2);
+  b.f64(88, level == 0 ? 2.0 : 4.0).f64(96, 0.005).f64(104, 0.0);
+  return b.bytes();
+}
+
+// Bin (i, j) of the image of centre k of a level: exact in float32, non-negative.
+inline float pyramidBin(uint32_t level, uint32_t k, uint32_t i, uint32_t j) {
+  return 0.0625f * float(1 + i + 2 * j + 4 * k + 16 * level);
+}
+
+inline std::vector<uint8_t> pyramidChunk(uint32_t level) {
+  const uint32_t layers = level == 0 ? 4 : 1;
+  return imageSection(kPyramidRes, kPyramidRes, 1, layers,
+                      [level](uint32_t x, uint32_t y, uint32_t, uint32_t l) { return pyramidBin(level, l, x, y); });
+}
+
+// --- tensor-ndf (SPEC 10.4): R = 4 in 2 x 2 blocks of B = 2, one level of one centre, one group
+// of rank 1 holding two blocks, float16 factors, non-negative. -------------------------------
+
+inline std::vector<uint8_t> tensorLevel() {
+  Bytes b(112);
+  b.u32(0, 0x4C444E47).u32(4, 1).u32(8, 0).u32(12, 4);
+  b.u32(16, 1).u32(20, 1).u32(24, 1).u32(28, 1).u32(32, 1);
+  b.u32(36, 1).u32(40, 16).u32(44, 16).u32(48, 1);
+  b.f64(56, 16.0).f64(64, 16.0).f64(72, 8.0).f64(80, 8.0).f64(88, 8.0).f64(96, 0.005);
+  return b.bytes();
+}
+
+inline std::vector<uint8_t> tensorInfo() {
+  Bytes b(64);
+  b.u32(0, 0x494E5447).u32(4, 1).u32(8, 4).u32(12, 2).u32(16, 2).u32(20, 1).u32(24, 1).u32(28, 1);
+  b.u32(32, 1).u32(36, 1).f64(40, 1e-6);
+  return b.bytes();
+}
+
+// Blocks 0 and 3 are rows 0 and 1 of group 0; blocks 1 and 2 were dropped.
+inline std::vector<uint8_t> tensorIndex() {
+  Bytes b(4 * 8);
+  b.u32(0, 0).u32(4, 0).u32(8, 0xFFFFFFFFu).u32(12, 0).u32(16, 0xFFFFFFFFu).u32(20, 0).u32(24, 0).u32(28, 1);
+  return b.bytes();
+}
+
+// Factors A = (1, 0.5), B = (0.25, 1), C = (2, 0.5) as binary16, then the float32 prefix sums.
+constexpr float kTensorA[2] = {1.0f, 0.5f}, kTensorB[2] = {0.25f, 1.0f}, kTensorC[2] = {2.0f, 0.5f};
+
+inline std::vector<uint8_t> tensorGroup() {
+  Bytes b(32 + 2 * 6 + 4 * 6);
+  b.u32(0, 0x474E5447).u32(4, 2).u32(8, 1).u32(12, 2).u32(16, 0).u32(20, 0).u32(24, 1).u32(28, 0);
+  // binary16 of 1, 0.5 | 0.25, 1 | 2, 0.5
+  b.u16(32, 0x3C00).u16(34, 0x3800).u16(36, 0x3400).u16(38, 0x3C00).u16(40, 0x4000).u16(42, 0x3800);
+  b.f32(44, 0.0f).f32(48, 1.0f).f32(52, 1.5f);    // A prefix
+  b.f32(56, 0.0f).f32(60, 0.25f).f32(64, 1.25f);  // B prefix
+  return b.bytes();
+}
+
+// --- ltc-table (SPEC 10.2): N = 2, 4 channels. ---------------------------------------------------
+
+inline float ltcValue(uint64_t key, uint32_t a, uint32_t t, uint32_t c) {
+  return float(key) * 8.0f + float(a) + 2.0f * float(t) + 0.25f * float(c) + 0.5f;
+}
+
+inline std::vector<uint8_t> ltcSection(uint64_t key) {
+  return imageSection(2, 2, 4, 1,
+                      [key](uint32_t x, uint32_t y, uint32_t c, uint32_t) { return ltcValue(key, x, y, c); });
+}
+
+// --- roughness (SPEC 10.3): a 3 x 2 map, mips 3 x 2, 2 x 1, 1 x 1. ------------------------------
+
+constexpr uint32_t kRoughnessW[3] = {3, 2, 1}, kRoughnessH[3] = {2, 1, 1};
+
+inline float roughnessValue(uint32_t level, uint32_t x, uint32_t y) {
+  return 0.125f * float(1 + x + 3 * y) + 0.0625f * float(level);
+}
+
+inline std::vector<uint8_t> roughnessMip(uint32_t level) {
+  return imageSection(kRoughnessW[level], kRoughnessH[level], 1, 1,
+                      [level](uint32_t x, uint32_t y, uint32_t, uint32_t) { return roughnessValue(level, x, y); });
+}
+
+}  // namespace glintbake::format::frozen
