@@ -327,6 +327,23 @@ TEST(CpDecomposition, OneAxisGroupsAtEveryRank) {
   }
 }
 
+TEST(CpDecomposition, LargeNdfValuesGiveFiniteFactors) {
+  // Bins of 1e6-1e9 (a fine --ndf-res with a small --sigma-r): the range finder's power iteration
+  // squares the scale, and its float QR overflowed (NaN core, NaN factors) before the sketch was
+  // rescaled by a power of two.
+  for (float scale : {1e6f, 1e9f}) {
+    GroupTensor t = makeOneAxisGroup(32, 300, 2, false);
+    for (float& v : t.values) v *= scale;
+    for (bool nonneg : {true, false}) {
+      CpOptions o;
+      o.nonneg = nonneg;
+      const CpFactors f = decompose(t, o);
+      ASSERT_TRUE(allFinite(f)) << "scale " << scale << " nonneg " << nonneg;
+      EXPECT_LT(f.relative_error, 0.8) << "scale " << scale << " nonneg " << nonneg;
+    }
+  }
+}
+
 TEST(CpDecomposition, ZeroTensorGivesZeroModel) {
   GroupTensor t;
   t.bins = 8;
