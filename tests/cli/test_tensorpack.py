@@ -2,6 +2,7 @@
 the default output name, byte-identical output for every thread count and run, and the documented
 exit codes for bad arguments and bad input with nothing left behind."""
 
+import json
 import math
 import os
 import shutil
@@ -52,7 +53,7 @@ class TensorPack(ToolTestCase):
     def test_help_and_version(self):
         code, out, _ = run("tensorpack", "--help")
         self.assertEqual(code, clitest.OK)
-        for option in ("--rank", "--block", "--error-target", "--blank-threshold", "--precision", "--nonneg",
+        for option in ("--rank", "--block", "--error-target", "--max-error", "--blank-threshold", "--precision", "--nonneg",
                        "--ndf-res", "--json", "--depfile", "--threads"):
             self.assertIn(option, out)
         code, out, _ = run("tensorpack", "--version")
@@ -139,6 +140,68 @@ class TensorPack(ToolTestCase):
             if os.path.exists(clitest.tool_path("glintinfo")):
                 code, _, err = run("glintinfo", "validate", self.path(f"one_axis_{axis}.gbk"))
                 self.assertEqual(code, clitest.OK, err)
+
+    def warnings_on_stderr(self, err):
+        lines = [l for l in err.splitlines() if "warning" in l]
+        for l in lines:
+            self.assertTrue(l.startswith("tensorpack: warning: "), l)
+        return lines
+
+    def test_quality_warnings(self):
+        m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
+        # A fit within the default bound: no warning.
+        out, err = self.run_ok("tensorpack", m, "-o", self.path("good.gbk"), *PYRAMID, "--rank", "8", "--block", "16",
+                               "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertLessEqual(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertEqual(doc["warnings"], [])
+        self.assertEqual(self.warnings_on_stderr(err), [])
+        # Rank 1 leaves most of the structure: above the default bound 0.5, one warning line, the
+        # same message in --json, and the asset is still written.
+        bad = self.path("bad.gbk")
+        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertGreater(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertEqual(len(doc["warnings"]), 1)
+        self.assertIn("default bound 0.5", doc["warnings"][0])
+        lines = self.warnings_on_stderr(err)
+        self.assertEqual(len(lines), 1)
+        self.assertIn(doc["warnings"][0], lines[0])
+        self.assertTrue(os.path.exists(bad))
+        # --quiet drops the stderr line (the reporter's convention for warnings); --json keeps it.
+        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
+                               "--quiet")
+        self.assertEqual(self.warnings_on_stderr(err), [])
+        self.assertEqual(len(json.loads(out)["warnings"]), 1)
+        # A missed --error-target warns whatever the default bound says.
+        out, err = self.run_ok("tensorpack", m, "-o", self.path("target.gbk"), *PYRAMID, "--rank", "2", "--block",
+                               "16", "--error-target", "0.001", "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertEqual(len(doc["warnings"]), 1)
+        self.assertIn("misses --error-target 0.0010", doc["warnings"][0])
+        self.assertEqual(len(self.warnings_on_stderr(err)), 1)
+
+    def test_max_error_gate(self):
+        m = self.mapgen("scratches", "s.png", "--size", "32", "--seed", "5")
+        ref = self.path("ref.gbk")
+        doc = self.run_json("tensorpack", m, "-o", ref, *PYRAMID, *PACK, schema="tensorpack.schema.json")
+        achieved = max(doc["relative_error"], doc["max_group_error"])
+        # Exceeded: runtime failure, one line naming the achieved error, nothing written.
+        out = self.path("gated.gbk")
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error",
+                                "%.6f" % (achieved * 0.5), outputs=[out])
+        self.assertIn("--max-error", err)
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--json",
+                                "--max-error", "0", outputs=[out])
+        # Met: the gate does not change a byte.
+        self.run_ok("tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error", "%.6f" % (achieved * 1.01 + 1e-6))
+        self.assertEqual(clitest.file_hash(out), clitest.file_hash(ref))
+        for bad in ("-1", "nan", "inf"):
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID, *PACK,
+                              "--max-error", bad, outputs=[self.path("x.gbk")])
 
     def test_bad_arguments(self):
         m = self.mapgen("beckmann", "m.png", "--size", "32")

@@ -10,13 +10,16 @@
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -47,6 +50,49 @@ std::string defaultOutput(const std::string& input, bool container) {
 }
 
 int exitCodeOf(const bake::Error& e) { return int(e.code); }
+
+// Relative error above which tensorpack warns when no --error-target is given (README, "tensorpack
+// defaults"). At rank 16 the real maps of ../shared/data that CP compresses well land at 0.15-0.25
+// (brushed_blender_1024 0.164, scratches_straight_cutlery_512 0.151), while a sharp-flake map lands
+// at 0.93 (flakes_voronoi_sharp_snail_512; the example flakes asset 0.88): an asset that far off has
+// lost most of its glints. 0.5 separates the two with room on both sides.
+constexpr double kDefaultErrorBound = 0.5;
+
+std::string errorText(double e) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4f", e);
+  return text;
+}
+
+// The error a gate compares: the larger of the whole pyramid's relative error (dropped blocks
+// included) and the largest group's (its kept blocks).
+double gatedError(const tensor::TensorPackReport& r) { return std::max(r.relative_error, r.max_group_error); }
+
+std::string achievedText(const tensor::TensorPackReport& r) {
+  return "relative error " + errorText(r.relative_error) + " (largest group " + errorText(r.max_group_error) + ")";
+}
+
+// --max-error: fails (runtime failure, before anything is written) when the gated error exceeds E.
+void checkMaxError(const tensor::TensorPackReport& r, double max_error, const std::string& input) {
+  if (max_error < 0.0 || !(gatedError(r) > max_error)) return;
+  throw Error(cli::kExitRuntime,
+              input + ": " + achievedText(r) + " exceeds --max-error " + errorText(max_error) + "; no output written");
+}
+
+// One warning when the gated error misses --error-target (when given) or the default bound.
+std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, double error_target, int rank) {
+  std::vector<std::string> warnings;
+  if (error_target >= 0.0) {
+    if (gatedError(r) > error_target) {
+      warnings.push_back(achievedText(r) + " misses --error-target " + errorText(error_target) + " at --rank " +
+                         std::to_string(rank));
+    }
+  } else if (gatedError(r) > kDefaultErrorBound) {
+    warnings.push_back(achievedText(r) + " exceeds the default bound " + errorText(kDefaultErrorBound) +
+                       " (raise --rank, or gate with --max-error)");
+  }
+  return warnings;
+}
 
 Json levelJson(const tensor::TensorPackLevelReport& l) {
   Json j;
@@ -86,7 +132,7 @@ int main(int argc, char** argv) {
   // negative density, where plain factors put 1-5% of the absolute density below zero (queries
   // clamp it, so pdf and value / mass disagree there).
   opt.cp.nonneg = true;
-  double error_target = -1.0;
+  double error_target = -1.0, max_error = -1.0;
   int zstd_level = 9;
   CLI::App& app = tool.app();
   app.add_option("input", input, "Normal map (or height field with --height), or an ndf-pyramid container (.gbk)")
@@ -101,7 +147,11 @@ int main(int argc, char** argv) {
   app.add_option("--tol", opt.cp.tol, "Stop when the fit changes by less than this (>= 0)")->capture_default_str();
   app.add_option("--max-iters", opt.cp.max_iters, "Most ALS sweeps per group (>= 1)")->capture_default_str();
   app.add_option("--error-target", error_target,
-                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1)");
+                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1); a warning when "
+                 "the achieved error misses it");
+  app.add_option("--max-error", max_error,
+                 "Fail (exit 4, no output) when the relative error of the pyramid or of any group exceeds this "
+                 "(>= 0; unset: no gate). Without --error-target, errors above 0.5 warn");
   app.add_option("--blank-threshold", opt.blank_threshold, "Drop blocks whose mass is below this (0..1)")
       ->capture_default_str();
   app.add_option("--precision", precision_text, "Factor storage: float32 or float16")->capture_default_str();
@@ -123,6 +173,9 @@ int main(int argc, char** argv) {
     opt.error_target = error_target;
     if (app.count("--error-target") && !(error_target >= 0.0 && error_target <= 1.0)) {
       throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
+    }
+    if (app.count("--max-error") && !(max_error >= 0.0 && std::isfinite(max_error))) {
+      throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
     }
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
     if (bake::Status s = tensor::validateTensorPackOptions(opt); !s)
@@ -196,6 +249,9 @@ int main(int argc, char** argv) {
       if (!s) throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
     }
 
+    checkMaxError(report, max_error, input);
+    const std::vector<std::string> warnings = qualityWarnings(report, error_target, opt.cp.rank);
+
     Json asset;
     asset["ndf_res"] = report.ndf_res;
     asset["block"] = opt.block;
@@ -220,6 +276,8 @@ int main(int argc, char** argv) {
     Json meta = t.makeMetadata("tensor-ndf", params);
     meta["asset"] = asset;
     out->finish(meta);
+    // After the asset is in place, so that a failed write is still a one-line error.
+    for (const std::string& w : warnings) t.warning(input + ": " + w);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const uint64_t file_bytes = out->bytesWritten();
     const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
@@ -248,6 +306,7 @@ int main(int argc, char** argv) {
       doc["relative_error"] = report.relative_error;
       doc["max_group_error"] = report.max_group_error;
       doc["negative_mass_fraction"] = report.negative_mass_fraction;
+      doc["warnings"] = warnings;
       doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},
                         {"wait", report.wait_seconds}, {"pack", report.total_seconds}, {"total", seconds}};
       t.printJson(doc);
