@@ -23,14 +23,52 @@ MatD gram(const MatF& m) {
   return g;
 }
 
-Eigen::VectorXd normaliseColumns(MatF& m, MatF* absorb) {
+namespace {
+
+// Column r of m to unit norm, its norm into absorb's column r. The float arithmetic below is the
+// packer's historical one and is kept bit for bit whenever its results are finite. A rank-1 term
+// that is dying (its scale, carried by C, decaying through the float subnormals) or being revived
+// from such a column has norms whose reciprocal or product leaves the float range (1 / 1e-40, a
+// HALS column of 1e43 computed in double); those columns are scaled in double from `exact` (the
+// column before its float rounding) or from m itself, so no inf or NaN can appear. Returns the
+// norm (1 for a zero column); *widened is set when the double path ran.
+double normaliseColumn(MatF& m, Eigen::Index r, MatF* absorb, const Eigen::VectorXd* exact, bool* widened) {
+  const double norm = m.col(r).cast<double>().norm();
+  if (!(norm > 0.0)) return 1.0;  // a zero column stays zero (its term is dead)
+  if (std::isfinite(norm)) {
+    const float inverse = static_cast<float>(1.0 / norm), scale = static_cast<float>(norm);
+    const Eigen::VectorXf unit = m.col(r) * inverse;
+    bool finite = unit.allFinite();
+    Eigen::VectorXf absorbed;
+    if (finite && absorb) {
+      absorbed = absorb->col(r) * scale;
+      finite = absorbed.allFinite();
+    }
+    if (finite) {
+      m.col(r) = unit;
+      if (absorb) absorb->col(r) = absorbed;
+      return norm;
+    }
+  }
+  const Eigen::VectorXd wide = exact ? *exact : Eigen::VectorXd(m.col(r).cast<double>());
+  const double wide_norm = wide.norm();
+  if (!(wide_norm > 0.0) || !std::isfinite(wide_norm)) return 1.0;
+  m.col(r) = (wide / wide_norm).cast<float>();
+  if (absorb) absorb->col(r) = (absorb->col(r).cast<double>() * wide_norm).cast<float>();
+  if (widened) *widened = true;
+  return wide_norm;
+}
+
+}  // namespace
+
+Eigen::VectorXd normaliseColumns(MatF& m, MatF* absorb, const MatD* exact, bool* widened) {
   Eigen::VectorXd norms = Eigen::VectorXd::Ones(m.cols());
   for (Eigen::Index r = 0; r < m.cols(); ++r) {
-    const double norm = m.col(r).cast<double>().norm();
-    if (norm > 0.0 && std::isfinite(norm)) {
-      m.col(r) *= static_cast<float>(1.0 / norm);
-      if (absorb) absorb->col(r) *= static_cast<float>(norm);
-      norms[r] = norm;
+    if (exact) {
+      const Eigen::VectorXd column = exact->col(r);
+      norms[r] = normaliseColumn(m, r, absorb, &column, widened);
+    } else {
+      norms[r] = normaliseColumn(m, r, absorb, nullptr, widened);
     }
   }
   return norms;
@@ -160,8 +198,11 @@ namespace {
 
 // One pass of HALS column updates on F (rows x R) for the problem min |M - F G|, F >= 0:
 // f_r <- max(0, f_r + (m_r - F g_r) / g_rr), columns in order (Cichocki & Phan 2009). A column
-// that reaches zero stays zero (the model loses that rank-1 term).
-void halsUpdate(MatF& f, const MatD& m, const MatD& g) {
+// that reaches zero stays zero (the model loses that rank-1 term). The update runs in double;
+// `exact` (when given) receives it before the rounding to float, for normaliseColumns: the update
+// of A or B against a dying term's subnormal C column (g_rr ~ |c_r|^2 ~ 1e-86) is of the order
+// 1 / |c_r| and overflows float, though its product with c_r is an ordinary rank-1 term.
+void halsUpdate(MatF& f, const MatD& m, const MatD& g, MatD* exact = nullptr) {
   MatD fd = f.cast<double>();
   for (Eigen::Index r = 0; r < fd.cols(); ++r) {
     const double diag = g(r, r);
@@ -170,6 +211,7 @@ void halsUpdate(MatF& f, const MatD& m, const MatD& g) {
     fd.col(r) = col.cwiseMax(0.0);
   }
   f = fd.cast<float>();
+  if (exact) *exact = std::move(fd);
 }
 
 }  // namespace
@@ -178,17 +220,26 @@ double CpEngine::halsSweep(CpState& s) {
   contractW(s.c);
   MatD ctc = gram(s.c);
 
+  MatD exact;
+  bool widened = false;
   contractModeA(s.b, m_);
-  halsUpdate(s.a, m_, gram(s.b).cwiseProduct(ctc));
-  const Eigen::VectorXd norms = normaliseColumns(s.a, &s.c);
-  // W = X^T C is linear in C: absorbing A's norms into C scales W's columns the same way.
-  // C^T C follows the same scaling: (D C^T C D)(i, j) = n_i n_j (C^T C)(i, j).
-  for (int r = 0; r < rank_; ++r) w_.col(r) *= static_cast<float>(norms[r]);
-  ctc = norms.asDiagonal() * ctc * norms.asDiagonal();
+  halsUpdate(s.a, m_, gram(s.b).cwiseProduct(ctc), &exact);
+  const Eigen::VectorXd norms = normaliseColumns(s.a, &s.c, &exact, &widened);
+  if (widened) {
+    // A norm beyond the float range moved into C (a revived term): contract again rather than
+    // scale W by a factor float cannot hold.
+    contractW(s.c);
+    ctc = gram(s.c);
+  } else {
+    // W = X^T C is linear in C: absorbing A's norms into C scales W's columns the same way.
+    // C^T C follows the same scaling: (D C^T C D)(i, j) = n_i n_j (C^T C)(i, j).
+    for (int r = 0; r < rank_; ++r) w_.col(r) *= static_cast<float>(norms[r]);
+    ctc = norms.asDiagonal() * ctc * norms.asDiagonal();
+  }
 
   contractModeB(s.a, m_);
-  halsUpdate(s.b, m_, gram(s.a).cwiseProduct(ctc));
-  normaliseColumns(s.b, &s.c);
+  halsUpdate(s.b, m_, gram(s.a).cwiseProduct(ctc), &exact);
+  normaliseColumns(s.b, &s.c, &exact, nullptr);
 
   return solveC(s, 0.0, true);
 }

@@ -70,8 +70,11 @@ class CpEngine {
 // Column-wise helpers shared by the drivers.
 MatD gram(const MatF& m);  // m^T m in double
 // Scales m's columns to unit norm (zero columns stay zero) and multiplies absorb's columns by the
-// norms (when given). Returns the norms (1 for zero columns).
-Eigen::VectorXd normaliseColumns(MatF& m, MatF* absorb);
+// norms (when given). Returns the norms (1 for zero columns). Norms outside the float range (a
+// subnormal column, or a HALS column that overflowed float) are applied in double, from `exact`
+// (m before its rounding to float, same size) when given, and set *widened (so a term revived from
+// a subnormal C column keeps finite factors, its scale in C).
+Eigen::VectorXd normaliseColumns(MatF& m, MatF* absorb, const MatD* exact = nullptr, bool* widened = nullptr);
 // Solves X * G = M for X (G symmetric positive semi-definite, R x R) with a relative ridge.
 MatD solveNormalEquations(const MatD& m, const MatD& g, double ridge);
 

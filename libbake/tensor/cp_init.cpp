@@ -74,7 +74,13 @@ MatF modeThreeRangeBasis(const float* x, int bins, int blocks, int basis, uint64
   const Eigen::Index n = static_cast<Eigen::Index>(bins) * bins;
   Eigen::Map<const MatF> xt(x, n, blocks);  // X^T, (B*B) x K
   SplitMix64 rng(seed ^ 0x2545F4914F6CDD1Dull);
-  auto orthonormalise = [blocks, basis](const MatF& y) {
+  auto orthonormalise = [blocks, basis](MatF& y) {
+    // The power iteration squares the data's scale: NDF bins of 1e6 give sketch entries beyond
+    // 1e20, whose squared column norms overflow the float QR. Q is invariant under scaling y by a
+    // power of two (every Householder quantity scales exactly), so large sketches are brought to
+    // [1, 2) first; below 2^40 nothing is touched.
+    const float peak = y.cwiseAbs().maxCoeff();
+    if (std::isfinite(peak) && peak > 0x1.0p40f) y *= std::ldexp(1.0f, -std::ilogb(peak));
     Eigen::HouseholderQR<MatF> qr(y);
     MatF q = qr.householderQ() * MatF::Identity(blocks, basis);
     return q;

@@ -93,16 +93,27 @@ bool hasDeadColumns(const CpFactors& f) {
   return false;
 }
 
-// Retries a decomposition stuck with dead columns from the seeded random start of kAlsPlain (same
-// rank, same options otherwise) and keeps whichever fits better. Costs nothing on groups without
-// dead columns; deterministic either way.
+bool isFinite(const CpFactors& f) {
+  for (const auto* m : {&f.a, &f.b, &f.c}) {
+    for (float v : *m) {
+      if (!std::isfinite(v)) return false;
+    }
+  }
+  return std::isfinite(f.relative_error);
+}
+
+// Retries a decomposition stuck with dead columns (or, as a last resort, one whose factors are not
+// finite) from the seeded random start of kAlsPlain (same rank, same options otherwise) and keeps
+// whichever fits better. Costs nothing on groups without dead columns; deterministic either way.
 void retryDeadColumns(const GroupTensor& tensor, const CpOptions& options, CpFactors& f) {
-  if (options.method == CpMethod::kAlsPlain || !(f.relative_error > 1e-6) || !hasDeadColumns(f)) return;
+  if (options.method == CpMethod::kAlsPlain) return;
+  const bool finite = isFinite(f);
+  if (finite && (!(f.relative_error > 1e-6) || !hasDeadColumns(f))) return;
   CpOptions plain = options;
   plain.method = CpMethod::kAlsPlain;
   plain.rank = f.rank;
   Result<CpFactors> retry = decomposeCp(tensor, plain);
-  if (retry && retry.value().relative_error < f.relative_error) f = std::move(retry).value();
+  if (retry && (!finite || retry.value().relative_error < f.relative_error)) f = std::move(retry).value();
 }
 
 }  // namespace

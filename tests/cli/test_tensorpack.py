@@ -2,8 +2,11 @@
 the default output name, byte-identical output for every thread count and run, and the documented
 exit codes for bad arguments and bad input with nothing left behind."""
 
+import json
+import math
 import os
 import shutil
+import struct
 
 import clitest
 from clitest import ToolTestCase, run
@@ -12,11 +15,45 @@ PYRAMID = ["--ndf-res", "32", "--stride", "8", "--sigma0", "4"]
 PACK = ["--rank", "8", "--block", "16", "--quiet"]
 
 
+def write_half_exr(path, width, height, texel):
+    """A scanline, uncompressed, half-float RGB EXR; texel(x, y) gives (r, g, b)."""
+    def attribute(name, kind, data):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(data)) + data
+
+    channels = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", 1, 0, 1, 1) for c in "BGR") + b"\0"
+    window = struct.pack("<iiii", 0, 0, width - 1, height - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<I", 2) + attribute("channels", "chlist", channels) +
+              attribute("compression", "compression", b"\0") + attribute("dataWindow", "box2i", window) +
+              attribute("displayWindow", "box2i", window) + attribute("lineOrder", "lineOrder", b"\0") +
+              attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0)) +
+              attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0)) +
+              attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    line = 8 + width * 3 * 2
+    first = len(header) + 8 * height
+    table = b"".join(struct.pack("<Q", first + y * line) for y in range(height))
+    lines = []
+    for y in range(height):
+        row = [texel(x, y) for x in range(width)]
+        data = b"".join(struct.pack("<%de" % width, *[t[c] for t in row]) for c in (2, 1, 0))  # B, G, R
+        lines.append(struct.pack("<ii", y, len(data)) + data)
+    with open(path, "wb") as f:
+        f.write(header + table + b"".join(lines))
+
+
+def one_axis_normal(t, size):
+    """A brushed-like normal that depends on one coordinate t only: n_x within +-0.02, n_y within
+    +-0.5 (smooth periodic profiles)."""
+    w = 2.0 * math.pi / size
+    nx = 0.02 * (math.sin(3 * w * t + 0.4) + 0.5 * math.sin(7 * w * t + 0.8)) / 1.5
+    ny = 0.5 * (math.sin(2 * w * t + 1.3) + 0.5 * math.sin(5 * w * t + 2.6)) / 1.5
+    return nx, ny, math.sqrt(1.0 - nx * nx - ny * ny)
+
+
 class TensorPack(ToolTestCase):
     def test_help_and_version(self):
         code, out, _ = run("tensorpack", "--help")
         self.assertEqual(code, clitest.OK)
-        for option in ("--rank", "--block", "--error-target", "--blank-threshold", "--precision", "--nonneg",
+        for option in ("--rank", "--block", "--error-target", "--max-error", "--blank-threshold", "--precision", "--nonneg",
                        "--ndf-res", "--json", "--depfile", "--threads"):
             self.assertIn(option, out)
         code, out, _ = run("tensorpack", "--version")
@@ -84,6 +121,87 @@ class TensorPack(ToolTestCase):
             text = f.read()
         self.assertIn("br.gbk", text)
         self.assertIn("br.png", text)
+
+    def test_one_axis_signed_half_exr_maps(self):
+        # Normals that vary along x only, or along y only: every NDF image is a thin line at s_x ~ 0
+        # on a block boundary, so the CP groups are rank deficient. The default non-negative bake
+        # (the default pyramid, --rank 16) used to fail with exit 4 and non-finite factors.
+        size = 64
+        for axis in ("x", "y"):
+            m = self.path(f"one_axis_{axis}.exr")
+            write_half_exr(m, size, size, lambda x, y: one_axis_normal(x if axis == "x" else y, size))
+            doc = self.run_json("tensorpack", m, "--rank", "16", "--quiet", schema="tensorpack.schema.json")
+            self.assertEqual(doc["map"], {"width": size, "height": size, "wrap": "repeat"})
+            self.assertTrue(doc["parameters"]["nonneg"])
+            self.assertEqual(doc["negative_mass_fraction"], 0.0)
+            self.assertGreater(doc["relative_error"], 0.0)
+            self.assertLess(doc["relative_error"], 0.5, axis)
+            self.assertLess(doc["max_group_error"], 0.5, axis)
+            if os.path.exists(clitest.tool_path("glintinfo")):
+                code, _, err = run("glintinfo", "validate", self.path(f"one_axis_{axis}.gbk"))
+                self.assertEqual(code, clitest.OK, err)
+
+    def warnings_on_stderr(self, err):
+        lines = [l for l in err.splitlines() if "warning" in l]
+        for l in lines:
+            self.assertTrue(l.startswith("tensorpack: warning: "), l)
+        return lines
+
+    def test_quality_warnings(self):
+        m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
+        # A fit within the default bound: no warning.
+        out, err = self.run_ok("tensorpack", m, "-o", self.path("good.gbk"), *PYRAMID, "--rank", "8", "--block", "16",
+                               "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertLessEqual(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertEqual(doc["warnings"], [])
+        self.assertEqual(self.warnings_on_stderr(err), [])
+        # Rank 1 leaves most of the structure: above the default bound 0.5, one warning line, the
+        # same message in --json, and the asset is still written.
+        bad = self.path("bad.gbk")
+        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertGreater(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertEqual(len(doc["warnings"]), 1)
+        self.assertIn("default bound 0.5", doc["warnings"][0])
+        lines = self.warnings_on_stderr(err)
+        self.assertEqual(len(lines), 1)
+        self.assertIn(doc["warnings"][0], lines[0])
+        self.assertTrue(os.path.exists(bad))
+        # --quiet drops the stderr line (the reporter's convention for warnings); --json keeps it.
+        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
+                               "--quiet")
+        self.assertEqual(self.warnings_on_stderr(err), [])
+        self.assertEqual(len(json.loads(out)["warnings"]), 1)
+        # A missed --error-target warns whatever the default bound says.
+        out, err = self.run_ok("tensorpack", m, "-o", self.path("target.gbk"), *PYRAMID, "--rank", "2", "--block",
+                               "16", "--error-target", "0.001", "--json")
+        doc = json.loads(out)
+        clitest.validate(doc, "tensorpack.schema.json")
+        self.assertEqual(len(doc["warnings"]), 1)
+        self.assertIn("misses --error-target 0.0010", doc["warnings"][0])
+        self.assertEqual(len(self.warnings_on_stderr(err)), 1)
+
+    def test_max_error_gate(self):
+        m = self.mapgen("scratches", "s.png", "--size", "32", "--seed", "5")
+        ref = self.path("ref.gbk")
+        doc = self.run_json("tensorpack", m, "-o", ref, *PYRAMID, *PACK, schema="tensorpack.schema.json")
+        achieved = max(doc["relative_error"], doc["max_group_error"])
+        # Exceeded: runtime failure, one line naming the achieved error, nothing written.
+        out = self.path("gated.gbk")
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error",
+                                "%.6f" % (achieved * 0.5), outputs=[out])
+        self.assertIn("--max-error", err)
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--json",
+                                "--max-error", "0", outputs=[out])
+        # Met: the gate does not change a byte.
+        self.run_ok("tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error", "%.6f" % (achieved * 1.01 + 1e-6))
+        self.assertEqual(clitest.file_hash(out), clitest.file_hash(ref))
+        for bad in ("-1", "nan", "inf"):
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID, *PACK,
+                              "--max-error", bad, outputs=[self.path("x.gbk")])
 
     def test_bad_arguments(self):
         m = self.mapgen("beckmann", "m.png", "--size", "32")

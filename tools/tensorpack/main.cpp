@@ -10,13 +10,16 @@
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -48,6 +51,49 @@ std::string defaultOutput(const std::string& input, bool container) {
 
 int exitCodeOf(const bake::Error& e) { return int(e.code); }
 
+// Relative error above which tensorpack warns when no --error-target is given (README, "tensorpack
+// defaults"). At rank 16 the real maps of ../shared/data that CP compresses well land at 0.15-0.25
+// (brushed_blender_1024 0.164, scratches_straight_cutlery_512 0.151), while a sharp-flake map lands
+// at 0.93 (flakes_voronoi_sharp_snail_512; the example flakes asset 0.88): an asset that far off has
+// lost most of its glints. 0.5 separates the two with room on both sides.
+constexpr double kDefaultErrorBound = 0.5;
+
+std::string errorText(double e) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4f", e);
+  return text;
+}
+
+// The error a gate compares: the larger of the whole pyramid's relative error (dropped blocks
+// included) and the largest group's (its kept blocks).
+double gatedError(const tensor::TensorPackReport& r) { return std::max(r.relative_error, r.max_group_error); }
+
+std::string achievedText(const tensor::TensorPackReport& r) {
+  return "relative error " + errorText(r.relative_error) + " (largest group " + errorText(r.max_group_error) + ")";
+}
+
+// --max-error: fails (runtime failure, before anything is written) when the gated error exceeds E.
+void checkMaxError(const tensor::TensorPackReport& r, double max_error, const std::string& input) {
+  if (max_error < 0.0 || !(gatedError(r) > max_error)) return;
+  throw Error(cli::kExitRuntime,
+              input + ": " + achievedText(r) + " exceeds --max-error " + errorText(max_error) + "; no output written");
+}
+
+// One warning when the gated error misses --error-target (when given) or the default bound.
+std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, double error_target, int rank) {
+  std::vector<std::string> warnings;
+  if (error_target >= 0.0) {
+    if (gatedError(r) > error_target) {
+      warnings.push_back(achievedText(r) + " misses --error-target " + errorText(error_target) + " at --rank " +
+                         std::to_string(rank));
+    }
+  } else if (gatedError(r) > kDefaultErrorBound) {
+    warnings.push_back(achievedText(r) + " exceeds the default bound " + errorText(kDefaultErrorBound) +
+                       " (raise --rank, or gate with --max-error)");
+  }
+  return warnings;
+}
+
 Json levelJson(const tensor::TensorPackLevelReport& l) {
   Json j;
   j["level"] = l.level;
@@ -67,17 +113,18 @@ Json rankHistogramJson(const tensor::TensorPackReport& r) {
   return h;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  cli::Tool tool(
-      "tensorpack",
-      "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
+// Everything the command line sets; filled by CLI11 (addOptions) and checked by resolveOptions.
+struct Options {
   std::string input, output, method_text = "compressed", precision_text = "float32";
   bake::IngestOptions ingest;
   cli::PyramidCliOptions pyramid;
-  const bake::ndf::PyramidOptions& pyr = pyramid.options;
-  tensor::TensorPackOptions opt;
+  tensor::TensorPackOptions pack;
+  double error_target = -1.0, max_error = -1.0;
+  int zstd_level = 9;
+};
+
+// Stage 1a: registers the options.
+void addOptions(CLI::App& app, Options& o) {
   // Non-negative factors by default. Measured on 256^2 mapgen maps at the default pyramid (R = 128,
   // B = 32): at equal rank their relative error is 1-4% higher than plain ALS (beckmann rank 16:
   // 0.364 vs 0.356), but their files are about half as large (zstd packs the sparse HALS factors
@@ -85,181 +132,239 @@ int main(int argc, char** argv) {
   // vs plain rank 16, 0.356 in 247 kB; likewise on brushed, scratches and flakes); and they have no
   // negative density, where plain factors put 1-5% of the absolute density below zero (queries
   // clamp it, so pdf and value / mass disagree there).
-  opt.cp.nonneg = true;
-  double error_target = -1.0;
-  int zstd_level = 9;
-  CLI::App& app = tool.app();
-  app.add_option("input", input, "Normal map (or height field with --height), or an ndf-pyramid container (.gbk)")
+  o.pack.cp.nonneg = true;
+  tensor::TensorPackOptions& opt = o.pack;
+  app.add_option("input", o.input, "Normal map (or height field with --height), or an ndf-pyramid container (.gbk)")
       ->required();
-  app.add_option("-o,--output", output, "Output tensor-ndf container (default: the input's name with .gbk)");
+  app.add_option("-o,--output", o.output, "Output tensor-ndf container (default: the input's name with .gbk)");
   app.add_option("--rank", opt.cp.rank, "CP rank per group (1..64); the largest rank with --error-target")
       ->capture_default_str();
   app.add_option("--block", opt.block, "Bins per angular block side B (divides --ndf-res)")->capture_default_str();
-  app.add_option("--method", method_text, "CP method: compressed, als or als-plain")->capture_default_str();
+  app.add_option("--method", o.method_text, "CP method: compressed, als or als-plain")->capture_default_str();
   app.add_flag("--nonneg,!--no-nonneg", opt.cp.nonneg,
                "Non-negative factors (HALS; default on): no negative density anywhere");
   app.add_option("--tol", opt.cp.tol, "Stop when the fit changes by less than this (>= 0)")->capture_default_str();
   app.add_option("--max-iters", opt.cp.max_iters, "Most ALS sweeps per group (>= 1)")->capture_default_str();
-  app.add_option("--error-target", error_target,
-                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1)");
+  app.add_option("--error-target", o.error_target,
+                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1); a warning when "
+                 "the achieved error misses it");
+  app.add_option("--max-error", o.max_error,
+                 "Fail (exit 4, no output) when the relative error of the pyramid or of any group exceeds this "
+                 "(>= 0; unset: no gate). Without --error-target, errors above 0.5 warn");
   app.add_option("--blank-threshold", opt.blank_threshold, "Drop blocks whose mass is below this (0..1)")
       ->capture_default_str();
-  app.add_option("--precision", precision_text, "Factor storage: float32 or float16")->capture_default_str();
+  app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
   app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
-  app.add_option("--zstd-level", zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
+  app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
-  cli::addPyramidOptions(app, pyramid, "Footprint centres per group side (1..256)");
-  cli::addIngestOptions(app, ingest);
+  cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
+  cli::addIngestOptions(app, o.ingest);
+}
 
+// Stage 1b: checks the parsed options and derives the library's (exit 1 on anything out of range).
+void resolveOptions(const CLI::App& app, Options& o) {
+  const std::optional<tensor::CpMethod> method = tensor::parseCpMethod(o.method_text);
+  if (!method) throw Error(cli::kExitBadArguments, "--method must be compressed, als or als-plain");
+  o.pack.cp.method = *method;
+  if (o.precision_text != "float32" && o.precision_text != "float16") {
+    throw Error(cli::kExitBadArguments, "--precision must be float32 or float16");
+  }
+  o.pack.precision = o.precision_text == "float16" ? 1 : 0;
+  o.pack.error_target = o.error_target;
+  if (app.count("--error-target") && !(o.error_target >= 0.0 && o.error_target <= 1.0)) {
+    throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
+  }
+  if (app.count("--max-error") && !(o.max_error >= 0.0 && std::isfinite(o.max_error))) {
+    throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
+  }
+  if (o.zstd_level < 1 || o.zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
+  if (bake::Status s = tensor::validateTensorPackOptions(o.pack); !s)
+    throw Error(exitCodeOf(s.error()), s.error().message);
+}
+
+// Canonical parameters (container metadata and --json), in their recorded order; readInput adds
+// "pyramid" and "source".
+Json parametersJson(const Options& o) {
+  const tensor::TensorPackOptions& opt = o.pack;
+  Json params;
+  params["rank"] = opt.cp.rank;
+  params["block"] = opt.block;
+  params["method"] = tensor::cpMethodName(opt.cp.method);
+  params["nonneg"] = opt.cp.nonneg;
+  params["tol"] = opt.cp.tol;
+  params["max_iters"] = opt.cp.max_iters;
+  params["error_target"] = o.error_target < 0.0 ? Json(nullptr) : Json(o.error_target);
+  params["blank_threshold"] = opt.blank_threshold;
+  params["precision"] = o.precision_text;
+  params["seed"] = opt.cp.seed;
+  params["zstd_level"] = o.zstd_level;
+  return params;
+}
+
+// The input: an ndf-pyramid container (open reader) or a loaded normal map.
+struct Input {
+  bool from_container = false;
+  format::Reader reader;
+  bake::NormalMap map;
+  Json map_json = nullptr, source_asset = nullptr;
+};
+
+// Stage 2: opens the container, or loads the normal map, and completes the parameters.
+void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
+  in.from_container = isContainer(o.input);
+  if (o.output.empty()) o.output = defaultOutput(o.input, in.from_container);
+  if (in.from_container) {
+    for (CLI::Option* flag : o.pyramid.flags) {
+      if (flag->count() > 0)
+        throw Error(cli::kExitBadArguments, flag->get_name() + " applies to normal-map inputs only");
+    }
+    t.addInput(o.input);
+    if (format::Status st = in.reader.open(o.input); st != format::Status::kOk) {
+      const int code = st == format::Status::kIoError              ? cli::kExitIo
+                       : st == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
+                                                                   : cli::kExitInvalidInput;
+      throw Error(code, o.input + ": " + format::statusString(st));
+    }
+    if (in.reader.kind() != format::AssetKind::kNdfPyramid) {
+      throw Error(cli::kExitInvalidInput, o.input + ": not an ndf-pyramid container (asset kind " +
+                                              format::assetKindString(in.reader.kind()) + ")");
+    }
+    std::string meta_text;
+    if (in.reader.readMetadata(&meta_text) == format::Status::kOk) {
+      const Json source = Json::parse(meta_text, nullptr, false);
+      if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
+      if (source.is_object() && source.contains("asset")) in.source_asset = source["asset"];
+    }
+    params["source"] = "ndf-pyramid";
+    return;
+  }
+  cli::resolvePyramidOptions(o.pyramid);
+  const int ndf_res = o.pyramid.options.splat.ndf_res;
+  if (ndf_res % o.pack.block != 0) {
+    throw Error(cli::kExitBadArguments,
+                "--block " + std::to_string(o.pack.block) + " must divide --ndf-res " + std::to_string(ndf_res));
+  }
+  bake::IngestReport ingest_report;
+  in.map = cli::loadNormalMapForTool(t, o.input, o.ingest, &ingest_report);
+  cli::requireBakeableMap(in.map, o.input);
+  in.map_json = {{"width", in.map.width}, {"height", in.map.height}, {"wrap", bake::wrapString(in.map.wrap)}};
+  Json p = cli::pyramidOptionsJson(o.pyramid);
+  p["ingest"] = cli::ingestOptionsJson(o.ingest);
+  params["pyramid"] = p;
+  params["source"] = "normal-map";
+}
+
+// Stage 3: packs the input into the (temporary) output container; nothing is in place yet.
+tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out) {
+  tensor::TensorPackReport report;
+  bake::Status s = bake::okStatus();
+  if (in.from_container) {
+    s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
+  } else {
+    cli::LevelProgress progress(t);
+    s = tensor::packTensorNdfFromMap(in.map, o.pyramid.options, o.pack, out.writer(), &report, progress.callback());
+    progress.finish();
+  }
+  if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
+  return report;
+}
+
+// Stage 4: the asset's metadata; adds it and renames the container into place.
+void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& params,
+                const tensor::TensorPackReport& report, cli::ContainerOutput& out) {
+  Json asset;
+  asset["ndf_res"] = report.ndf_res;
+  asset["block"] = o.pack.block;
+  asset["blocks_per_side"] = report.blocks_per_side;
+  asset["levels"] = Json::array();
+  for (const auto& l : report.levels) {
+    asset["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
+  }
+  asset["groups"] = report.groups;
+  asset["max_rank"] = report.max_rank;
+  asset["rank_histogram"] = rankHistogramJson(report);
+  asset["precision"] = o.precision_text;
+  asset["nonneg"] = o.pack.cp.nonneg;
+  asset["blank_threshold"] = o.pack.blank_threshold;
+  asset["relative_error"] = report.relative_error;
+  if (!in.map_json.is_null()) asset["map"] = in.map_json;
+  if (in.source_asset.is_object()) {
+    for (const char* key : {"map_size", "wrap", "sigma_r", "rate"}) {
+      if (in.source_asset.contains(key)) asset[key] = in.source_asset[key];
+    }
+  }
+  Json meta = t.makeMetadata("tensor-ndf", params);
+  meta["asset"] = asset;
+  out.finish(meta);
+}
+
+// Stage 5: the warnings, then the --json summary or the one-line summary.
+void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& params,
+                 const tensor::TensorPackReport& report, const std::vector<std::string>& warnings, uint64_t file_bytes,
+                 double seconds) {
+  for (const std::string& w : warnings) t.warning(o.input + ": " + w);
+  const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
+  if (!t.common().json) {
+    char summary[256];
+    std::snprintf(summary, sizeof(summary),
+                  ": %zu levels, %llu groups (rank <= %d), %llu bytes = %.2f%% of the raw float32 NDF images, "
+                  "relative error %.4f, %.1f s",
+                  report.levels.size(), static_cast<unsigned long long>(report.groups), report.max_rank,
+                  static_cast<unsigned long long>(file_bytes), 100.0 * ratio, report.relative_error, seconds);
+    t.info("wrote " + o.output + summary);
+    return;
+  }
+  Json doc;
+  doc["tool"] = "tensorpack";
+  doc["input"] = cli::baseName(o.input);
+  doc["output"] = cli::baseName(o.output);
+  doc["source"] = in.from_container ? "ndf-pyramid" : "normal-map";
+  doc["map"] = in.map_json;
+  doc["parameters"] = params;
+  doc["ndf_res"] = report.ndf_res;
+  Json levels = Json::array();
+  for (const auto& l : report.levels) levels.push_back(levelJson(l));
+  doc["levels"] = levels;
+  doc["groups"] = report.groups;
+  doc["blocks_kept"] = report.blocks_kept;
+  doc["blocks_dropped"] = report.blocks_dropped;
+  doc["rank_histogram"] = rankHistogramJson(report);
+  doc["max_rank"] = report.max_rank;
+  doc["raw_bytes"] = report.raw_bytes;
+  doc["stored_bytes"] = report.stored_bytes;
+  doc["file_bytes"] = file_bytes;
+  doc["ratio"] = ratio;
+  doc["relative_error"] = report.relative_error;
+  doc["max_group_error"] = report.max_group_error;
+  doc["negative_mass_fraction"] = report.negative_mass_fraction;
+  doc["warnings"] = warnings;
+  doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},
+                    {"wait", report.wait_seconds}, {"pack", report.total_seconds}, {"total", seconds}};
+  t.printJson(doc);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Tool tool(
+      "tensorpack",
+      "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
+  Options o;
+  addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
-    const std::optional<tensor::CpMethod> method = tensor::parseCpMethod(method_text);
-    if (!method) throw Error(cli::kExitBadArguments, "--method must be compressed, als or als-plain");
-    opt.cp.method = *method;
-    if (precision_text != "float32" && precision_text != "float16") {
-      throw Error(cli::kExitBadArguments, "--precision must be float32 or float16");
-    }
-    opt.precision = precision_text == "float16" ? 1 : 0;
-    opt.error_target = error_target;
-    if (app.count("--error-target") && !(error_target >= 0.0 && error_target <= 1.0)) {
-      throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
-    }
-    if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-    if (bake::Status s = tensor::validateTensorPackOptions(opt); !s)
-      throw Error(exitCodeOf(s.error()), s.error().message);
-
-    const bool from_container = isContainer(input);
-    if (output.empty()) output = defaultOutput(input, from_container);
-
-    Json params;
-    params["rank"] = opt.cp.rank;
-    params["block"] = opt.block;
-    params["method"] = tensor::cpMethodName(opt.cp.method);
-    params["nonneg"] = opt.cp.nonneg;
-    params["tol"] = opt.cp.tol;
-    params["max_iters"] = opt.cp.max_iters;
-    params["error_target"] = error_target < 0.0 ? Json(nullptr) : Json(error_target);
-    params["blank_threshold"] = opt.blank_threshold;
-    params["precision"] = precision_text;
-    params["seed"] = opt.cp.seed;
-    params["zstd_level"] = zstd_level;
-
-    tensor::TensorPackReport report;
-    Json map_json = nullptr, source_asset = nullptr;
-    std::unique_ptr<cli::ContainerOutput> out;
-    if (from_container) {
-      for (CLI::Option* o : pyramid.flags) {
-        if (o->count() > 0) throw Error(cli::kExitBadArguments, o->get_name() + " applies to normal-map inputs only");
-      }
-      t.addInput(input);
-      format::Reader reader;
-      if (format::Status st = reader.open(input); st != format::Status::kOk) {
-        const int code = st == format::Status::kIoError              ? cli::kExitIo
-                         : st == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
-                                                                     : cli::kExitInvalidInput;
-        throw Error(code, input + ": " + format::statusString(st));
-      }
-      if (reader.kind() != format::AssetKind::kNdfPyramid) {
-        throw Error(cli::kExitInvalidInput, input + ": not an ndf-pyramid container (asset kind " +
-                                                format::assetKindString(reader.kind()) + ")");
-      }
-      std::string meta_text;
-      if (reader.readMetadata(&meta_text) == format::Status::kOk) {
-        const Json source = Json::parse(meta_text, nullptr, false);
-        if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
-        if (source.is_object() && source.contains("asset")) source_asset = source["asset"];
-      }
-      params["source"] = "ndf-pyramid";
-      out = std::make_unique<cli::ContainerOutput>(t, output, format::AssetKind::kTensorNdf, zstd_level);
-      if (bake::Status s = tensor::packTensorNdfFromPyramid(reader, opt, out->writer(), &report); !s) {
-        throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
-      }
-    } else {
-      cli::resolvePyramidOptions(pyramid);
-      if (pyr.splat.ndf_res % opt.block != 0) {
-        throw Error(cli::kExitBadArguments, "--block " + std::to_string(opt.block) + " must divide --ndf-res " +
-                                                std::to_string(pyr.splat.ndf_res));
-      }
-      bake::IngestReport ingest_report;
-      const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
-      cli::requireBakeableMap(map, input);
-      map_json = {{"width", map.width}, {"height", map.height}, {"wrap", bake::wrapString(map.wrap)}};
-      Json p = cli::pyramidOptionsJson(pyramid);
-      p["ingest"] = cli::ingestOptionsJson(ingest);
-      params["pyramid"] = p;
-      params["source"] = "normal-map";
-      out = std::make_unique<cli::ContainerOutput>(t, output, format::AssetKind::kTensorNdf, zstd_level);
-
-      cli::LevelProgress progress(t);
-      bake::Status s = tensor::packTensorNdfFromMap(map, pyr, opt, out->writer(), &report, progress.callback());
-      progress.finish();
-      if (!s) throw Error(exitCodeOf(s.error()), input + ": " + s.error().message);
-    }
-
-    Json asset;
-    asset["ndf_res"] = report.ndf_res;
-    asset["block"] = opt.block;
-    asset["blocks_per_side"] = report.blocks_per_side;
-    asset["levels"] = Json::array();
-    for (const auto& l : report.levels) {
-      asset["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
-    }
-    asset["groups"] = report.groups;
-    asset["max_rank"] = report.max_rank;
-    asset["rank_histogram"] = rankHistogramJson(report);
-    asset["precision"] = precision_text;
-    asset["nonneg"] = opt.cp.nonneg;
-    asset["blank_threshold"] = opt.blank_threshold;
-    asset["relative_error"] = report.relative_error;
-    if (!map_json.is_null()) asset["map"] = map_json;
-    if (source_asset.is_object()) {
-      for (const char* key : {"map_size", "wrap", "sigma_r", "rate"}) {
-        if (source_asset.contains(key)) asset[key] = source_asset[key];
-      }
-    }
-    Json meta = t.makeMetadata("tensor-ndf", params);
-    meta["asset"] = asset;
-    out->finish(meta);
+    resolveOptions(t.app(), o);
+    Json params = parametersJson(o);
+    Input in;
+    readInput(t, o, in, params);
+    cli::ContainerOutput out(t, o.output, format::AssetKind::kTensorNdf, o.zstd_level);
+    const tensor::TensorPackReport report = packAsset(t, o, in, out);
+    // The gate runs before anything is in place: a failure leaves no output.
+    checkMaxError(report, o.max_error, o.input);
+    const std::vector<std::string> warnings = qualityWarnings(report, o.error_target, o.pack.cp.rank);
+    writeAsset(t, o, in, params, report, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const uint64_t file_bytes = out->bytesWritten();
-    const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
-
-    if (t.common().json) {
-      Json doc;
-      doc["tool"] = "tensorpack";
-      doc["input"] = cli::baseName(input);
-      doc["output"] = cli::baseName(output);
-      doc["source"] = from_container ? "ndf-pyramid" : "normal-map";
-      doc["map"] = map_json;
-      doc["parameters"] = params;
-      doc["ndf_res"] = report.ndf_res;
-      Json levels = Json::array();
-      for (const auto& l : report.levels) levels.push_back(levelJson(l));
-      doc["levels"] = levels;
-      doc["groups"] = report.groups;
-      doc["blocks_kept"] = report.blocks_kept;
-      doc["blocks_dropped"] = report.blocks_dropped;
-      doc["rank_histogram"] = rankHistogramJson(report);
-      doc["max_rank"] = report.max_rank;
-      doc["raw_bytes"] = report.raw_bytes;
-      doc["stored_bytes"] = report.stored_bytes;
-      doc["file_bytes"] = file_bytes;
-      doc["ratio"] = ratio;
-      doc["relative_error"] = report.relative_error;
-      doc["max_group_error"] = report.max_group_error;
-      doc["negative_mass_fraction"] = report.negative_mass_fraction;
-      doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},
-                        {"wait", report.wait_seconds}, {"pack", report.total_seconds}, {"total", seconds}};
-      t.printJson(doc);
-    } else {
-      char summary[256];
-      std::snprintf(summary, sizeof(summary),
-                    ": %zu levels, %llu groups (rank <= %d), %llu bytes = %.2f%% of the raw float32 NDF images, "
-                    "relative error %.4f, %.1f s",
-                    report.levels.size(), static_cast<unsigned long long>(report.groups), report.max_rank,
-                    static_cast<unsigned long long>(file_bytes), 100.0 * ratio, report.relative_error, seconds);
-      t.info("wrote " + output + summary);
-    }
+    printReport(t, o, in, params, report, warnings, out.bytesWritten(), seconds);
     return cli::kExitOk;
   });
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 namespace glintbake::bake::tensor {
 namespace {
@@ -228,6 +229,119 @@ TEST(CpDecomposition, RejectsBadOptionsAndInputs) {
   EXPECT_EQ(decomposeCpToError(t, CpOptions{}, 1.5).error().code, ErrorCode::kBadArgument);
   EXPECT_EQ(parseCpMethod("als-plain"), CpMethod::kAlsPlain);
   EXPECT_FALSE(parseCpMethod("tucker").has_value());
+}
+
+// The group of a map whose normals vary along one axis only (a brushed map, n_x within +-0.02):
+// every NDF image is a thin line at s_x ~ 0, on a block boundary, so the blocks beside it hold
+// their mass in the few bins next to one edge. The mode-1 unfolding (mode 2 with `across_j`) then
+// has rank 3-6, below R = 16: the surplus rank-1 terms die, their scale (carried by C) decays
+// through the float subnormals, and the next HALS update of A or B divides by |c_r|^2.
+GroupTensor makeOneAxisGroup(int bins, int blocks, uint64_t seed, bool across_j) {
+  uint64_t state = seed;
+  auto uniform = [&state] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 11) * 0x1.0p-53;
+  };
+  GroupTensor t;
+  t.bins = bins;
+  t.blocks = blocks;
+  t.values.assign(size_t(bins) * bins * blocks, 0.0f);
+  const double width = 0.6;  // bins
+  for (int k = 0; k < blocks; ++k) {
+    const double edge = (k % 2) ? 0.0 : double(bins);
+    double centre[3], sigma[3], amp[3];
+    for (int n = 0; n < 3; ++n) {
+      centre[n] = uniform() * bins;
+      sigma[n] = 0.7 + 2.5 * uniform();
+      amp[n] = 700.0 * uniform();
+    }
+    for (int j = 0; j < bins; ++j) {
+      for (int i = 0; i < bins; ++i) {
+        const int across = across_j ? j : i, along = across_j ? i : j;
+        const double d = (across + 0.5 - edge) / width;
+        double profile = 0.0;
+        for (int n = 0; n < 3; ++n) {
+          const double e = (along + 0.5 - centre[n]) / sigma[n];
+          profile += amp[n] * std::exp(-0.5 * e * e);
+        }
+        const float v = float(std::exp(-0.5 * d * d) * profile);
+        t.values[(size_t(k) * bins + j) * bins + i] = v > 1e-12f ? v : 0.0f;
+      }
+    }
+  }
+  return t;
+}
+
+bool allFinite(const CpFactors& f) {
+  for (const auto* v : {&f.a, &f.b, &f.c}) {
+    for (float x : *v) {
+      if (!std::isfinite(x)) return false;
+    }
+  }
+  return std::isfinite(f.relative_error);
+}
+
+TEST(CpDecomposition, RankDeficientOneAxisGroupsGiveFiniteFactors) {
+  // Before the HALS updates kept such scales in double, the four non-negative compressed
+  // decompositions across i ended in NaN factors (tensorpack's "not finite at the storage
+  // precision"). kAls starts from the HOSVD and stalls with dead columns here (up to 0.67; the
+  // packer retries those from a random start), hence the loose bound.
+  for (bool across_j : {false, true}) {
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      const GroupTensor t = makeOneAxisGroup(32, 300, seed, across_j);
+      for (CpMethod method : {CpMethod::kCompressed, CpMethod::kAls, CpMethod::kAlsPlain}) {
+        for (bool nonneg : {true, false}) {
+          if (method != CpMethod::kCompressed && seed > 1) continue;  // the slow methods on one seed
+          CpOptions o;
+          o.method = method;
+          o.nonneg = nonneg;
+          const CpFactors f = decompose(t, o);
+          const std::string what = std::string(cpMethodName(method)) + (nonneg ? " nonneg" : " signed") + " seed " +
+                                   std::to_string(seed) + (across_j ? " across j" : " across i");
+          ASSERT_TRUE(allFinite(f)) << what;
+          EXPECT_GT(f.relative_error, 0.0) << what;
+          EXPECT_LT(f.relative_error, 0.8) << what;
+          EXPECT_NEAR(f.relative_error, cpReconstructionError(t, f), 1e-4) << what;
+          if (nonneg) {
+            for (const auto* v : {&f.a, &f.b, &f.c}) {
+              for (float x : *v) ASSERT_GE(x, 0.0f) << what;
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(CpDecomposition, OneAxisGroupsAtEveryRank) {
+  // Ranks below, at and far above the unfolding's rank, with the default non-negative method
+  // (ranks 16, 32 and 64 gave NaN factors before).
+  const GroupTensor t = makeOneAxisGroup(32, 1008, 3, false);
+  for (int rank : {1, 4, 8, 16, 32, 64}) {
+    CpOptions o;
+    o.rank = rank;
+    o.nonneg = true;
+    const CpFactors f = decompose(t, o);
+    ASSERT_TRUE(allFinite(f)) << "rank " << rank;
+    EXPECT_LT(f.relative_error, 1.0) << "rank " << rank;
+  }
+}
+
+TEST(CpDecomposition, LargeNdfValuesGiveFiniteFactors) {
+  // Bins of 1e6-1e9 (a fine --ndf-res with a small --sigma-r): the range finder's power iteration
+  // squares the scale, and its float QR overflowed (NaN core, NaN factors) before the sketch was
+  // rescaled by a power of two.
+  for (float scale : {1e6f, 1e9f}) {
+    GroupTensor t = makeOneAxisGroup(32, 300, 2, false);
+    for (float& v : t.values) v *= scale;
+    for (bool nonneg : {true, false}) {
+      CpOptions o;
+      o.nonneg = nonneg;
+      const CpFactors f = decompose(t, o);
+      ASSERT_TRUE(allFinite(f)) << "scale " << scale << " nonneg " << nonneg;
+      EXPECT_LT(f.relative_error, 0.8) << "scale " << scale << " nonneg " << nonneg;
+    }
+  }
 }
 
 TEST(CpDecomposition, ZeroTensorGivesZeroModel) {

@@ -456,6 +456,60 @@ TEST(TensorPack, NonNegativeFactorsHaveNoNegativeMass) {
   }
 }
 
+// A map whose normals vary along one coordinate only (x with along_x, otherwise y),
+// like a real brushed map: n_x within +-0.02, n_y within +-0.5, smooth periodic profiles.
+NormalMap oneAxisMap(int size, bool along_x) {
+  NormalMap map;
+  map.width = map.height = size;
+  map.normals.resize(size_t(size) * size * 3);
+  auto profile = [size](double t, double k1, double k2, double phase) {
+    const double w = 2.0 * 3.14159265358979 / size;
+    return (std::sin(k1 * w * t + phase) + 0.5 * std::sin(k2 * w * t + 2.0 * phase)) / 1.5;
+  };
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const double t = along_x ? x : y;
+      const double nx = 0.02 * profile(t, 3, 7, 0.4), ny = 0.5 * profile(t, 2, 5, 1.3);
+      float* n = map.at(x, y);
+      n[0] = float(nx);
+      n[1] = float(ny);
+      n[2] = float(std::sqrt(1.0 - nx * nx - ny * ny));
+    }
+  }
+  return map;
+}
+
+TEST(TensorPack, OneAxisMapsPackWithTheDefaults) {
+  // The NDF images are lines at s_x ~ 0 on a block boundary: rank-deficient groups, whose default
+  // non-negative decomposition used to end in NaN factors (kRuntime, "not finite at the storage
+  // precision"). The default pyramid and block, as tensorpack --rank 16 uses them.
+  for (bool along_x : {true, false}) {
+    for (int precision : {0, 1}) {
+      const NormalMap map = oneAxisMap(64, along_x);
+      TensorPackOptions o;
+      o.cp.nonneg = true;
+      o.precision = precision;
+      const std::string name = std::string("one_axis_") + (along_x ? "x" : "y") + std::to_string(precision) + ".gbk";
+      TensorPackReport rep;
+      const ndf::PyramidOptions pyramid;
+      const Status s = packFromMap(map, o, tempPath(name), &rep, pyramid);
+      ASSERT_TRUE(s.ok()) << name << ": " << s.error().message;
+      EXPECT_TRUE(std::isfinite(rep.relative_error)) << name;
+      EXPECT_LT(rep.relative_error, 0.5) << name;
+      EXPECT_LT(rep.max_group_error, 0.5) << name;
+      EXPECT_EQ(rep.negative_mass_fraction, 0.0) << name;
+      const Decoded d = decode(tempPath(name));
+      for (const Decoded::Group& g : d.groups) {
+        for (const auto* m : {&g.a, &g.b, &g.c}) {
+          for (float v : *m) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << name;
+        }
+      }
+      EXPECT_NEAR(decodedError(d, capturePyramid(map, pyramid)), rep.relative_error, 1e-4) << name;
+      std::remove(tempPath(name).c_str());
+    }
+  }
+}
+
 TEST(TensorPack, RejectsBadOptionsAndAllBlankPyramids) {
   const NormalMap map = testMap(MapKind::kBeckmann);
   TensorPackOptions o = packOptions(8);

@@ -49,6 +49,14 @@
 // published non-negative baseline (random start, plain HALS, its stopping rule) and at most 0.13 of
 // the signed als-plain's. Every reconstructed value and every range sum is >= 0.
 //
+// Rank-deficient groups: when R exceeds the rank of an unfolding (e.g. a map whose normals vary
+// along one axis only: its NDF images are thin lines, so one mode of the group spans a few bins),
+// the surplus rank-1 terms die and their scales, carried by C, decay through the float subnormals.
+// The HALS updates of A and B against such a column are of the order 1 / |c_r|; they are formed
+// and normalised in double and the scale moved into C, so every factor stays finite (a dead term
+// is zero or is revived as an ordinary one). The float arithmetic of every other column is
+// unchanged.
+//
 // Determinism: results depend only on the tensor and the options (seeded generators, fixed
 // summation order, no threading inside one decomposition): identical bytes on every run and for
 // any thread count of decomposeCpBatch.
