@@ -13,19 +13,31 @@ footprint). The smooth baseline is the whole map's NDF, one image per map, score
 against every reference image: what a single smooth lobe fitted to the map could at best give.
 
 Whole-map NDF (--baseline):
-  splat (default)  ndfgen bakes one footprint of sigma = max(width, height) texels (--levels 1,
-                   --stride = map size, wrap repeat). With a periodic map, a Gaussian footprint
-                   whose std equals the period weights every texel equally to ~1e-8 (the ripple
-                   of a periodic sum of Gaussians is 2 exp(-2 pi^2 sigma^2 / P^2)), and the lobes'
-                   position shift and spatial blur vanish at that sigma, so the image is the
-                   position-independent NDF of the whole map. Cheap (one splat pass).
-  ref              the same footprint through glintref (exact, but 36 W*H lobes: hours on 1024^2).
-  mean             the mean of the cached reference images of each sigma (cheap but biased: it
-                   contains the image it is compared against).
+  splat (default)  ndfgen bakes one footprint of sigma = 0.6 max(width, height) texels (--levels 1,
+                   one centre, wrap repeat). On a periodic map a Gaussian footprint of std sigma
+                   weights the texels with a relative ripple of 2 exp(-2 pi^2 sigma^2 / P^2)
+                   (1.6e-3 at sigma = 0.6 P), and the lobes' position shift and spatial blur vanish
+                   at that sigma, so the image is the position-independent NDF of the whole map.
+  ref              glintref at sigma = max(width, height) (exact, but 36 W*H lobes: hours on 1024^2).
+  mean             the mean of the reference images of each sigma (cheap but biased: it contains
+                   the image it is compared against).
+  none             no baseline.
+
+References: `glintref image` (exact bin averages, lobes truncated at 6 sigma) for sigma up to
+--splat-above (default 16 texels). Its cost grows as sigma^2 (about 170 s of one core for one
+128^2 image at sigma 64), so above that the reference is one footprint splatted by ndfgen
+(--levels 1, one centre at the map's centre) on a copy of the map shifted periodically by whole
+texels so that the footprint lands on that centre: footprint centres of those sigmas keep the
+fractional part of the map's centre (whole texels for even sizes). The splatter truncates
+footprints at 4 sigma and agrees with glintref to relative L1 4e-4 (sigma 16, two real maps,
+random positions); it is the baker's own evaluator, so `--splat-above -1` gives an independent
+reference everywhere when time allows. The shift needs a non-interlaced 8/16-bit PNG and wrap
+repeat; other maps use glintref at every sigma.
 
 Caching (--cache, default build/fidelity-cache under the repository): reference images are keyed by
 (map content hash, x, y, sigma, R, sigma_r, and any non-default ingest option); baked assets by
-(map hash, tool binary hash, tool arguments); so a rerun only computes what is new. Footprints are
+(map hash, tool binary hash, tool arguments); the assets' images by (asset file, size, mtime, x, y,
+sigma); so a rerun only computes what is new. Footprints are
 drawn from Random((seed, map hash, sigma)), so the same seed gives the same footprints on every run
 and for every asset, and a new asset reuses all references.
 
@@ -257,7 +269,7 @@ class Harness:
         self.args = args
         self.bin = os.path.abspath(args.bin)
         self.cache = os.path.abspath(args.cache)
-        for sub in ("ref", "assets", "baseline", "tmp"):
+        for sub in ("ref", "assets", "baseline", "query", "tmp"):
             os.makedirs(os.path.join(self.cache, sub), exist_ok=True)
         self.ingest = shlex.split(args.ingest) if args.ingest else []
         self._tool_hash = {}
@@ -328,7 +340,9 @@ class Harness:
     def asset_params(self, asset):
         doc = json.loads(_run([self.tool("glintinfo"), "--json", "-q", "info", asset]))
         md = doc.get("metadata", {})
-        p = md.get("parameters", {})
+        p = dict(md.get("parameters", {}))
+        if isinstance(p.get("pyramid"), dict):  # tensorpack nests the pyramid's parameters
+            p = dict(p["pyramid"], **{k: v for k, v in p.items() if k != "pyramid"})
         a = md.get("asset", {})
         res = a.get("ndf_res", p.get("ndf_res", self.args.res))
         sigma_r = a.get("sigma_r", p.get("sigma_r", self.args.sigma_r))
@@ -432,14 +446,17 @@ class Harness:
                     os.remove(base + ext)
 
     def query(self, asset, x, y, sigma):
-        fd, tmp = tempfile.mkstemp(suffix=".exr", dir=os.path.join(self.cache, "tmp"))
-        os.close(fd)
-        try:
+        # Cached by the asset's name, size and modification time and the glintquery binary.
+        st = os.stat(asset)
+        key = hashlib.sha256(json.dumps([os.path.abspath(asset), st.st_size, st.st_mtime_ns,
+                                         self.tool_hash("glintquery"), x, y, sigma]).encode()).hexdigest()[:24]
+        path = os.path.join(self.cache, "query", key + ".exr")
+        if not os.path.exists(path):
+            tmp = path + ".%d.%d.tmp.exr" % (os.getpid(), threading.get_ident())
             _run([self.tool("glintquery"), "-q", "-j1", "image", asset, "--at", "%r,%r" % (x, y), "--sigma", repr(sigma),
                   "-o", tmp])
-            return _read_exr(tmp)[2]
-        finally:
-            os.remove(tmp)
+            os.replace(tmp, path)
+        return _read_exr(path)[2]
 
     def baseline(self, map_path, minfo, params, mean_of=None):
         mode = self.args.baseline
@@ -545,6 +562,11 @@ def main(argv):
             params = h.asset_params(path)
             record["bytes"] = params["bytes"]
             record["level_sigmas"] = params["level_sigmas"]
+            tj = record.get("tool_json") or {}
+            if not record["level_sigmas"] and tj.get("levels"):  # tensor-ndf: sigma0 * 2^level
+                tp = tj.get("parameters") or {}
+                sigma0 = float(tp.get("sigma0", (tp.get("pyramid") or {}).get("sigma0", 8.0)))
+                record["level_sigmas"] = [sigma0 * 2 ** l.get("level", i) for i, l in enumerate(tj["levels"])]
             bakes[label] = record
             assets.append((label, path, params))
         entry = {"map": minfo, "bakes": bakes, "sigmas": []}
