@@ -42,11 +42,16 @@ drawn from Random((seed, map hash, sigma)), so the same seed gives the same foot
 and for every asset, and a new asset reuses all references.
 
 Usage:
-  # bake the current defaults and score them (6 footprints per sigma, 2 processes at a time)
+  # bake the current defaults and score them (the "before" run of bench/fidelity-survey.md)
   python3 scripts/fidelity.py /path/maps/*.png \\
       --bake pyramid=ndfgen --bake rank16="tensorpack --rank 16" --bake rank32="tensorpack --rank 32" \\
-      --sigmas 0.5 1 2 4 8 16 32 64 --footprints 6 --jobs 2 \\
-      --markdown before.md --json before.json
+      --sigmas 0.5 1 2 4 8 16 32 64 --footprints 6 --splat-above 8 --jobs 2 \\
+      --band 0.5:4 --band 8:64 --markdown before.md --json before.json
+
+  # the survey: configurations against log-uniform sigma from 8 to the map size
+  python3 scripts/fidelity.py maps/a.png maps/b.png --bake d=ndfgen \\
+      --bake s12full="ndfgen --stride 12 --converge-mse 1e-9" --sigma-range 8 1024 --clip-range \\
+      --sigma-count 16 --footprints 1 --seed 13 --splat-above 8 --band 8:16 --band 16:64 --band 64:inf
 
   # existing assets ({stem} = the map's file name without extension), log-uniform sigma
   python3 scripts/fidelity.py maps/a.png maps/b.exr --asset mine=assets/{stem}.gbk \\
