@@ -141,13 +141,8 @@ bool fileReadable(const std::string& path) {
   return f.good();
 }
 
-}  // namespace
-
-Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report) {
-  IngestReport local;
-  IngestReport* r = report != nullptr ? report : &local;
-  *r = IngestReport{};
-
+// Opens the image (and the requested part) after the checks that need no decoding.
+Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
     return makeError(ErrorCode::kBadArgument, "height scale must be a finite value > 0");
   }
@@ -158,7 +153,6 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   if (!fileReadable(path)) {
     return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
   }
-  QuietStderr quiet;
   const OIIO::ImageSpec config = readConfig();
   auto input = OIIO::ImageInput::open(path, &config);
   if (!input) {
@@ -175,11 +169,11 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
     return makeError(ErrorCode::kBadArgument, path + ": has no part " + std::to_string(options.part) + " (it has " +
                                                   std::to_string(parts) + ")");
   }
-  const OIIO::ImageSpec spec = input->spec();
-  r->file_format = input->format_name();
-  r->pixel_type = pixelTypeName(spec.format);
-  r->channels_in = spec.nchannels;
+  return std::unique_ptr<OIIO::ImageInput>(std::move(input));
+}
 
+// The size and channel checks of the opened part.
+Status checkImageSpec(const std::string& path, const OIIO::ImageSpec& spec, const IngestOptions& options) {
   const int width = spec.width, height = spec.height, channels = spec.nchannels;
   if (spec.deep) {
     return makeError(ErrorCode::kUnsupported, path + ": deep images are not supported");
@@ -199,99 +193,140 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
     return makeError(ErrorCode::kInvalidInput,
                      path + ": unsupported channel count " + std::to_string(channels) + " (expected " + expected + ")");
   }
+  return okStatus();
+}
 
-  // Alpha and any extra channels are never read; height fields use the first channel only.
-  const int used = options.height ? 1 : std::min(channels, 3);
-  const size_t texels = size_t(width) * size_t(height);
+// The first `used` channels of every texel as float.
+Result<std::vector<float>> readPixels(const std::string& path, OIIO::ImageInput& input, const IngestOptions& options,
+                                      int used) {
+  const OIIO::ImageSpec& spec = input.spec();
+  const size_t texels = size_t(spec.width) * size_t(spec.height);
   std::vector<float> pixels;
   try {
     pixels.resize(texels * size_t(used));
   } catch (const std::bad_alloc&) {
-    return makeError(ErrorCode::kRuntime, path + ": out of memory reading a " + std::to_string(width) + "x" +
-                                              std::to_string(height) + " image");
+    return makeError(ErrorCode::kRuntime, path + ": out of memory reading a " + std::to_string(spec.width) + "x" +
+                                              std::to_string(spec.height) + " image");
   }
-  if (!input->read_image(options.part, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data())) {
+  if (!input.read_image(options.part, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data())) {
     return makeError(ErrorCode::kInvalidInput,
-                     path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+                     path + ": corrupt or truncated image (" + oneLine(input.geterror()) + ")");
   }
   // Some readers report problems only through the error queue.
-  if (input->has_error()) {
+  if (input.has_error()) {
     return makeError(ErrorCode::kInvalidInput,
-                     path + ": corrupt or truncated image (" + oneLine(input->geterror()) + ")");
+                     path + ": corrupt or truncated image (" + oneLine(input.geterror()) + ")");
   }
-  input->close();
+  input.close();
+  return Result<std::vector<float>>(std::move(pixels));
+}
+
+// A height field's normals. Non-finite heights would spread into their neighbours' normals; they
+// are counted, replaced by 0 when asked, and their own normal is (0,0,1) as for normal maps.
+Status heightsToMap(const std::string& path, std::vector<float>& pixels, const IngestOptions& options, NormalMap* map,
+                    IngestReport* r) {
+  const size_t texels = size_t(map->width) * size_t(map->height);
+  std::vector<size_t> bad_texels;
+  for (size_t i = 0; i < texels; ++i) {
+    if (!std::isfinite(pixels[i])) {
+      bad_texels.push_back(i);
+      pixels[i] = 0.0f;
+    }
+  }
+  const int64_t bad = int64_t(bad_texels.size());
+  const size_t first = bad_texels.empty() ? 0 : bad_texels.front();
+  if (bad > 0 && !options.fix_nonfinite) {
+    r->nonfinite = bad;
+    r->texels = int64_t(texels);
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": " + std::to_string(bad) + " height(s) hold NaN or Inf, the first at column " +
+                         std::to_string(first % size_t(map->width)) + ", row " +
+                         std::to_string(first / size_t(map->width)) + " (--fix-nonfinite replaces them)");
+  }
+  heightsToNormals(pixels, options.height_scale, map);
+  for (size_t i : bad_texels) {
+    map->normals[i * 3 + 0] = 0.0f;
+    map->normals[i * 3 + 1] = 0.0f;
+    map->normals[i * 3 + 2] = 1.0f;
+  }
+  r->encoding_used = Encoding::kUnorm;
+  Status status = normaliseNormals(map, options, r);
+  if (!status) return makeError(status.error().code, path + ": " + status.error().message);
+  r->nonfinite = bad;
+  return okStatus();
+}
+
+// How stored values map to [-1, 1]: the option, else the encoding the writer recorded (glintbake's
+// own maps do), else signed floats or signed integer types are snorm and everything else unorm.
+Encoding chooseEncoding(const OIIO::ImageSpec& spec, const std::vector<float>& pixels, Encoding requested) {
+  if (requested != Encoding::kAuto) return requested;
+  const std::string recorded = spec.get_string_attribute(kNormalEncodingAttribute);
+  if (recorded == "snorm" || recorded == "unorm") return recorded == "snorm" ? Encoding::kSnorm : Encoding::kUnorm;
+  if (spec.format.is_floating_point()) {
+    const bool any_negative = std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
+    return any_negative ? Encoding::kSnorm : Encoding::kUnorm;
+  }
+  // OIIO already maps signed integer types to [-1, 1].
+  return isSignedInteger(spec.format) ? Encoding::kSnorm : Encoding::kUnorm;
+}
+
+// A normal map's normals from `used` stored channels (2: z reconstructed).
+Status pixelsToMap(const std::string& path, const OIIO::ImageSpec& spec, const std::vector<float>& pixels, int used,
+                   const IngestOptions& options, NormalMap* map, IngestReport* r) {
+  const Encoding encoding = chooseEncoding(spec, pixels, options.encoding);
+  r->encoding_used = encoding;
+  const float scale = encoding == Encoding::kUnorm ? 2.0f : 1.0f;
+  const float offset = encoding == Encoding::kUnorm ? -1.0f : 0.0f;
+  const float sign_y = options.flip_green ? -1.0f : 1.0f;
+  const size_t texels = size_t(map->width) * size_t(map->height);
+  for (size_t i = 0; i < texels; ++i) {
+    const float* p = &pixels[i * size_t(used)];
+    float* n = &map->normals[i * 3];
+    n[0] = scale * p[0] + offset;
+    n[1] = sign_y * (scale * p[1] + offset);
+    if (used == 2) {
+      const float r2 = n[0] * n[0] + n[1] * n[1];
+      n[2] = std::isfinite(r2) ? std::sqrt(std::max(0.0f, 1.0f - r2)) : r2;
+    } else {
+      n[2] = scale * p[2] + offset;
+    }
+  }
+  Status status = normaliseNormals(map, options, r);
+  if (!status) return makeError(status.error().code, path + ": " + status.error().message);
+  return okStatus();
+}
+
+}  // namespace
+
+Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report) {
+  IngestReport local;
+  IngestReport* r = report != nullptr ? report : &local;
+  *r = IngestReport{};
+
+  QuietStderr quiet;
+  Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path, options);
+  if (!opened) return opened.error();
+  OIIO::ImageInput& input = *opened.value();
+  const OIIO::ImageSpec spec = input.spec();
+  r->file_format = input.format_name();
+  r->pixel_type = pixelTypeName(spec.format);
+  r->channels_in = spec.nchannels;
+  if (Status s = checkImageSpec(path, spec, options); !s) return s.error();
+
+  // Alpha and any extra channels are never read; height fields use the first channel only.
+  const int used = options.height ? 1 : std::min(spec.nchannels, 3);
+  Result<std::vector<float>> read = readPixels(path, input, options, used);
+  if (!read) return read.error();
+  std::vector<float>& pixels = read.value();
 
   NormalMap map;
-  map.width = width;
-  map.height = height;
+  map.width = spec.width;
+  map.height = spec.height;
   map.wrap = options.wrap;
-  map.normals.resize(texels * 3);
-
-  if (options.height) {
-    // Non-finite heights would spread into their neighbours' normals; count them here, replace
-    // them by 0 when asked, and make their own normal (0,0,1) as for normal maps.
-    std::vector<size_t> bad_texels;
-    for (size_t i = 0; i < texels; ++i) {
-      if (!std::isfinite(pixels[i])) {
-        bad_texels.push_back(i);
-        pixels[i] = 0.0f;
-      }
-    }
-    const int64_t bad = int64_t(bad_texels.size());
-    const size_t first = bad_texels.empty() ? 0 : bad_texels.front();
-    if (bad > 0 && !options.fix_nonfinite) {
-      r->nonfinite = bad;
-      r->texels = int64_t(texels);
-      return makeError(ErrorCode::kInvalidInput,
-                       path + ": " + std::to_string(bad) + " height(s) hold NaN or Inf, the first at column " +
-                           std::to_string(first % size_t(width)) + ", row " + std::to_string(first / size_t(width)) +
-                           " (--fix-nonfinite replaces them)");
-    }
-    heightsToNormals(pixels, options.height_scale, &map);
-    for (size_t i : bad_texels) {
-      map.normals[i * 3 + 0] = 0.0f;
-      map.normals[i * 3 + 1] = 0.0f;
-      map.normals[i * 3 + 2] = 1.0f;
-    }
-    r->encoding_used = Encoding::kUnorm;
-    Status status = normaliseNormals(&map, options, r);
-    if (!status) return makeError(status.error().code, path + ": " + status.error().message);
-    r->nonfinite = bad;
-  } else {
-    // Decide how stored values map to [-1, 1].
-    Encoding encoding = options.encoding;
-    const std::string recorded = spec.get_string_attribute(kNormalEncodingAttribute);
-    if (encoding == Encoding::kAuto && (recorded == "snorm" || recorded == "unorm")) {
-      // The writer recorded the encoding (glintbake's own maps do): trust it over the heuristic.
-      encoding = recorded == "snorm" ? Encoding::kSnorm : Encoding::kUnorm;
-    } else if (encoding == Encoding::kAuto) {
-      if (spec.format.is_floating_point()) {
-        const bool any_negative = std::any_of(pixels.begin(), pixels.end(), [](float v) { return v < 0.0f; });
-        encoding = any_negative ? Encoding::kSnorm : Encoding::kUnorm;
-      } else {
-        // OIIO already maps signed integer types to [-1, 1].
-        encoding = isSignedInteger(spec.format) ? Encoding::kSnorm : Encoding::kUnorm;
-      }
-    }
-    r->encoding_used = encoding;
-    const float scale = encoding == Encoding::kUnorm ? 2.0f : 1.0f;
-    const float offset = encoding == Encoding::kUnorm ? -1.0f : 0.0f;
-    const float sign_y = options.flip_green ? -1.0f : 1.0f;
-    for (size_t i = 0; i < texels; ++i) {
-      const float* p = &pixels[i * size_t(used)];
-      float* n = &map.normals[i * 3];
-      n[0] = scale * p[0] + offset;
-      n[1] = sign_y * (scale * p[1] + offset);
-      if (used == 2) {
-        const float r2 = n[0] * n[0] + n[1] * n[1];
-        n[2] = std::isfinite(r2) ? std::sqrt(std::max(0.0f, 1.0f - r2)) : r2;
-      } else {
-        n[2] = scale * p[2] + offset;
-      }
-    }
-    Status status = normaliseNormals(&map, options, r);
-    if (!status) return makeError(status.error().code, path + ": " + status.error().message);
-  }
+  map.normals.resize(size_t(spec.width) * size_t(spec.height) * 3);
+  const Status decoded = options.height ? heightsToMap(path, pixels, options, &map, r)
+                                        : pixelsToMap(path, spec, pixels, used, options, &map, r);
+  if (!decoded) return decoded.error();
 
   std::string hex;
   if (format::hashFile128Hex(path, &hex) != format::Status::kOk) {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 
 namespace glintbake::bake::ndf {
 namespace {
@@ -162,222 +163,313 @@ Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, form
   return buildNdfPyramid(map, options, sink, report, progress, cancel);
 }
 
+namespace {
+
+// One build of a pyramid, stage by stage: the level plan (geometry, record, convergence samples),
+// the convergence probe, and the region pipeline (images computed in parallel, region r + 1 while
+// region r is in the sink). Every image is computed by one thread, or, for footprints with very
+// many flakes, as kSplitParts row sets summed in a fixed order, so results never depend on the
+// thread count.
+class PyramidBuild {
+ public:
+  PyramidBuild(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport& report,
+               const PyramidProgress& progress, const std::atomic<bool>* cancel)
+      : map_(map),
+        options_(options),
+        sink_(sink),
+        rep_(report),
+        progress_(progress),
+        cancel_(cancel),
+        res_(options.splat.ndf_res),
+        image_floats_(size_t(res_) * size_t(res_)) {}
+
+  Status run();
+
+ private:
+  // The level being built: its plan and its convergence samples.
+  struct Level {
+    int level = 0;
+    LevelGeometry geo;
+    format::NdfLevelRecord rec;
+    bool split = false;                      // footprints split over kSplitParts row sets
+    std::vector<Sample> samples;             // of this level, predicted from the level below
+    std::vector<Sample> next;                // of the next level, predicted from this one
+    std::vector<std::vector<float>> probed;  // images of `samples`, computed by the probe
+    Clock::time_point start;                 // when the level's plan was made (the probe counts)
+    uint64_t bytes_before = 0;               // sink bytes before the level
+  };
+
+  bool cancelled() const { return cancel_ && cancel_->load(std::memory_order_relaxed); }
+  static Status cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
+
+  Status prepare();
+  Level planLevel(int level, std::vector<Sample> samples);
+  // Computes the probe images; *converged when the level below already predicts this one.
+  Status probe(Level& lv, bool* converged);
+  Status buildLevel(Level& lv);
+  void computeImage(const Level& lv, int i, int j, float* out);
+  void computeRegion(const Level& lv, int r, int slot);
+  void regionExtent(const Level& lv, int r, int* cx0, int* cy0, int* cw, int* ch) const;
+  const float* probedImage(const Level& lv, int centre) const;
+  PyramidChunk chunkOf(const Level& lv, int r, std::vector<float>& buf) const;
+  void collectSamples(Level& lv, const PyramidChunk& chunk, double* mse_sum) const;
+
+  const NormalMap& map_;
+  const PyramidOptions& options_;
+  PyramidSink& sink_;
+  PyramidReport& rep_;
+  const PyramidProgress& progress_;
+  const std::atomic<bool>* cancel_;
+  const int res_;
+  const size_t image_floats_;
+  std::optional<FlakeSet> flakes_;
+  std::optional<tbb::enumerable_thread_specific<Splatter>> splatters_;
+  std::vector<float> buffers_[2];              // chunk buffers: 32-byte image section header (8 floats), then images
+  std::vector<std::vector<double>> part_acc_;  // row-set sums of a split footprint
+};
+
+Status PyramidBuild::prepare() {
+  const auto t_flakes = Clock::now();
+  Result<FlakeSet> flakes_or = buildFlakes(map_, options_.rate);
+  if (!flakes_or) return flakes_or.error();
+  flakes_.emplace(std::move(flakes_or).value());
+  rep_.flakes = uint64_t(flakes_->grid_width) * uint64_t(flakes_->grid_height);
+  rep_.flake_seconds = secondsSince(t_flakes);
+  splatters_.emplace(*flakes_, options_.splat);
+  const size_t max_layers = size_t(options_.region_size) * size_t(options_.region_size);
+  try {
+    buffers_[0].resize(8 + max_layers * image_floats_);
+    buffers_[1].resize(8 + max_layers * image_floats_);
+  } catch (const std::bad_alloc&) {
+    return makeError(ErrorCode::kRuntime, "out of memory allocating chunk buffers");
+  }
+  part_acc_.assign(static_cast<size_t>(kSplitParts), std::vector<double>(image_floats_));
+  return okStatus();
+}
+
+// Level plan. Samples of THIS level compare its images with the prediction the runtime makes from
+// the level below (collected while that level was written); samples of the NEXT level collect the
+// prediction from this level's images.
+PyramidBuild::Level PyramidBuild::planLevel(int level, std::vector<Sample> samples) {
+  Level lv;
+  lv.start = Clock::now();
+  lv.bytes_before = sink_.storedBytes();
+  lv.level = level;
+  lv.geo = levelGeometry(map_.width, map_.height, options_, level);
+  lv.rec = levelRecord(map_, options_, level, lv.geo);
+  lv.samples = std::move(samples);
+  lv.next = planSamples(levelGeometry(map_.width, map_.height, options_, level + 1), lv.rec, image_floats_);
+  // Footprints with very many flakes (the top levels: few images, each costing up to several
+  // map's worth of flakes) are split; the split depends only on the level.
+  lv.split = splatters_->local().flakesPerImage(lv.geo.sigma) > kSplitFlakes;
+  return lv;
+}
+
+// Image of centre (i, j) of the level. Split footprints use the shared part buffers: call those
+// from one thread at a time.
+void PyramidBuild::computeImage(const Level& lv, int i, int j, float* out) {
+  const double x = (i + 0.5) * lv.geo.stride_x, y = (j + 0.5) * lv.geo.stride_y;
+  if (!lv.split) {
+    splatters_->local().image(x, y, lv.geo.sigma, out);
+    return;
+  }
+  tbb::parallel_for(0, kSplitParts, [&](int part) {
+    std::vector<double>& acc = part_acc_[size_t(part)];
+    std::fill(acc.begin(), acc.end(), 0.0);
+    splatters_->local().accumulate(x, y, lv.geo.sigma, part, kSplitParts, acc.data());
+  });
+  for (int part = 1; part < kSplitParts; ++part) {
+    for (size_t b = 0; b < image_floats_; ++b) part_acc_[0][b] += part_acc_[size_t(part)][b];
+  }
+  splatters_->local().finish(part_acc_[0].data(), out);
+}
+
+// Automatic level count: the level is probed at its convergence samples before it is computed. If
+// the runtime's prediction from the level below is already within converge_mse there, the level
+// would add little (queries above the top clamp to the level below), so it is not computed at all.
+// Otherwise the probed images are reused when their regions are computed.
+Status PyramidBuild::probe(Level& lv, bool* converged) {
+  *converged = false;
+  if (options_.levels != 0 || lv.samples.empty()) return okStatus();
+  try {
+    lv.probed.assign(lv.samples.size(), std::vector<float>(image_floats_));
+  } catch (const std::bad_alloc&) {
+    return makeError(ErrorCode::kRuntime, "out of memory allocating convergence samples");
+  }
+  auto one = [&](size_t q) {
+    const int centre = lv.samples[q].centre;
+    computeImage(lv, centre % lv.geo.grid_width, centre / lv.geo.grid_width, lv.probed[q].data());
+  };
+  if (lv.split) {
+    for (size_t q = 0; q < lv.samples.size(); ++q) one(q);
+  } else {
+    tbb::parallel_for(size_t(0), lv.samples.size(), one);
+  }
+  if (cancelled()) return cancelError();
+  double probe_mse = 0.0;
+  for (size_t q = 0; q < lv.samples.size(); ++q) {
+    probe_mse += relativeMse(lv.probed[q].data(), lv.samples[q].prediction.data(), image_floats_);
+  }
+  probe_mse /= double(lv.samples.size());
+  if (probe_mse < options_.converge_mse) {
+    rep_.stop_reason = "converged";
+    rep_.next_level_mse = probe_mse;
+    *converged = true;
+  }
+  return okStatus();
+}
+
+const float* PyramidBuild::probedImage(const Level& lv, int centre) const {
+  for (size_t q = 0; q < lv.probed.size(); ++q) {
+    if (lv.samples[q].centre == centre) return lv.probed[q].data();
+  }
+  return nullptr;
+}
+
+void PyramidBuild::regionExtent(const Level& lv, int r, int* cx0, int* cy0, int* cw, int* ch) const {
+  const int rx = r % lv.geo.regions_x, ry = r / lv.geo.regions_x;
+  *cx0 = rx * options_.region_size;
+  *cy0 = ry * options_.region_size;
+  *cw = std::min(options_.region_size, lv.geo.grid_width - *cx0);
+  *ch = std::min(options_.region_size, lv.geo.grid_height - *cy0);
+}
+
+// Computes the images of region r into buffers_[slot] (probed images are copied).
+void PyramidBuild::computeRegion(const Level& lv, int r, int slot) {
+  int cx0, cy0, cw, ch;
+  regionExtent(lv, r, &cx0, &cy0, &cw, &ch);
+  float* images = buffers_[slot].data() + 8;
+  auto one = [&](int k) {
+    const int i = cx0 + k % cw, j = cy0 + k / cw;
+    float* out = images + size_t(k) * image_floats_;
+    if (const float* probed = probedImage(lv, j * lv.geo.grid_width + i)) {
+      std::memcpy(out, probed, image_floats_ * sizeof(float));
+    } else {
+      computeImage(lv, i, j, out);
+    }
+  };
+  if (lv.split) {
+    for (int k = 0; k < cw * ch; ++k) {
+      if (cancelled()) return;
+      one(k);
+    }
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, cw * ch, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k != range.end(); ++k) {
+      if (cancelled()) return;
+      one(k);
+    }
+  });
+}
+
+// The finished region r in `buf` as a chunk: its image section header written in front.
+PyramidChunk PyramidBuild::chunkOf(const Level& lv, int r, std::vector<float>& buf) const {
+  int cx0, cy0, cw, ch;
+  regionExtent(lv, r, &cx0, &cy0, &cw, &ch);
+  format::ImageSectionHeader header;
+  header.width = uint32_t(res_);
+  header.height = uint32_t(res_);
+  header.channels = 1;
+  header.layers = uint32_t(cw * ch);
+  std::memcpy(buf.data(), &header, sizeof(header));
+  PyramidChunk chunk;
+  chunk.level = lv.level;
+  chunk.region = r;
+  chunk.x0 = cx0;
+  chunk.y0 = cy0;
+  chunk.width = cw;
+  chunk.height = ch;
+  chunk.ndf_res = res_;
+  chunk.images = buf.data() + 8;
+  chunk.section = buf.data();
+  chunk.section_bytes = sizeof(header) + size_t(cw * ch) * image_floats_ * sizeof(float);
+  return chunk;
+}
+
+// Convergence bookkeeping of one written chunk: the MSE of this level's samples, and this level's
+// share of the next level's predictions.
+void PyramidBuild::collectSamples(Level& lv, const PyramidChunk& chunk, double* mse_sum) const {
+  for (int k = 0; k < chunk.width * chunk.height; ++k) {
+    const int centre = (chunk.y0 + k / chunk.width) * lv.geo.grid_width + (chunk.x0 + k % chunk.width);
+    const float* img = chunk.images + size_t(k) * image_floats_;
+    for (Sample& smp : lv.samples) {
+      if (smp.centre == centre) *mse_sum += relativeMse(img, smp.prediction.data(), image_floats_);
+    }
+    for (Sample& smp : lv.next) {
+      for (int q = 0; q < 4; ++q) {
+        if (smp.below[q] != centre || smp.weight[q] == 0.0) continue;
+        for (size_t b = 0; b < image_floats_; ++b) smp.prediction[b] += smp.weight[q] * double(img[b]);
+      }
+    }
+  }
+}
+
+// The region pipeline of one level: region r + 1 is computed while region r is in the sink.
+Status PyramidBuild::buildLevel(Level& lv) {
+  PyramidLevelReport lrep;
+  lrep.level = lv.level;
+  lrep.geometry = lv.geo;
+  if (Status s = sink_.addLevel(lv.rec); !s) return s;
+
+  const int region_count = lv.geo.regions_x * lv.geo.regions_y;
+  const uint64_t level_images = uint64_t(lv.geo.grid_width) * uint64_t(lv.geo.grid_height);
+  uint64_t done = 0;
+  double mse_sum = 0.0;
+  computeRegion(lv, 0, 0);
+  for (int r = 0; r < region_count; ++r) {
+    if (cancelled()) return cancelError();
+    tbb::task_group next;
+    if (r + 1 < region_count) next.run([&, r] { computeRegion(lv, r + 1, (r + 1) % 2); });
+    const PyramidChunk chunk = chunkOf(lv, r, buffers_[r % 2]);
+    Status sunk = sink_.addChunk(chunk);
+    next.wait();
+    if (!sunk) return sunk;
+    collectSamples(lv, chunk, &mse_sum);
+    const uint64_t images = uint64_t(chunk.width * chunk.height);
+    lrep.raw_bytes += chunk.section_bytes;
+    lrep.images += images;
+    done += images;
+    if (progress_) progress_(lv.level, done, level_images);
+  }
+  if (!lv.samples.empty()) lrep.mse_vs_previous = mse_sum / double(lv.samples.size());
+  if (Status s = sink_.endLevel(lv.level); !s) return s;
+  lrep.stored_bytes = sink_.storedBytes() - lv.bytes_before;
+  lrep.seconds = secondsSince(lv.start);
+  rep_.levels.push_back(lrep);
+  return okStatus();
+}
+
+Status PyramidBuild::run() {
+  if (Status s = prepare(); !s) return s;
+  const int max_levels = options_.levels > 0 ? options_.levels : kMaxPyramidLevels;
+  std::vector<Sample> samples;  // level 0 has no level below
+  for (int level = 0; level < max_levels; ++level) {
+    if (cancelled()) return cancelError();
+    Level lv = planLevel(level, std::move(samples));
+    bool converged = false;
+    if (Status s = probe(lv, &converged); !s || converged) return s;
+    if (Status s = buildLevel(lv); !s) return s;
+    if (options_.levels == 0 && lv.geo.grid_width == 1 && lv.geo.grid_height == 1) {
+      rep_.stop_reason = "grid-1x1";
+      return okStatus();
+    }
+    samples = std::move(lv.next);
+  }
+  rep_.stop_reason = options_.levels > 0 ? "levels" : "max-levels";
+  return okStatus();
+}
+
+}  // namespace
+
 Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport* report,
                        const PyramidProgress& progress, const std::atomic<bool>* cancel) {
   if (Status s = validatePyramidOptions(options); !s) return s;
   PyramidReport local_report;
   PyramidReport& rep = report ? *report : local_report;
   rep = PyramidReport{};
-
-  const auto t_flakes = Clock::now();
-  Result<FlakeSet> flakes_or = buildFlakes(map, options.rate);
-  if (!flakes_or) return flakes_or.error();
-  const FlakeSet& flakes = flakes_or.value();
-  rep.flakes = uint64_t(flakes.grid_width) * uint64_t(flakes.grid_height);
-  rep.flake_seconds = secondsSince(t_flakes);
-
-  const int res = options.splat.ndf_res;
-  const size_t image_floats = size_t(res) * size_t(res);
-  tbb::enumerable_thread_specific<Splatter> splatters(flakes, options.splat);
-  auto cancelled = [&] { return cancel && cancel->load(std::memory_order_relaxed); };
-  auto cancelError = [] { return Status(makeError(ErrorCode::kRuntime, "cancelled")); };
-
-  // Chunk buffers: 32-byte image section header (8 floats) followed by the images.
-  const size_t max_layers = size_t(options.region_size) * size_t(options.region_size);
-  std::vector<float> buffers[2];
-  try {
-    buffers[0].resize(8 + max_layers * image_floats);
-    buffers[1].resize(8 + max_layers * image_floats);
-  } catch (const std::bad_alloc&) {
-    return makeError(ErrorCode::kRuntime, "out of memory allocating chunk buffers");
-  }
-
-  std::vector<std::vector<double>> part_acc(static_cast<size_t>(kSplitParts), std::vector<double>(image_floats));
-  const int max_levels = options.levels > 0 ? options.levels : kMaxPyramidLevels;
-  std::vector<Sample> next_samples;  // level-0 has no level below
-  for (int level = 0; level < max_levels; ++level) {
-    const LevelGeometry geo = levelGeometry(map.width, map.height, options, level);
-    if (cancelled()) return cancelError();
-
-    const auto t_level = Clock::now();
-    const uint64_t bytes_before = sink.storedBytes();
-    PyramidLevelReport lrep;
-    lrep.level = level;
-    lrep.geometry = geo;
-
-    // Convergence bookkeeping. Samples of THIS level: compare its images with the prediction the
-    // runtime makes from the level below (bilinear blend of that level's images, collected while it
-    // was written). Samples of the NEXT level: collect the prediction from this level's images.
-    std::vector<Sample> samples = std::move(next_samples);
-    const format::NdfLevelRecord rec = levelRecord(map, options, level, geo);
-    next_samples = planSamples(levelGeometry(map.width, map.height, options, level + 1), rec, image_floats);
-    double mse_sum = 0.0;
-
-    // Footprints with very many flakes (the top levels: few images, each costing up to several
-    // map's worth of flakes) are split over kSplitParts interleaved row sets computed in parallel
-    // and summed in a fixed order; the split depends only on the level, never on the thread count.
-    const bool split = splatters.local().flakesPerImage(geo.sigma) > kSplitFlakes;
-    // Image of centre (i, j) of this level. Split footprints use the shared part buffers: call those
-    // from one thread at a time.
-    auto computeImage = [&](int i, int j, float* out) {
-      const double x = (i + 0.5) * geo.stride_x, y = (j + 0.5) * geo.stride_y;
-      if (!split) {
-        splatters.local().image(x, y, geo.sigma, out);
-        return;
-      }
-      tbb::parallel_for(0, kSplitParts, [&](int part) {
-        std::vector<double>& acc = part_acc[size_t(part)];
-        std::fill(acc.begin(), acc.end(), 0.0);
-        splatters.local().accumulate(x, y, geo.sigma, part, kSplitParts, acc.data());
-      });
-      for (int part = 1; part < kSplitParts; ++part) {
-        for (size_t b = 0; b < image_floats; ++b) part_acc[0][b] += part_acc[size_t(part)][b];
-      }
-      splatters.local().finish(part_acc[0].data(), out);
-    };
-
-    // Automatic level count: probe this level at its convergence samples before computing it. If
-    // the runtime's prediction from the level below is already within converge_mse there, the
-    // level would add little (queries above the top clamp to the level below), so it is not
-    // computed at all. Otherwise the probed images are reused when their regions are computed.
-    std::vector<std::vector<float>> probe_images;
-    if (options.levels == 0 && !samples.empty()) {
-      try {
-        probe_images.assign(samples.size(), std::vector<float>(image_floats));
-      } catch (const std::bad_alloc&) {
-        return makeError(ErrorCode::kRuntime, "out of memory allocating convergence samples");
-      }
-      auto probe = [&](size_t q) {
-        const int centre = samples[q].centre;
-        computeImage(centre % geo.grid_width, centre / geo.grid_width, probe_images[q].data());
-      };
-      if (split) {
-        for (size_t q = 0; q < samples.size(); ++q) probe(q);
-      } else {
-        tbb::parallel_for(size_t(0), samples.size(), probe);
-      }
-      if (cancelled()) return cancelError();
-      double probe_mse = 0.0;
-      for (size_t q = 0; q < samples.size(); ++q) {
-        probe_mse += relativeMse(probe_images[q].data(), samples[q].prediction.data(), image_floats);
-      }
-      probe_mse /= double(samples.size());
-      if (probe_mse < options.converge_mse) {
-        rep.stop_reason = "converged";
-        rep.next_level_mse = probe_mse;
-        return okStatus();
-      }
-    }
-    auto probedImage = [&](int centre) -> const float* {
-      for (size_t q = 0; q < probe_images.size(); ++q) {
-        if (samples[q].centre == centre) return probe_images[q].data();
-      }
-      return nullptr;
-    };
-
-    if (Status s = sink.addLevel(rec); !s) return s;
-
-    const int region_count = geo.regions_x * geo.regions_y;
-    const uint64_t level_images = uint64_t(geo.grid_width) * uint64_t(geo.grid_height);
-    uint64_t done = 0;
-
-    // Computes region r into buffers[slot]; returns the number of layers.
-    auto regionExtent = [&](int r, int* cx0, int* cy0, int* cw, int* ch) {
-      const int rx = r % geo.regions_x, ry = r / geo.regions_x;
-      *cx0 = rx * options.region_size;
-      *cy0 = ry * options.region_size;
-      *cw = std::min(options.region_size, geo.grid_width - *cx0);
-      *ch = std::min(options.region_size, geo.grid_height - *cy0);
-    };
-    auto computeRegion = [&](int r, int slot) {
-      int cx0, cy0, cw, ch;
-      regionExtent(r, &cx0, &cy0, &cw, &ch);
-      float* images = buffers[slot].data() + 8;
-      auto one = [&](int k) {
-        const int i = cx0 + k % cw, j = cy0 + k / cw;
-        float* out = images + size_t(k) * image_floats;
-        if (const float* probed = probedImage(j * geo.grid_width + i)) {
-          std::memcpy(out, probed, image_floats * sizeof(float));
-        } else {
-          computeImage(i, j, out);
-        }
-      };
-      if (split) {
-        for (int k = 0; k < cw * ch; ++k) {
-          if (cancelled()) return;
-          one(k);
-        }
-        return;
-      }
-      tbb::parallel_for(tbb::blocked_range<int>(0, cw * ch, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int k = range.begin(); k != range.end(); ++k) {
-          if (cancelled()) return;
-          one(k);
-        }
-      });
-    };
-
-    // Double buffering: region r + 1 is computed while region r is compressed and written.
-    computeRegion(0, 0);
-    for (int r = 0; r < region_count; ++r) {
-      if (cancelled()) return cancelError();
-      tbb::task_group next;
-      if (r + 1 < region_count) next.run([&, r] { computeRegion(r + 1, (r + 1) % 2); });
-      int cx0, cy0, cw, ch;
-      regionExtent(r, &cx0, &cy0, &cw, &ch);
-      format::ImageSectionHeader header;
-      header.width = uint32_t(res);
-      header.height = uint32_t(res);
-      header.channels = 1;
-      header.layers = uint32_t(cw * ch);
-      std::vector<float>& buf = buffers[r % 2];
-      std::memcpy(buf.data(), &header, sizeof(header));
-      const size_t bytes = sizeof(header) + size_t(cw * ch) * image_floats * sizeof(float);
-      PyramidChunk chunk;
-      chunk.level = level;
-      chunk.region = r;
-      chunk.x0 = cx0;
-      chunk.y0 = cy0;
-      chunk.width = cw;
-      chunk.height = ch;
-      chunk.ndf_res = res;
-      chunk.images = buf.data() + 8;
-      chunk.section = buf.data();
-      chunk.section_bytes = bytes;
-      Status sunk = sink.addChunk(chunk);
-      next.wait();
-      if (!sunk) return sunk;
-      for (int k = 0; k < cw * ch; ++k) {
-        const int centre = (cy0 + k / cw) * geo.grid_width + (cx0 + k % cw);
-        const float* img = buf.data() + 8 + size_t(k) * image_floats;
-        for (Sample& smp : samples) {
-          if (smp.centre == centre) mse_sum += relativeMse(img, smp.prediction.data(), image_floats);
-        }
-        for (Sample& smp : next_samples) {
-          for (int q = 0; q < 4; ++q) {
-            if (smp.below[q] != centre || smp.weight[q] == 0.0) continue;
-            for (size_t b = 0; b < image_floats; ++b) smp.prediction[b] += smp.weight[q] * double(img[b]);
-          }
-        }
-      }
-      lrep.raw_bytes += bytes;
-      lrep.images += uint64_t(cw * ch);
-      done += uint64_t(cw * ch);
-      if (progress) progress(level, done, level_images);
-    }
-    if (!samples.empty()) lrep.mse_vs_previous = mse_sum / double(samples.size());
-    if (Status s = sink.endLevel(level); !s) return s;
-    lrep.stored_bytes = sink.storedBytes() - bytes_before;
-    lrep.seconds = secondsSince(t_level);
-    rep.levels.push_back(lrep);
-
-    if (options.levels == 0 && geo.grid_width == 1 && geo.grid_height == 1) {
-      rep.stop_reason = "grid-1x1";
-      return okStatus();
-    }
-  }
-  rep.stop_reason = options.levels > 0 ? "levels" : "max-levels";
-  return okStatus();
+  PyramidBuild build(map, options, sink, rep, progress, cancel);
+  return build.run();
 }
 
 }  // namespace glintbake::bake::ndf

@@ -133,146 +133,180 @@ class Shader {
       *out = total;
       return true;
     }
-    const double inv_spp = 1.0 / options_.spp;
     for (size_t li = 0; li < scene_.lights.size(); ++li) {
       const Light& light = scene_.lights[li];
       Stream rng(options_.seed, pixel, li);
+      bool ok = true;
       switch (light.type) {
-        case LightType::kPoint: {
-          const Vec3 d = toVec(light.position) - hit.position;
-          const double d2 = dot(d, d);
-          if (!(d2 > 0.0)) break;
-          const Vec3 wi = frame.toLocal((1.0 / std::sqrt(d2)) * d);
-          Rgb f;
-          if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
-          const double k = std::fmax(0.0, wi.z) / d2;
-          total.r += f.r * light.color[0] * k;
-          total.g += f.g * light.color[1] * k;
-          total.b += f.b * light.color[2] * k;
+        case LightType::kPoint:
+          ok = shadePoint(brdf, light, frame, hit, wo, &total);
           break;
+        case LightType::kDirectional:
+          ok = shadeDirectional(brdf, light, frame, wo, &total);
+          break;
+        case LightType::kPolygon:
+          ok = shadePolygon(brdf, light, frame, hit, wo, wo_world, li, rng, &total);
+          break;
+        case LightType::kSphericalGaussian:
+          ok = shadeSg(brdf, light, frame, wo, rng, &total);
+          break;
+        case LightType::kUniform:
+          ok = shadeUniform(brdf, light, wo, rng, &total);
+          break;
+      }
+      if (!ok) return false;
+    }
+    *out = total;
+    return true;
+  }
+
+  // A point light: the BRDF at its direction, over the squared distance.
+  bool shadePoint(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const SurfaceHit& hit,
+                  const Vec3& wo, Rgb* total) const {
+    const Vec3 d = toVec(light.position) - hit.position;
+    const double d2 = dot(d, d);
+    if (!(d2 > 0.0)) return true;
+    const Vec3 wi = frame.toLocal((1.0 / std::sqrt(d2)) * d);
+    Rgb f;
+    if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+    const double k = std::fmax(0.0, wi.z) / d2;
+    total->r += f.r * light.color[0] * k;
+    total->g += f.g * light.color[1] * k;
+    total->b += f.b * light.color[2] * k;
+    return true;
+  }
+
+  // A directional light: the BRDF at its direction.
+  bool shadeDirectional(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const Vec3& wo,
+                        Rgb* total) const {
+    const Vec3 wi = frame.toLocal(normalize(toVec(light.direction)));
+    Rgb f;
+    if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+    const double k = std::fmax(0.0, wi.z);
+    total->r += f.r * light.color[0] * k;
+    total->g += f.g * light.color[1] * k;
+    total->b += f.b * light.color[2] * k;
+    return true;
+  }
+
+  // A polygon light: the LTC table when given, else light and BRDF samples with MIS.
+  bool shadePolygon(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const SurfaceHit& hit,
+                    const Vec3& wo, const Vec3& wo_world, size_t li, Stream& rng, Rgb* total) const {
+    const double inv_spp = 1.0 / options_.spp;
+    if (options_.ltc != nullptr) {
+      add(total, shadeLtc(light, hit, wo_world, brdf), 1.0);
+      return true;
+    }
+    const PolygonLight& poly = polygons_[li];
+    Rgb acc;
+    for (int n = 0; n < options_.spp; ++n) {
+      // Light sample: a uniform point of the polygon.
+      const double ut = rng.next() * poly.area, us = rng.next(), uv = rng.next();
+      size_t tri = 0;
+      while (tri + 1 < poly.cdf.size() && ut > poly.cdf[tri]) ++tri;
+      const double su = std::sqrt(us);
+      const Vec3 y = poly.a[tri] + (su * (1.0 - uv)) * poly.e1[tri] + (su * uv) * poly.e2[tri];
+      const Vec3 d = y - hit.position;
+      const double d2 = dot(d, d);
+      const Vec3 wi_world = (1.0 / std::sqrt(d2)) * d;
+      const double cos_l = std::fabs(dot(poly.normal, wi_world));
+      if (cos_l > 1e-12) {
+        const Vec3 wi = frame.toLocal(wi_world);
+        Rgb f;
+        double bpdf = 0.0;
+        if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+        if (wi.z > 0.0 && (f.r > 0.0 || f.g > 0.0 || f.b > 0.0)) {
+          if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
+          const double lpdf = d2 / (poly.area * cos_l);
+          add(&acc, f, wi.z * powerHeuristic(lpdf, bpdf) / lpdf);
         }
-        case LightType::kDirectional: {
-          const Vec3 wi = frame.toLocal(normalize(toVec(light.direction)));
-          Rgb f;
-          if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
-          const double k = std::fmax(0.0, wi.z);
-          total.r += f.r * light.color[0] * k;
-          total.g += f.g * light.color[1] * k;
-          total.b += f.b * light.color[2] * k;
-          break;
-        }
-        case LightType::kPolygon: {
-          if (options_.ltc != nullptr) {
-            add(&total, shadeLtc(light, hit, wo_world, brdf), 1.0);
-            break;
-          }
-          const PolygonLight& poly = polygons_[li];
-          Rgb acc;
-          for (int n = 0; n < options_.spp; ++n) {
-            // Light sample: a uniform point of the polygon.
-            const double ut = rng.next() * poly.area, us = rng.next(), uv = rng.next();
-            size_t tri = 0;
-            while (tri + 1 < poly.cdf.size() && ut > poly.cdf[tri]) ++tri;
-            const double su = std::sqrt(us);
-            const Vec3 y = poly.a[tri] + (su * (1.0 - uv)) * poly.e1[tri] + (su * uv) * poly.e2[tri];
-            const Vec3 d = y - hit.position;
-            const double d2 = dot(d, d);
-            const Vec3 wi_world = (1.0 / std::sqrt(d2)) * d;
-            const double cos_l = std::fabs(dot(poly.normal, wi_world));
-            if (cos_l > 1e-12) {
-              const Vec3 wi = frame.toLocal(wi_world);
-              Rgb f;
-              double bpdf = 0.0;
-              if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
-              if (wi.z > 0.0 && (f.r > 0.0 || f.g > 0.0 || f.b > 0.0)) {
-                if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
-                const double lpdf = d2 / (poly.area * cos_l);
-                add(&acc, f, wi.z * powerHeuristic(lpdf, bpdf) / lpdf);
-              }
-            }
-            // BRDF sample.
-            BrdfSample s;
-            if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
-            if (s.pdf > 0.0 && s.wi.z > 0.0) {
-              const Vec3 wi_world2 = frame.toWorld(s.wi);
-              const double t = hitPolygon(poly, hit.position, wi_world2);
-              if (t > 0.0) {
-                const double c2 = std::fabs(dot(poly.normal, wi_world2));
-                const double lpdf = c2 > 0.0 ? t * t / (poly.area * c2) : 0.0;
-                add(&acc, s.weight, powerHeuristic(s.pdf, lpdf));
-              }
-            }
-          }
-          total.r += acc.r * light.color[0] * inv_spp;
-          total.g += acc.g * light.color[1] * inv_spp;
-          total.b += acc.b * light.color[2] * inv_spp;
-          break;
-        }
-        case LightType::kSphericalGaussian: {
-          runtime::SphericalGaussian sg;
-          sg.axis = normalize(toVec(light.direction));
-          sg.sharpness = light.sharpness;
-          sg.amplitude = toRgb(light.color);
-          if (options_.mode == NdfMode::kAsset && options_.env_method == EnvMethod::kPrefilter) {
-            runtime::SphericalGaussian local = sg;
-            local.axis = frame.toLocal(sg.axis);
-            const double amp = std::fmax(sg.amplitude.r, std::fmax(sg.amplitude.g, sg.amplitude.b));
-            if (!(amp > 0.0)) break;
-            Rgb radiance;
-            if (runtime::prefilteredSgShading(brdf, local, options_.sg_epsilon * amp, wo, &radiance) !=
-                runtime::Status::kOk) {
-              return false;
-            }
-            add(&total, radiance, 1.0);
-            break;
-          }
-          Rgb acc;
-          for (int n = 0; n < options_.spp; ++n) {
-            double lpdf = 0.0;
-            const Vec3 wi_world = runtime::sampleSg(sg, rng.next(), rng.next(), &lpdf);
-            const Vec3 wi = frame.toLocal(wi_world);
-            if (wi.z > 0.0 && lpdf > 0.0) {
-              Rgb f;
-              double bpdf = 0.0;
-              if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
-              if (f.r > 0.0 || f.g > 0.0 || f.b > 0.0) {
-                if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
-                const Rgb le = runtime::evalSg(sg, wi_world);
-                const double k = wi.z * powerHeuristic(lpdf, bpdf) / lpdf;
-                acc.r += f.r * le.r * k;
-                acc.g += f.g * le.g * k;
-                acc.b += f.b * le.b * k;
-              }
-            }
-            BrdfSample s;
-            if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
-            if (s.pdf > 0.0 && s.wi.z > 0.0) {
-              const Vec3 w = frame.toWorld(s.wi);
-              const Rgb le = runtime::evalSg(sg, w);
-              const double k = powerHeuristic(s.pdf, runtime::sgPdf(sg, w));
-              acc.r += s.weight.r * le.r * k;
-              acc.g += s.weight.g * le.g * k;
-              acc.b += s.weight.b * le.b * k;
-            }
-          }
-          add(&total, acc, inv_spp);
-          break;
-        }
-        case LightType::kUniform: {
-          Rgb acc;
-          for (int n = 0; n < options_.spp; ++n) {
-            BrdfSample s;
-            if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
-            if (s.pdf > 0.0 && s.wi.z > 0.0) add(&acc, s.weight, 1.0);
-          }
-          total.r += acc.r * light.color[0] * inv_spp;
-          total.g += acc.g * light.color[1] * inv_spp;
-          total.b += acc.b * light.color[2] * inv_spp;
-          break;
+      }
+      // BRDF sample.
+      BrdfSample s;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (s.pdf > 0.0 && s.wi.z > 0.0) {
+        const Vec3 wi_world2 = frame.toWorld(s.wi);
+        const double t = hitPolygon(poly, hit.position, wi_world2);
+        if (t > 0.0) {
+          const double c2 = std::fabs(dot(poly.normal, wi_world2));
+          const double lpdf = c2 > 0.0 ? t * t / (poly.area * c2) : 0.0;
+          add(&acc, s.weight, powerHeuristic(s.pdf, lpdf));
         }
       }
     }
-    *out = total;
+    total->r += acc.r * light.color[0] * inv_spp;
+    total->g += acc.g * light.color[1] * inv_spp;
+    total->b += acc.b * light.color[2] * inv_spp;
+    return true;
+  }
+
+  // A spherical-Gaussian environment: prefiltered with assets (--env prefilter), else light and BRDF
+  // samples with MIS.
+  bool shadeSg(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const Vec3& wo, Stream& rng,
+               Rgb* total) const {
+    const double inv_spp = 1.0 / options_.spp;
+    runtime::SphericalGaussian sg;
+    sg.axis = normalize(toVec(light.direction));
+    sg.sharpness = light.sharpness;
+    sg.amplitude = toRgb(light.color);
+    if (options_.mode == NdfMode::kAsset && options_.env_method == EnvMethod::kPrefilter) {
+      runtime::SphericalGaussian local = sg;
+      local.axis = frame.toLocal(sg.axis);
+      const double amp = std::fmax(sg.amplitude.r, std::fmax(sg.amplitude.g, sg.amplitude.b));
+      if (!(amp > 0.0)) return true;
+      Rgb radiance;
+      if (runtime::prefilteredSgShading(brdf, local, options_.sg_epsilon * amp, wo, &radiance) !=
+          runtime::Status::kOk) {
+        return false;
+      }
+      add(total, radiance, 1.0);
+      return true;
+    }
+    Rgb acc;
+    for (int n = 0; n < options_.spp; ++n) {
+      double lpdf = 0.0;
+      const Vec3 wi_world = runtime::sampleSg(sg, rng.next(), rng.next(), &lpdf);
+      const Vec3 wi = frame.toLocal(wi_world);
+      if (wi.z > 0.0 && lpdf > 0.0) {
+        Rgb f;
+        double bpdf = 0.0;
+        if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+        if (f.r > 0.0 || f.g > 0.0 || f.b > 0.0) {
+          if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
+          const Rgb le = runtime::evalSg(sg, wi_world);
+          const double k = wi.z * powerHeuristic(lpdf, bpdf) / lpdf;
+          acc.r += f.r * le.r * k;
+          acc.g += f.g * le.g * k;
+          acc.b += f.b * le.b * k;
+        }
+      }
+      BrdfSample s;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (s.pdf > 0.0 && s.wi.z > 0.0) {
+        const Vec3 w = frame.toWorld(s.wi);
+        const Rgb le = runtime::evalSg(sg, w);
+        const double k = powerHeuristic(s.pdf, runtime::sgPdf(sg, w));
+        acc.r += s.weight.r * le.r * k;
+        acc.g += s.weight.g * le.g * k;
+        acc.b += s.weight.b * le.b * k;
+      }
+    }
+    add(total, acc, inv_spp);
+    return true;
+  }
+
+  // A uniform environment: BRDF samples.
+  bool shadeUniform(const MicrofacetBrdf& brdf, const Light& light, const Vec3& wo, Stream& rng, Rgb* total) const {
+    const double inv_spp = 1.0 / options_.spp;
+    Rgb acc;
+    for (int n = 0; n < options_.spp; ++n) {
+      BrdfSample s;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (s.pdf > 0.0 && s.wi.z > 0.0) add(&acc, s.weight, 1.0);
+    }
+    total->r += acc.r * light.color[0] * inv_spp;
+    total->g += acc.g * light.color[1] * inv_spp;
+    total->b += acc.b * light.color[2] * inv_spp;
     return true;
   }
 

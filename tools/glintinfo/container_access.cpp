@@ -1,4 +1,5 @@
 #include "container_access.h"
+#include <glintbake/cli/exit_codes.h>
 
 #include <glintbake/format/validate.h>
 
@@ -6,24 +7,6 @@
 #include <cstring>
 
 namespace glintbake::glintinfo {
-
-int exitCodeFor(format::Status status) {
-  using format::Status;
-  switch (status) {
-    case Status::kOk:
-      return cli::kExitOk;
-    case Status::kIoError:
-      return cli::kExitIo;
-    case Status::kUnsupportedVersion:
-      return cli::kExitUnsupported;
-    case Status::kInvalidArgument:
-      return cli::kExitBadArguments;
-    case Status::kNotFound:
-      return cli::kExitBadArguments;
-    default:
-      return cli::kExitInvalidInput;
-  }
-}
 
 std::unique_ptr<format::Reader> openContainer(const std::string& path) {
   auto reader = std::make_unique<format::Reader>();
@@ -44,14 +27,14 @@ std::unique_ptr<format::Reader> openContainer(const std::string& path) {
       break;
     }
   }
-  throw cli::Error(exitCodeFor(status), path + ": " + reason);
+  throw cli::Error(cli::exitCodeOf(status), path + ": " + reason);
 }
 
 std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i) {
   std::vector<uint8_t> bytes;
   const format::Status status = reader.readSection(i, &bytes);
   if (status != format::Status::kOk) {
-    throw cli::Error(exitCodeFor(status),
+    throw cli::Error(cli::exitCodeOf(status),
                      path + ": section " + std::to_string(i) + ": " + format::statusString(status));
   }
   return bytes;

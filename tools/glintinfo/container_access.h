@@ -13,7 +13,6 @@
 namespace glintbake::glintinfo {
 
 // io -> 2; bad magic, corrupt, checksum, truncated, too large -> 3; newer major -> 5.
-int exitCodeFor(format::Status status);
 
 // Opens path; throws cli::Error with the mapped exit code and a message such as
 // "a.gbk: header checksum mismatch (stored ..., computed ...)".

@@ -1,4 +1,5 @@
 // glintinfo export: writes one layer of an image-like section as an EXR/PNG/... image.
+#include <glintbake/cli/exit_codes.h>
 #include "commands.h"
 #include "container_access.h"
 
@@ -149,7 +150,7 @@ int runExport(cli::Tool& tool, const ExportOptions& options) {
 
   const bake::Status status =
       bake::writeImage(options.output, int(header.width), int(header.height), out_channels, out.data());
-  if (!status.ok()) throw cli::Error(int(status.error().code), status.error().message);
+  cli::check(status);
   tool.addOutput(options.output);
 
   if (tool.common().json) {

@@ -1,5 +1,6 @@
 // glintref image: the bin-averaged NDF image of a footprint (each bin the exact average of D over
 // the bin), written as a 1-channel float EXR or, for viewing, a PNG normalised by its maximum.
+#include <glintbake/cli/exit_codes.h>
 #include "commands.h"
 
 #include <glintbake/bake/io/image_io.h>
@@ -22,7 +23,8 @@ std::string lowerExtension(const std::string& path) {
 }  // namespace
 
 CLI::App* addImageCommand(CLI::App& app, ImageOptions& options) {
-  CLI::App* cmd = app.add_subcommand("image", "Write the bin-averaged NDF image of a footprint (.exr, or .png for viewing)");
+  CLI::App* cmd =
+      app.add_subcommand("image", "Write the bin-averaged NDF image of a footprint (.exr, or .png for viewing)");
   addQueryOptions(*cmd, options.query);
   cmd->add_option("--res", options.res, "Bins per side of the image over s in [-1,1]^2 (1..4096)");
   cmd->add_option("-o,--output", options.output, "Output image: .exr (float densities) or .png (scaled by the maximum)")
@@ -60,7 +62,7 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
   for (size_t k = 0; k < image.size(); ++k) pixels[k] = float(image[k] * scale);
 
   const bake::Status written = bake::writeImage(options.output, res, res, 1, pixels.data());
-  if (!written) throw cli::Error(int(written.error().code), written.error().message);
+  cli::check(written);
   tool.addOutput(options.output);
 
   if (tool.common().json) {
@@ -74,8 +76,8 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
     doc["max"] = max_value;
     tool.printJson(doc);
   } else {
-    tool.info("wrote " + options.output + " (" + std::to_string(res) + "x" + std::to_string(res) +
-              ", integral " + std::to_string(sum * bin_area) + ")");
+    tool.info("wrote " + options.output + " (" + std::to_string(res) + "x" + std::to_string(res) + ", integral " +
+              std::to_string(sum * bin_area) + ")");
   }
   return cli::kExitOk;
 }

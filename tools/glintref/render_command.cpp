@@ -7,8 +7,8 @@
 #include <glintbake/bake/render/image_compare.h>
 #include <glintbake/bake/render/renderer.h>
 #include <glintbake/bake/render/scene.h>
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
-#include <glintbake/cli/runtime_status.h>
 #include <glintbake/reference/flakes.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -24,6 +24,175 @@ namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The command-line checks that need no file: the NDF mode and the --image-size override (0 x 0 when
+// not given).
+bake::render::NdfMode checkRenderOptions(const RenderOptions& options, int* width, int* height) {
+  bake::render::NdfMode mode = bake::render::NdfMode::kSmooth;
+  bake::render::ndfModeFromString(options.ndf, &mode);
+  if (options.spp < 1 || options.spp > 65536) {
+    throw cli::Error(cli::kExitBadArguments, "--spp must be in 1..65536, got " + std::to_string(options.spp));
+  }
+  *width = *height = 0;
+  if (!options.image_size.empty()) {
+    double w = 0.0, h = 0.0;
+    parsePair("--image-size", options.image_size, &w, &h);
+    if (w < 1 || w > 8192 || h < 1 || h > 8192 || w != std::floor(w) || h != std::floor(h)) {
+      throw cli::Error(cli::kExitBadArguments, "--image-size must be two integers W,H in 1..8192");
+    }
+    *width = int(w);
+    *height = int(h);
+  }
+  if (!options.ltc.empty() && mode != bake::render::NdfMode::kSmooth) {
+    throw cli::Error(cli::kExitBadArguments, "--ltc needs --ndf smooth (the table holds the smooth GGX BRDF)");
+  }
+  if (!(options.exposure > 0.0) || !std::isfinite(options.exposure)) {
+    throw cli::Error(cli::kExitBadArguments, "--exposure must be positive");
+  }
+  if (!bake::isFloatImagePath(options.output) || bake::imageExtension(options.output) != "exr") {
+    throw cli::Error(cli::kExitBadArguments, "-o " + options.output + ": the render must be written as .exr");
+  }
+  if (!options.preview.empty() && bake::imageExtension(options.preview) != "png") {
+    throw cli::Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
+  }
+  for (const std::string& out : {options.output, options.preview}) {
+    if (out.empty()) continue;
+    const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+      throw cli::Error(cli::kExitIo, "cannot write " + out + ": no such directory");
+    }
+  }
+  return mode;
+}
+
+// The scene with the command line's overrides.
+bake::render::Scene loadRenderScene(cli::Tool& tool, const RenderOptions& options, int width, int height) {
+  tool.addInput(options.scene);
+  bake::render::Scene scene = cli::unwrap(bake::render::loadScene(options.scene));
+  if (!options.asset.empty()) scene.material.asset = options.asset;
+  if (!options.normal_map.empty()) scene.material.normal_map = options.normal_map;
+  if (width > 0) {
+    scene.camera.width = width;
+    scene.camera.height = height;
+  }
+  return scene;
+}
+
+// What the NDF mode reads: the map (for the reference's flakes, or only for its size when the scene
+// does not state it), the asset, the LTC table. `inputs` points into this.
+struct RenderSources {
+  bake::render::NdfInputs inputs;
+  std::optional<reference::FlakeSet> flakes;
+  std::unique_ptr<runtime::NdfSource> asset;
+  runtime::LtcTable ltc;
+};
+
+void loadMapInputs(cli::Tool& tool, const RenderOptions& options, bake::render::NdfMode mode,
+                   const bake::render::Scene& scene, RenderSources* sources) {
+  bake::render::NdfInputs& inputs = sources->inputs;
+  const bool need_map =
+      mode == bake::render::NdfMode::kReference ||
+      (inputs.map_width == 0 && (mode == bake::render::NdfMode::kAsset || !scene.material.normal_map.empty()));
+  if (!need_map) return;
+  if (scene.material.normal_map.empty()) {
+    throw cli::Error(cli::kExitBadArguments,
+                     mode == bake::render::NdfMode::kReference
+                         ? "--ndf reference needs material.normal_map (or --normal-map)"
+                         : "--ndf asset needs material.map_size or a normal map for the map size");
+  }
+  bake::IngestReport report;
+  const bake::NormalMap map = cli::loadNormalMapForTool(tool, scene.material.normal_map, options.ingest, &report);
+  if (inputs.map_width == 0) {
+    inputs.map_width = map.width;
+    inputs.map_height = map.height;
+  }
+  if (mode == bake::render::NdfMode::kReference) {
+    sources->flakes = reference::buildFlakes(map, scene.material.rate);
+    inputs.flakes = &*sources->flakes;
+  }
+}
+
+void loadRenderSources(cli::Tool& tool, const RenderOptions& options, bake::render::NdfMode mode,
+                       const bake::render::Scene& scene, RenderSources* sources) {
+  bake::render::NdfInputs& inputs = sources->inputs;
+  inputs.map_width = scene.material.map_width;
+  inputs.map_height = scene.material.map_height;
+  loadMapInputs(tool, options, mode, scene, sources);
+  if (mode == bake::render::NdfMode::kAsset) {
+    if (scene.material.asset.empty()) {
+      throw cli::Error(cli::kExitBadArguments, "--ndf asset needs material.asset (or --asset)");
+    }
+    tool.addInput(scene.material.asset);
+    const runtime::Status st = runtime::openNdfAsset(scene.material.asset.c_str(), &sources->asset);
+    if (st != runtime::Status::kOk) {
+      throw cli::Error(cli::exitCodeOf(st),
+                       "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
+    }
+    inputs.asset = sources->asset.get();
+  }
+  if (mode == bake::render::NdfMode::kSmooth && inputs.map_width == 0) {
+    inputs.map_width = inputs.map_height = 1;  // footprints are not used by the smooth BRDF
+  }
+  if (!options.ltc.empty()) {
+    tool.addInput(options.ltc);
+    const runtime::Status st = sources->ltc.open(options.ltc.c_str());
+    if (st != runtime::Status::kOk) {
+      throw cli::Error(cli::exitCodeOf(st), "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
+    }
+  }
+}
+
+// One image file, written atomically.
+void writeRenderImage(cli::Tool& tool, const std::string& path, int width, int height, const float* rgb, int png_bits) {
+  cli::AtomicOutput out(path);
+  bake::ImageWriteOptions wo;
+  if (png_bits > 0) wo.png_bits = png_bits;
+  wo.temporary_path = out.temporaryPath();
+  wo.rename = false;
+  cli::check(bake::writeImage(path, width, height, 3, rgb, wo));
+  out.commit();
+  tool.addOutput(path);
+}
+
+// The render, then the preview.
+void writeRenderOutputs(cli::Tool& tool, const RenderOptions& options, const bake::render::RenderedImage& image) {
+  writeRenderImage(tool, options.output, image.width, image.height, image.rgb.data(), 0);
+  if (!options.preview.empty()) {
+    bake::render::RgbImage rgb{image.width, image.height, image.rgb};
+    const std::vector<float> display = bake::render::tonemapSrgb(rgb, options.exposure);
+    writeRenderImage(tool, options.preview, image.width, image.height, display.data(), 8);
+  }
+}
+
+void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::render::NdfMode mode,
+                        const bake::render::NdfInputs& inputs, const bake::render::RenderedImage& image,
+                        double load_seconds, double render_seconds) {
+  if (tool.common().json) {
+    cli::Json doc;
+    doc["tool"] = "glintref";
+    doc["command"] = "render";
+    doc["scene"] = cli::baseName(options.scene);
+    doc["ndf"] = bake::render::ndfModeString(mode);
+    doc["env"] = options.env;
+    doc["area"] = options.ltc.empty() ? "sample" : "ltc";
+    doc["spp"] = options.spp;
+    doc["seed"] = options.seed;
+    doc["width"] = image.width;
+    doc["height"] = image.height;
+    doc["threads"] = tool.threadCount();
+    doc["pixels_hit"] = image.stats.pixels_hit;
+    doc["footprint_sigma_texels"] = {{"mean", image.stats.mean_sigma_texels}, {"max", image.stats.max_sigma_texels}};
+    doc["mean_radiance"] = {image.stats.mean_radiance[0], image.stats.mean_radiance[1], image.stats.mean_radiance[2]};
+    doc["map_size"] = {inputs.map_width, inputs.map_height};
+    doc["time_seconds"] = {{"load", load_seconds}, {"render", render_seconds}};
+    doc["output"] = cli::baseName(options.output);
+    if (!options.preview.empty()) doc["preview"] = cli::baseName(options.preview);
+    tool.printJson(doc);
+  } else {
+    tool.info("wrote " + options.output + " (" + std::to_string(image.width) + "x" + std::to_string(image.height) +
+              ", --ndf " + options.ndf + ", " + std::to_string(render_seconds) + " s)");
+  }
 }
 
 }  // namespace
@@ -57,105 +226,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options) {
 
 int runRender(cli::Tool& tool, RenderOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
-  bake::render::NdfMode mode = bake::render::NdfMode::kSmooth;
-  bake::render::ndfModeFromString(options.ndf, &mode);
-  if (options.spp < 1 || options.spp > 65536) {
-    throw cli::Error(cli::kExitBadArguments, "--spp must be in 1..65536, got " + std::to_string(options.spp));
-  }
   int width = 0, height = 0;
-  if (!options.image_size.empty()) {
-    double w = 0.0, h = 0.0;
-    parsePair("--image-size", options.image_size, &w, &h);
-    if (w < 1 || w > 8192 || h < 1 || h > 8192 || w != std::floor(w) || h != std::floor(h)) {
-      throw cli::Error(cli::kExitBadArguments, "--image-size must be two integers W,H in 1..8192");
-    }
-    width = int(w);
-    height = int(h);
-  }
-  if (!options.ltc.empty() && mode != bake::render::NdfMode::kSmooth) {
-    throw cli::Error(cli::kExitBadArguments, "--ltc needs --ndf smooth (the table holds the smooth GGX BRDF)");
-  }
-  if (!(options.exposure > 0.0) || !std::isfinite(options.exposure)) {
-    throw cli::Error(cli::kExitBadArguments, "--exposure must be positive");
-  }
-  if (!bake::isFloatImagePath(options.output) || bake::imageExtension(options.output) != "exr") {
-    throw cli::Error(cli::kExitBadArguments, "-o " + options.output + ": the render must be written as .exr");
-  }
-  if (!options.preview.empty() && bake::imageExtension(options.preview) != "png") {
-    throw cli::Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
-  }
-  for (const std::string& out : {options.output, options.preview}) {
-    if (out.empty()) continue;
-    const std::filesystem::path parent = std::filesystem::path(out).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-      throw cli::Error(cli::kExitIo, "cannot write " + out + ": no such directory");
-    }
-  }
-
-  tool.addInput(options.scene);
-  bake::Result<bake::render::Scene> loaded = bake::render::loadScene(options.scene);
-  if (!loaded) throw cli::Error(int(loaded.error().code), loaded.error().message);
-  bake::render::Scene scene = std::move(loaded.value());
-  if (!options.asset.empty()) scene.material.asset = options.asset;
-  if (!options.normal_map.empty()) scene.material.normal_map = options.normal_map;
-  if (width > 0) {
-    scene.camera.width = width;
-    scene.camera.height = height;
-  }
-
-  // The inputs the mode needs.
-  bake::render::NdfInputs inputs;
-  inputs.map_width = scene.material.map_width;
-  inputs.map_height = scene.material.map_height;
-  std::optional<reference::FlakeSet> flakes;
-  std::unique_ptr<runtime::NdfSource> asset;
-  // The map is read for the reference's flakes, and otherwise only for its size (the uv to texel
-  // mapping of the footprints) when the scene does not state it.
-  const bool need_map =
-      mode == bake::render::NdfMode::kReference ||
-      (inputs.map_width == 0 && (mode == bake::render::NdfMode::kAsset || !scene.material.normal_map.empty()));
-  if (need_map) {
-    if (scene.material.normal_map.empty()) {
-      throw cli::Error(cli::kExitBadArguments,
-                       mode == bake::render::NdfMode::kReference
-                           ? "--ndf reference needs material.normal_map (or --normal-map)"
-                           : "--ndf asset needs material.map_size or a normal map for the map size");
-    }
-    bake::IngestReport report;
-    const bake::NormalMap map = cli::loadNormalMapForTool(tool, scene.material.normal_map, options.ingest, &report);
-    if (inputs.map_width == 0) {
-      inputs.map_width = map.width;
-      inputs.map_height = map.height;
-    }
-    if (mode == bake::render::NdfMode::kReference) {
-      flakes = reference::buildFlakes(map, scene.material.rate);
-      inputs.flakes = &*flakes;
-    }
-  }
-  if (mode == bake::render::NdfMode::kAsset) {
-    if (scene.material.asset.empty()) {
-      throw cli::Error(cli::kExitBadArguments, "--ndf asset needs material.asset (or --asset)");
-    }
-    tool.addInput(scene.material.asset);
-    const runtime::Status st = runtime::openNdfAsset(scene.material.asset.c_str(), &asset);
-    if (st != runtime::Status::kOk) {
-      throw cli::Error(cli::exitCodeOfRuntime(st),
-                       "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
-    }
-    inputs.asset = asset.get();
-  }
-  if (mode == bake::render::NdfMode::kSmooth && inputs.map_width == 0) {
-    inputs.map_width = inputs.map_height = 1;  // footprints are not used by the smooth BRDF
-  }
-  runtime::LtcTable ltc;
-  if (!options.ltc.empty()) {
-    tool.addInput(options.ltc);
-    const runtime::Status st = ltc.open(options.ltc.c_str());
-    if (st != runtime::Status::kOk) {
-      throw cli::Error(cli::exitCodeOfRuntime(st),
-                       "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
-    }
-  }
+  const bake::render::NdfMode mode = checkRenderOptions(options, &width, &height);
+  const bake::render::Scene scene = loadRenderScene(tool, options, width, height);
+  RenderSources sources;
+  loadRenderSources(tool, options, mode, scene, &sources);
   const double load_seconds = secondsSince(t_start);
 
   bake::render::RenderOptions ro;
@@ -163,68 +238,18 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   ro.env_method = options.env == "sample" ? bake::render::EnvMethod::kSample : bake::render::EnvMethod::kPrefilter;
   ro.spp = options.spp;
   ro.seed = options.seed;
-  ro.ltc = options.ltc.empty() ? nullptr : &ltc;
+  ro.ltc = options.ltc.empty() ? nullptr : &sources.ltc;
   const uint64_t pixels = uint64_t(scene.camera.width) * uint64_t(scene.camera.height);
   std::unique_ptr<cli::Progress> progress = tool.progress("render", pixels);
   ro.progress = [&](uint64_t n) { progress->advance(n); };
 
   const auto t_render = std::chrono::steady_clock::now();
-  bake::Result<bake::render::RenderedImage> rendered = bake::render::renderScene(scene, inputs, ro);
+  bake::Result<bake::render::RenderedImage> rendered = bake::render::renderScene(scene, sources.inputs, ro);
   const double render_seconds = secondsSince(t_render);
   progress->finish();
-  if (!rendered) throw cli::Error(int(rendered.error().code), rendered.error().message);
-  const bake::render::RenderedImage& image = rendered.value();
-
-  // The render, then the preview, each atomically.
-  {
-    cli::AtomicOutput out(options.output);
-    bake::ImageWriteOptions wo;
-    wo.temporary_path = out.temporaryPath();
-    wo.rename = false;
-    const bake::Status st = bake::writeImage(options.output, image.width, image.height, 3, image.rgb.data(), wo);
-    if (!st) throw cli::Error(int(st.error().code), st.error().message);
-    out.commit();
-    tool.addOutput(options.output);
-  }
-  if (!options.preview.empty()) {
-    bake::render::RgbImage rgb{image.width, image.height, image.rgb};
-    const std::vector<float> display = bake::render::tonemapSrgb(rgb, options.exposure);
-    cli::AtomicOutput out(options.preview);
-    bake::ImageWriteOptions wo;
-    wo.png_bits = 8;
-    wo.temporary_path = out.temporaryPath();
-    wo.rename = false;
-    const bake::Status st = bake::writeImage(options.preview, image.width, image.height, 3, display.data(), wo);
-    if (!st) throw cli::Error(int(st.error().code), st.error().message);
-    out.commit();
-    tool.addOutput(options.preview);
-  }
-
-  if (tool.common().json) {
-    cli::Json doc;
-    doc["tool"] = "glintref";
-    doc["command"] = "render";
-    doc["scene"] = cli::baseName(options.scene);
-    doc["ndf"] = bake::render::ndfModeString(mode);
-    doc["env"] = options.env;
-    doc["area"] = options.ltc.empty() ? "sample" : "ltc";
-    doc["spp"] = options.spp;
-    doc["seed"] = options.seed;
-    doc["width"] = image.width;
-    doc["height"] = image.height;
-    doc["threads"] = tool.threadCount();
-    doc["pixels_hit"] = image.stats.pixels_hit;
-    doc["footprint_sigma_texels"] = {{"mean", image.stats.mean_sigma_texels}, {"max", image.stats.max_sigma_texels}};
-    doc["mean_radiance"] = {image.stats.mean_radiance[0], image.stats.mean_radiance[1], image.stats.mean_radiance[2]};
-    doc["map_size"] = {inputs.map_width, inputs.map_height};
-    doc["time_seconds"] = {{"load", load_seconds}, {"render", render_seconds}};
-    doc["output"] = cli::baseName(options.output);
-    if (!options.preview.empty()) doc["preview"] = cli::baseName(options.preview);
-    tool.printJson(doc);
-  } else {
-    tool.info("wrote " + options.output + " (" + std::to_string(image.width) + "x" + std::to_string(image.height) +
-              ", --ndf " + options.ndf + ", " + std::to_string(render_seconds) + " s)");
-  }
+  const bake::render::RenderedImage image = cli::unwrap(std::move(rendered));
+  writeRenderOutputs(tool, options, image);
+  printRenderSummary(tool, options, mode, sources.inputs, image, load_seconds, render_seconds);
   return cli::kExitOk;
 }
 

@@ -6,6 +6,7 @@
 #include <glintbake/bake/ltc/table.h>
 #include <glintbake/bake/result.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/tool.h>
 
 #include <string>
@@ -46,14 +47,8 @@ int runEval(cli::Tool& tool, const EvalArgs& args);
 int runMultiscale(cli::Tool& tool, const MultiscaleArgs& args);
 int runRoughness(cli::Tool& tool, const RoughnessArgs& args);
 
-// Throws cli::Error with the error's exit code if the result failed.
-template <typename T>
-T unwrap(bake::Result<T> result) {
-  if (!result.ok()) throw cli::Error(int(result.error().code), result.error().message);
-  return std::move(result).value();
-}
-inline void check(const bake::Status& status) {
-  if (!status.ok()) throw cli::Error(int(status.error().code), status.error().message);
-}
+// Throw cli::Error with the error's exit code if a result failed (cli/exit_codes.h).
+using cli::check;
+using cli::unwrap;
 
 }  // namespace glintbake::ltcfit

@@ -2,6 +2,7 @@
 // brushed, scratches, flakes), deterministic by seed; see libbake mapgen/mapgen.h for the models.
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/tool.h>
 
 #include <cctype>
@@ -119,7 +120,7 @@ int main(int argc, char** argv) {
     write_options.temporary_path = atomic.temporaryPath();
     write_options.rename = false;
     const bake::Status written = bake::writeNormalMap(output, map, write_options);
-    if (!written) throw Error(int(written.error().code), written.error().message);
+    cli::check(written);
     atomic.commit();
     t.addOutput(output);
 

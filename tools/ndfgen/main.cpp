@@ -3,6 +3,7 @@
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
@@ -19,8 +20,6 @@ using glintbake::cli::Json;
 namespace bake = glintbake::bake;
 namespace cli = glintbake::cli;
 namespace format = glintbake::format;
-
-int exitCodeOf(bake::ErrorCode code) { return int(code); }
 
 Json levelJson(const bake::ndf::PyramidLevelReport& l, int region_size) {
   Json j;
@@ -65,9 +64,7 @@ int main(int argc, char** argv) {
     cli::LevelProgress progress(t);
     const bake::Status built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
     progress.finish();
-    if (!built) {
-      throw Error(exitCodeOf(built.error().code), built.error().message);
-    }
+    cli::check(built);
     const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid);
 
     Json params = cli::pyramidOptionsJson(pyramid);

@@ -266,6 +266,17 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     progress.finish();
   }
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
+  // The flakes for exact small footprints (formats/SPEC.md 10.5): written from the map, or carried
+  // over from the source container.
+  if (!in.from_container) {
+    cli::writeFlakes(out.writer(), in.map, o.pyramid);
+  } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
+    std::vector<uint8_t> flakes;
+    format::Status st = in.reader.readSection(size_t(idx), &flakes);
+    if (st == format::Status::kOk) st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
+    if (st != format::Status::kOk)
+      throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
+  }
   return report;
 }
 

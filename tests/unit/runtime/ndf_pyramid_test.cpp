@@ -1,7 +1,7 @@
 // NdfPyramid on hand-made containers: exact centre values, trilinear weights, range averages,
 // sampling (pdf consistency and a chi-square test), the C API, and malformed assets.
 #include <glintbake/format/container.h>
-#include <glintbake/runtime/glintbake_c.h>
+#include <glintbake/runtime/glintbake_ndf_c.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
 #include <gtest/gtest.h>
@@ -298,29 +298,30 @@ TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {
 TEST(NdfPyramidC, CApiMatchesTheClass) {
   const std::string path = glintbake::testing::processTempDir() + "rt_pyramid_c.gbk";
   makePyramid(kLevels, 4, 0, path);
-  gb_ndf_pyramid* p = nullptr;
-  ASSERT_EQ(gb_ndf_pyramid_open(path.c_str(), &p), GB_OK);
-  int32_t res = 0, levels = 0;
-  ASSERT_EQ(gb_ndf_pyramid_info(p, &res, &levels), GB_OK);
+  gb_ndf_asset* p = nullptr;
+  ASSERT_EQ(gb_ndf_asset_open(path.c_str(), &p), GB_OK);
+  int32_t res = 0, kind = 0;
+  ASSERT_EQ(gb_ndf_asset_info(p, &kind, &res), GB_OK);
   EXPECT_EQ(res, kRes);
-  EXPECT_EQ(levels, 3);
+  EXPECT_EQ(kind, GB_KIND_NDF_PYRAMID);
   NdfPyramid cls;
   ASSERT_EQ(cls.open(path.c_str()), Status::kOk);
+  EXPECT_EQ(cls.levelCount(), 3);
   double a = 0.0, b = 0.0, sx = 0.0, sy = 0.0, pdf = 0.0, pdf2 = 0.0;
-  ASSERT_EQ(gb_ndf_pyramid_eval(p, 13.0, 50.0, 3.0, 0.1, -0.2, &a), GB_OK);
+  ASSERT_EQ(gb_ndf_asset_eval(p, 13.0, 50.0, 3.0, 0.1, -0.2, &a), GB_OK);
   ASSERT_EQ(cls.eval(fp(13.0, 50.0, 3.0), SPoint{0.1, -0.2}, &b), Status::kOk);
   EXPECT_EQ(a, b);
-  ASSERT_EQ(gb_ndf_pyramid_sample(p, 13.0, 50.0, 3.0, 0.3, 0.6, &sx, &sy, &pdf), GB_OK);
-  ASSERT_EQ(gb_ndf_pyramid_pdf(p, 13.0, 50.0, 3.0, sx, sy, &pdf2), GB_OK);
+  ASSERT_EQ(gb_ndf_asset_sample(p, 13.0, 50.0, 3.0, 0.3, 0.6, &sx, &sy, &pdf), GB_OK);
+  ASSERT_EQ(gb_ndf_asset_pdf(p, 13.0, 50.0, 3.0, sx, sy, &pdf2), GB_OK);
   EXPECT_EQ(pdf, pdf2);
-  ASSERT_EQ(gb_ndf_pyramid_average(p, 13.0, 50.0, 3.0, -0.5, -0.5, 0.5, 0.5, &a), GB_OK);
+  ASSERT_EQ(gb_ndf_asset_average(p, 13.0, 50.0, 3.0, -0.5, -0.5, 0.5, 0.5, &a), GB_OK);
   EXPECT_GT(a, 0.0);
   std::vector<float> img(kRes * kRes);
-  EXPECT_EQ(gb_ndf_pyramid_image(p, 1.0, 2.0, 3.0, img.data(), img.size() - 1), GB_INVALID_ARGUMENT);
-  EXPECT_EQ(gb_ndf_pyramid_image(p, 1.0, 2.0, 3.0, img.data(), img.size()), GB_OK);
-  gb_ndf_pyramid_close(p);
-  gb_ndf_pyramid* bad = nullptr;
-  EXPECT_EQ(gb_ndf_pyramid_open("/nonexistent/none.gbk", &bad), GB_IO_ERROR);
+  EXPECT_EQ(gb_ndf_asset_image(p, 1.0, 2.0, 3.0, img.data(), img.size() - 1), GB_INVALID_ARGUMENT);
+  EXPECT_EQ(gb_ndf_asset_image(p, 1.0, 2.0, 3.0, img.data(), img.size()), GB_OK);
+  gb_ndf_asset_close(p);
+  gb_ndf_asset* bad = nullptr;
+  EXPECT_EQ(gb_ndf_asset_open("/nonexistent/none.gbk", &bad), GB_IO_ERROR);
   EXPECT_EQ(bad, nullptr);
   EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(Status::kWrongKind));
   std::remove(path.c_str());

@@ -1,5 +1,6 @@
 // The normal-map ingest options shared by every tool that reads a normal map, their canonical JSON
 // form, and the loader that maps library errors to exit codes.
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
 
 #include <map>
@@ -73,7 +74,7 @@ bake::NormalMap loadNormalMapForTool(Tool& tool, const std::string& path, const 
   bake::IngestReport* r = report != nullptr ? report : &local;
   tool.addInput(path);
   bake::Result<bake::NormalMap> loaded = bake::loadNormalMap(path, options, r);
-  if (!loaded) throw Error(int(loaded.error().code), loaded.error().message);
+  if (!loaded) throw Error(exitCodeOf(loaded.error()), loaded.error().message);
 
   const std::string name = baseName(path);
   if (r->nonfinite > 0) {

@@ -1,3 +1,4 @@
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/pyramid_options.h>
 
 #include <glintbake/bake/ndf/flakes_section.h>
@@ -41,9 +42,7 @@ void resolvePyramidOptions(PyramidCliOptions& p) {
       throw Error(kExitBadArguments, "--levels must be auto or a positive integer");
     }
   }
-  if (bake::Status s = bake::ndf::validatePyramidOptions(p.options); !s) {
-    throw Error(int(s.error().code), s.error().message);
-  }
+  check(bake::ndf::validatePyramidOptions(p.options));
 }
 
 Json pyramidOptionsJson(const PyramidCliOptions& p) {

@@ -4,7 +4,7 @@
  * Directions are unit vectors {x, y, z} in the tangent frame (x right, y up, z the macro normal),
  * both pointing away from the surface; wi towards the light, wo towards the viewer. BRDF values are
  * per RGB channel in 1/sr. Every function returns a status code (GB_OK = 0 and the other codes of
- * glintbake_c.h) and writes results through out-parameters. Query functions never allocate and
+ * glintbake_ndf_c.h) and writes results through out-parameters. Query functions never allocate and
  * may be called concurrently; gb_brdf_ndf_open/close must not race with queries on that asset.
  * Opening is safe on untrusted files. */
 #ifndef GLINTBAKE_BRDF_C_H

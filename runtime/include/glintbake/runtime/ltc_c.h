@@ -1,6 +1,6 @@
 /* C API of the runtime-lite LTC area lights (see ltc.h for the conventions).
  *
- * Status codes are those of glintbake_c.h (GB_OK = 0, ...). A table is immutable after opening;
+ * Status codes are those of glintbake_ndf_c.h (GB_OK = 0, ...). A table is immutable after opening;
  * lookups and integrals never allocate and may run concurrently on one handle; open and close must
  * not race with queries on the same handle. Opening is safe on untrusted files. */
 #ifndef GLINTBAKE_LTC_C_H

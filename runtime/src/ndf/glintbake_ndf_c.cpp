@@ -1,7 +1,6 @@
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds.h>
-#include <glintbake/runtime/glintbake_c.h>
-#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/runtime/glintbake_ndf_c.h>
 #include <glintbake/runtime/ndf_source.h>
 
 #include <memory>
@@ -10,15 +9,10 @@
 #include <new>
 
 using glintbake::runtime::Footprint;
-using glintbake::runtime::NdfPyramid;
 using glintbake::runtime::NdfSample;
 using glintbake::runtime::SPoint;
 using glintbake::runtime::SRect;
 using glintbake::runtime::Status;
-
-struct gb_ndf_pyramid {
-  NdfPyramid pyramid;
-};
 
 struct gb_ndf_asset {
   std::unique_ptr<glintbake::runtime::NdfSource> source;
@@ -33,20 +27,6 @@ Footprint footprint(double x, double y, double sigma) {
   f.y = y;
   f.sigma = sigma;
   return f;
-}
-template <typename OpenFn>
-int32_t openWith(gb_ndf_pyramid** out, OpenFn&& fn) {
-  if (!out) return GB_INVALID_ARGUMENT;
-  *out = nullptr;
-  gb_ndf_pyramid* p = new (std::nothrow) gb_ndf_pyramid();
-  if (!p) return GB_OUT_OF_MEMORY;
-  const Status s = fn(p->pyramid);
-  if (s != Status::kOk) {
-    delete p;
-    return code(s);
-  }
-  *out = p;
-  return GB_OK;
 }
 // Wraps an opened NDF source in a handle; the kind code is the source's container kind.
 int32_t wrapAsset(gb_ndf_asset** out, Status opened, std::unique_ptr<glintbake::runtime::NdfSource> source) {
@@ -75,63 +55,6 @@ extern "C" {
 const char* gb_status_string(int32_t status) {
   if (status < 0 || status > GB_OUT_OF_MEMORY) return "unknown status";
   return glintbake::runtime::statusString(Status(status));
-}
-
-int32_t gb_ndf_pyramid_open(const char* path, gb_ndf_pyramid** out) {
-  return openWith(out, [&](NdfPyramid& p) { return p.open(path); });
-}
-
-int32_t gb_ndf_pyramid_open_memory(const void* data, size_t size, gb_ndf_pyramid** out) {
-  return openWith(out, [&](NdfPyramid& p) { return p.openMemory(data, size); });
-}
-
-void gb_ndf_pyramid_close(gb_ndf_pyramid* pyramid) { delete pyramid; }
-
-int32_t gb_ndf_pyramid_info(const gb_ndf_pyramid* p, int32_t* resolution, int32_t* levels) {
-  if (!p) return GB_INVALID_ARGUMENT;
-  if (resolution) *resolution = p->pyramid.resolution();
-  if (levels) *levels = p->pyramid.levelCount();
-  return GB_OK;
-}
-
-int32_t gb_ndf_pyramid_eval(const gb_ndf_pyramid* p, double x, double y, double sigma, double sx, double sy,
-                            double* value) {
-  if (!p) return GB_INVALID_ARGUMENT;
-  return code(p->pyramid.eval(footprint(x, y, sigma), SPoint{sx, sy}, value));
-}
-
-int32_t gb_ndf_pyramid_average(const gb_ndf_pyramid* p, double x, double y, double sigma, double sx0, double sy0,
-                               double sx1, double sy1, double* value) {
-  if (!p) return GB_INVALID_ARGUMENT;
-  SRect r;
-  r.x0 = sx0;
-  r.y0 = sy0;
-  r.x1 = sx1;
-  r.y1 = sy1;
-  return code(p->pyramid.average(footprint(x, y, sigma), r, value));
-}
-
-int32_t gb_ndf_pyramid_sample(const gb_ndf_pyramid* p, double x, double y, double sigma, double u1, double u2,
-                              double* sx, double* sy, double* pdf) {
-  if (!p || !sx || !sy || !pdf) return GB_INVALID_ARGUMENT;
-  NdfSample s;
-  const Status st = p->pyramid.sample(footprint(x, y, sigma), u1, u2, &s);
-  if (st != Status::kOk) return code(st);
-  *sx = s.s.x;
-  *sy = s.s.y;
-  *pdf = s.pdf;
-  return GB_OK;
-}
-
-int32_t gb_ndf_pyramid_pdf(const gb_ndf_pyramid* p, double x, double y, double sigma, double sx, double sy,
-                           double* pdf) {
-  if (!p) return GB_INVALID_ARGUMENT;
-  return code(p->pyramid.pdf(footprint(x, y, sigma), SPoint{sx, sy}, pdf));
-}
-
-int32_t gb_ndf_pyramid_image(const gb_ndf_pyramid* p, double x, double y, double sigma, float* out, size_t count) {
-  if (!p) return GB_INVALID_ARGUMENT;
-  return code(p->pyramid.image(footprint(x, y, sigma), out, count));
 }
 
 int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {

@@ -1,0 +1,67 @@
+/* C API of the glintbake runtime-lite's NDF assets (ndf-pyramid, tensor-ndf, behind one handle),
+ * for engines that do not link C++ directly. The BRDF and LTC C APIs are glintbake_brdf_c.h and
+ * ltc_c.h; they share the status codes below.
+ *
+ * Every function returns a status code (GB_OK = 0; the values equal glintbake::runtime::Status)
+ * and writes results through out-parameters. Positions and sigma are in texels of the source normal
+ * map (texel centres at +0.5, y downwards); s-plane points are (s_x, s_y) of the projected
+ * hemisphere, values are densities per unit s-plane area. Query functions never allocate and may be
+ * called concurrently on one handle; open and close must not race with queries on the same handle.
+ * Opening is safe on untrusted files. */
+#ifndef GLINTBAKE_NDF_C_H
+#define GLINTBAKE_NDF_C_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum {
+  GB_OK = 0,
+  GB_IO_ERROR = 1,
+  GB_INVALID_ASSET = 2,
+  GB_WRONG_KIND = 3,
+  GB_UNSUPPORTED_VERSION = 4,
+  GB_INVALID_ARGUMENT = 5,
+  GB_OUT_OF_MEMORY = 6
+};
+
+/* Stable text of a status code; never NULL. */
+const char* gb_status_string(int32_t status);
+
+/* Any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf), behind one handle. The queries
+ * follow ndf_source.h: trilinearly blended P-NDF values >= 0, averages over s-rectangles, importance
+ * samples whose pdf equals gb_ndf_asset_pdf at the sampled point bit for bit. */
+typedef struct gb_ndf_asset gb_ndf_asset;
+
+/* Container asset kinds of NDF assets (formats/SPEC.md section 4; the values of the kind registry,
+ * glintbake/format/kinds.h). */
+enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2 };
+
+/* GB_WRONG_KIND for containers of other asset kinds. */
+int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out);
+int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out);
+void gb_ndf_asset_close(gb_ndf_asset* asset); /* NULL is allowed */
+
+/* Asset kind (GB_KIND_*) and NDF resolution R (bins per side); either pointer may be NULL. */
+int32_t gb_ndf_asset_info(const gb_ndf_asset* asset, int32_t* kind, int32_t* resolution);
+
+int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
+                          double* value);
+int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0, double sy0,
+                             double sx1, double sy1, double* value);
+int32_t gb_ndf_asset_sample(const gb_ndf_asset* asset, double x, double y, double sigma, double u1, double u2,
+                            double* sx, double* sy, double* pdf);
+int32_t gb_ndf_asset_pdf(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
+                         double* pdf);
+/* Integral of the footprint's NDF over the s-plane (what sampling normalises by). */
+int32_t gb_ndf_asset_mass(const gb_ndf_asset* asset, double x, double y, double sigma, double* mass);
+int32_t gb_ndf_asset_image(const gb_ndf_asset* asset, double x, double y, double sigma, float* out, size_t count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GLINTBAKE_NDF_C_H */
