@@ -116,49 +116,72 @@ Footprint fp(double x, double y, double sigma) {
 }
 
 TEST_F(NdfPyramidTest, CentreQueriesReturnTheStoredImagesExactly) {
+  // At level 0's sigma the blend is bilinear over level 0: its centres return the stored images.
   ASSERT_EQ(pyr_.levelCount(), 3);
   ASSERT_EQ(pyr_.resolution(), kRes);
   std::vector<float> out(kRes * kRes);
-  for (int l = 0; l < 3; ++l) {
-    const NdfLevelRecord* rec = pyr_.level(l);
-    for (int j = 0; j < kLevels[l].grid; ++j) {
-      for (int i = 0; i < kLevels[l].grid; ++i) {
-        const double x = rec->origin_x + i * rec->stride_x, y = rec->origin_y + j * rec->stride_y;
-        ASSERT_EQ(pyr_.image(fp(x, y, kLevels[l].sigma), out.data(), out.size()), Status::kOk);
-        EXPECT_EQ(out, testImage(l, i, j)) << "level " << l << " centre " << i << "," << j;
-        // Point queries at bin centres too.
-        double v = 0.0;
-        ASSERT_EQ(pyr_.eval(fp(x, y, kLevels[l].sigma), SPoint{-1 + 9.5 * 2.0 / kRes, 1 - 6.5 * 2.0 / kRes}, &v),
-                  Status::kOk);
-        EXPECT_EQ(float(v), testImage(l, i, j)[6 * kRes + 9]);
-      }
+  const NdfLevelRecord* rec = pyr_.level(0);
+  for (int j = 0; j < kLevels[0].grid; ++j) {
+    for (int i = 0; i < kLevels[0].grid; ++i) {
+      const double x = rec->origin_x + i * rec->stride_x, y = rec->origin_y + j * rec->stride_y;
+      ASSERT_EQ(pyr_.image(fp(x, y, kLevels[0].sigma), out.data(), out.size()), Status::kOk);
+      EXPECT_EQ(out, testImage(0, i, j)) << "centre " << i << "," << j;
+      // Point queries at bin centres too.
+      double v = 0.0;
+      ASSERT_EQ(pyr_.eval(fp(x, y, kLevels[0].sigma), SPoint{-1 + 9.5 * 2.0 / kRes, 1 - 6.5 * 2.0 / kRes}, &v),
+                Status::kOk);
+      EXPECT_EQ(float(v), testImage(0, i, j)[6 * kRes + 9]);
     }
   }
 }
 
-TEST_F(NdfPyramidTest, TrilinearBlendOfTheBracketingLevels) {
-  // sigma 2.828 = 2^1.5: halfway (in log2) between levels 0 and 1. Position between centres.
-  const double x = 4.0 + 8.0 * 2 + 2.0, y = 4.0 + 8.0 * 5 + 6.0;  // level 0: i = 2 + 0.25, j = 5 + 0.75
-  const double sigma = std::sqrt(8.0);
+// The weight of centre i for a footprint at continuous centre index g: the Gaussian of std tau
+// (strides) integrated against the centre's tent, here by brute-force quadrature (independent of
+// the closed form in the blend), normalised over the centres.
+std::vector<double> tentGaussianWeights(double g, double tau, int n) {
+  std::vector<double> w(size_t(n), 0.0);
+  const int steps = 40000;
+  const double lo = g - 10 * tau - 2, hi = g + 10 * tau + 2, h = (hi - lo) / steps;
+  for (int k = 0; k < steps; ++k) {
+    const double c = lo + (k + 0.5) * h;
+    const double gauss = std::exp(-0.5 * (c - g) * (c - g) / (tau * tau));
+    const int i0 = int(std::floor(c));
+    const double f = c - i0;
+    w[size_t(((i0 % n) + n) % n)] += gauss * (1 - f);
+    w[size_t((((i0 + 1) % n) + n) % n)] += gauss * f;
+  }
+  double total = 0.0;
+  for (double v : w) total += v;
+  for (double& v : w) v /= total;
+  return w;
+}
+
+TEST_F(NdfPyramidTest, GaussianBlendOfTheFinestSufficientLevel) {
+  // sigma 6 over level 0 (sigma 2, stride 8): tau'^2 = 36 - 4 - 64 / 6, spread 0.58 strides, so
+  // level 0 answers alone with the tent-integrated Gaussian weights of its centres.
+  const double x = 4.0 + 8.0 * 2 + 2.0, y = 4.0 + 8.0 * 5 + 6.0;  // level 0: i = 2.25, j = 5.75
+  const double sigma = 6.0, tau = std::sqrt(36.0 - 4.0 - 64.0 / 6.0) / 8.0;
   const SPoint s{-1 + 7.5 * 2.0 / kRes, 1 - 8.5 * 2.0 / kRes};
   const int bin = 8 * kRes + 7;
   auto at = [&](int l, int i, int j) { return double(testImage(l, i, j)[bin]); };
-  const double l0 =
-      0.75 * 0.25 * at(0, 2, 5) + 0.25 * 0.25 * at(0, 3, 5) + 0.75 * 0.75 * at(0, 2, 6) + 0.25 * 0.75 * at(0, 3, 6);
-  // level 1: stride 16, origin 8: gx = (22 - 8) / 16 = 0.875, gy = (50 - 8) / 16 = 2.625
-  const double l1 = 0.125 * 0.375 * at(1, 0, 2) + 0.875 * 0.375 * at(1, 1, 2) + 0.125 * 0.625 * at(1, 0, 3) +
-                    0.875 * 0.625 * at(1, 1, 3);
+  const std::vector<double> wx = tentGaussianWeights(2.25, tau, 8), wy = tentGaussianWeights(5.75, tau, 8);
+  double expected = 0.0;
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) expected += wx[size_t(i)] * wy[size_t(j)] * double(testImage(0, i, j)[bin]);
   double v = 0.0;
   ASSERT_EQ(pyr_.eval(fp(x, y, sigma), s, &v), Status::kOk);
-  EXPECT_NEAR(v, 0.5 * l0 + 0.5 * l1, 1e-9 * std::fabs(v));
-  // Below level 0 and above the top clamp.
-  double below = 0.0, at0 = 0.0, above = 0.0, top = 0.0;
+  EXPECT_NEAR(v, expected, 2e-3 * expected);
+  // Below level 0 it is level 0; far above the top level of this repeating map it is the mean of
+  // the top level's centres.
+  double below = 0.0, at0 = 0.0, above = 0.0;
   ASSERT_EQ(pyr_.eval(fp(x, y, 0.1), s, &below), Status::kOk);
   ASSERT_EQ(pyr_.eval(fp(x, y, 2.0), s, &at0), Status::kOk);
   ASSERT_EQ(pyr_.eval(fp(x, y, 1000.0), s, &above), Status::kOk);
-  ASSERT_EQ(pyr_.eval(fp(x, y, 8.0), s, &top), Status::kOk);
   EXPECT_EQ(below, at0);
-  EXPECT_EQ(above, top);
+  double mean = 0.0;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) mean += 0.25 * double(testImage(2, i, j)[bin]);
+  EXPECT_NEAR(above, mean, 1e-6 * mean);
   // Repeat wrap: a query one map period away is identical; the grid wraps between the last and
   // first centres.
   double shifted = 0.0;
@@ -167,6 +190,25 @@ TEST_F(NdfPyramidTest, TrilinearBlendOfTheBracketingLevels) {
   double seam = 0.0;
   ASSERT_EQ(pyr_.eval(fp(kMap, 4.0, 2.0), s, &seam), Status::kOk);  // midway between centres 7 and 0
   EXPECT_NEAR(seam, 0.5 * (at(0, 7, 0) + at(0, 0, 0)), 1e-6 * seam);
+}
+
+TEST_F(NdfPyramidTest, BlendIsContinuousInSigma) {
+  // Across the switch from one level to the next the weights change smoothly: the largest change
+  // between neighbouring sigmas of a sweep halves with the step (a jump would not).
+  const SPoint s{-1 + 7.5 * 2.0 / kRes, 1 - 8.5 * 2.0 / kRes};
+  auto worstStep = [&](double ratio) {
+    double prev = -1.0, worst = 0.0;
+    for (double sigma = 2.0; sigma < 40.0; sigma *= ratio) {
+      double v = 0.0;
+      EXPECT_EQ(pyr_.eval(fp(21.0, 43.0, sigma), s, &v), Status::kOk);
+      if (prev > 0.0) worst = std::max(worst, std::fabs(v - prev) / prev);
+      prev = v;
+    }
+    return worst;
+  };
+  const double coarse = worstStep(1.002), fine = worstStep(1.001);
+  EXPECT_LT(coarse, 2e-2);
+  EXPECT_LT(fine, 0.6 * coarse);
 }
 
 TEST_F(NdfPyramidTest, RepeatBlendOfFarAndSeamPositionsMatchesTheReducedPosition) {

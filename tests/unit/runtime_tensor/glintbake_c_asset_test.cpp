@@ -49,7 +49,8 @@ TEST(GlintbakeCAsset, TensorAndPyramidThroughOneHandle) {
     ASSERT_EQ(sources[k]->average(fp, r, &b), Status::kOk);
     EXPECT_EQ(a, b);
     ASSERT_EQ(gb_ndf_asset_mass(handles[k], fp.x, fp.y, fp.sigma, &a), GB_OK);
-    EXPECT_NEAR(a, 1.0, 2e-2);
+    // The weighted mean of the blended centres' masses (rank-16 models of a 64^2 map: 1 to 3%).
+    EXPECT_NEAR(a, 1.0, 3e-2);
     double sx = 0.0, sy = 0.0, p = 0.0, q = -1.0;
     ASSERT_EQ(gb_ndf_asset_sample(handles[k], fp.x, fp.y, fp.sigma, 0.4, 0.6, &sx, &sy, &p), GB_OK);
     ASSERT_EQ(gb_ndf_asset_pdf(handles[k], fp.x, fp.y, fp.sigma, sx, sy, &q), GB_OK);

@@ -47,10 +47,13 @@ TEST(TensorNdf, DescribesTheAsset) {
   EXPECT_EQ(t.indexEntry(0, 0, 0, 4), nullptr);
 }
 
+// At level 0's sigma the footprint blend is bilinear over level 0, so at its centres it returns
+// the stored model (above level 0 the blend is a Gaussian mean of several centres, checked against
+// NdfPyramid below).
 TEST(TensorNdf, EvalAtCentresEqualsTheFactors) {
   for (const TensorNdf* t : {&assets().nonneg, &assets().plain}) {
     const int res = t->resolution();
-    for (int l = 0; l < t->levelCount(); ++l) {
+    for (int l = 0; l < 1; ++l) {
       const NdfLevelRecord& r = *t->level(l);
       for (uint32_t cj = 0; cj < r.grid_height; ++cj) {
         for (uint32_t ci = 0; ci < r.grid_width; ++ci) {
