@@ -123,7 +123,7 @@ class GlintQuery(ToolTestCase):
         img = self.run_json("glintquery", "image", tensor, "--at", "16,16", "--sigma", "8", "-o", self.path("t.exr"),
                             schema="glintquery-image.schema.json")
         self.assertEqual(img["resolution"], 32)
-        self.assertAlmostEqual(img["mass"], 1.0, delta=2e-2)
+        self.assertAlmostEqual(img["mass"], 1.0, delta=3e-2)  # a 32^2 image of a rank-16 model of a 32^2 map
         fp = {"x": 3.0, "y": 4.0, "sigma": 6.0}
         queries = [dict(fp, op="sample", u=[k / 7.0, (k * 3 % 7) / 7.0]) for k in range(7)]
         queries += [dict(fp, op="range", s0=[-1, -1], s1=[1, 1]), dict(fp, op="mass")]

@@ -52,7 +52,7 @@ std::string defaultOutput(const std::string& input, bool container) {
 int exitCodeOf(const bake::Error& e) { return int(e.code); }
 
 // Relative error above which tensorpack warns when no --error-target is given (README, "tensorpack
-// defaults"). At rank 16 the real maps of ../shared/data that CP compresses well land at 0.15-0.25
+// defaults"). At rank 16 the real maps that CP compresses well land at 0.15-0.25
 // (brushed_blender_1024 0.164, scratches_straight_cutlery_512 0.151), while a sharp-flake map lands
 // at 0.93 (flakes_voronoi_sharp_snail_512; the example flakes asset 0.88): an asset that far off has
 // lost most of its glints. 0.5 separates the two with room on both sides.

@@ -66,13 +66,14 @@ TEST(KindRegistry, RangesAreDisjointAndOwned) {
     EXPECT_EQ(r->last, k.last_type);
   }
   for (const SectionTypeInfo& t : kSectionTypeRegistry) EXPECT_NE(findSectionRange(t.type), nullptr) << t.name;
-  // The new kinds and the flakes family have blocks of their own, with no type defined yet.
+  // The new kinds and the flakes family have blocks of their own (the flakes family defines 80).
   for (const char* owner : {"flakes", "wang-tiles", "tiny-example", "glitter"}) {
     bool found = false;
     for (const SectionRange& r : kSectionRanges) found = found || std::string(r.owner) == owner;
     EXPECT_TRUE(found) << owner;
   }
-  EXPECT_FALSE(isRegisteredSectionType(80));  // flakes: reserved, not defined
+  EXPECT_TRUE(isRegisteredSectionType(kSectionFlakes));
+  EXPECT_FALSE(isRegisteredSectionType(81));  // flakes: reserved, not defined
   EXPECT_TRUE(isRegisteredSectionType(40));   // tensor-ndf's open block
   EXPECT_TRUE(isRegisteredSectionType(kSectionFirstPrivate + 5));
 }

@@ -7,8 +7,8 @@
 // plus per-block 1D summed-area tables of the columns of A and B, so that the sum over any
 // rectangle of bins is a rank-R product of two prefix-sum differences: O(R) whatever its size.
 //
-// The asset-level runtime blends up to kCpMaxBlend weighted blocks (trilinear interpolation over
-// footprint centres and pyramid levels); every query here acts on such a blend, CpMix. Blocks of
+// The asset-level runtime blends up to kCpMaxBlend weighted blocks (the footprint blend over
+// centres and pyramid levels, formats/SPEC.md 10.1); every query here acts on such a blend, CpMix. Blocks of
 // the same group share A and B, so their C rows are summed first (weights applied): a blend of
 // 8 blocks from 2 groups costs 2 rank-R products per query.
 //

@@ -32,7 +32,7 @@ enum {
 const char* gb_status_string(int32_t status);
 
 /* Any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf), behind one handle. The queries
- * follow ndf_source.h: trilinearly blended P-NDF values >= 0, averages over s-rectangles, importance
+ * follow ndf_source.h: blended P-NDF values >= 0, averages over s-rectangles, importance
  * samples whose pdf equals gb_ndf_asset_pdf at the sampled point bit for bit. */
 typedef struct gb_ndf_asset gb_ndf_asset;
 

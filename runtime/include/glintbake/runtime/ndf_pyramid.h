@@ -1,6 +1,6 @@
 // Runtime-lite reader of ndf-pyramid assets (written by ndfgen): NDF images of Gaussian footprints
-// on a multi-level grid of footprint centres (Deng et al. 2022, section 3), queried with trilinear
-// interpolation.
+// on a multi-level grid of footprint centres (Deng et al. 2022, section 3), queried with the
+// Gaussian footprint blend of formats/SPEC.md 10.1 (glintbake/format/kinds/ndf_pyramid_blend.h).
 //
 // Asset layout (formats/SPEC.md, "ndf-pyramid"):
 //  - one kSectionNdfLevel section per level l (key = l) holding an NdfLevelRecord
@@ -16,12 +16,12 @@
 //  - footprint std of level l: sigma_texels = sigma0 * 2^l.
 //
 // Queries (Footprint in texels, SPoint in the s-plane):
-//  - level coordinate t = log2(sigma / sigma_0); sigma <= sigma_0 uses level 0 only, t >= top uses
-//    the top level only, otherwise the two bracketing levels are blended linearly in t;
-//  - on each level the four nearest centres are blended bilinearly; repeat maps wrap around the
-//    grid, clamp maps clamp to the edge centres;
-//  - every stored image is piecewise constant per bin, so the blend of up to 8 images is too:
-//    eval(), average(), sample() and pdf() are exactly consistent.
+//  - sigma <= sigma_0: the four nearest level-0 centres bilinearly; above, the Gaussian-weighted
+//    mean of the centres of the finest level whose spread allows it (at most
+//    format::kMaxBlendCentres images, of one or two levels); repeat maps wrap around the grid,
+//    clamp maps clamp to the edge centres;
+//  - every stored image is piecewise constant per bin, so the blend is too: eval(), average(),
+//    sample() and pdf() are exactly consistent.
 //
 // Memory: all images are decompressed into memory by open() (R * R * 4 bytes per centre, plus
 // (R + 1) * 8 bytes of row sums for sampling); e.g. a 1024^2 map at stride 16, R = 128 holds about

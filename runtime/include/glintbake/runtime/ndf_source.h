@@ -12,7 +12,8 @@
 //  - sample() returns a point together with the density with which it was drawn, and pdf() at that
 //    point returns the same number (bit for bit);
 //  - queries are const, thread-safe, never allocate and never throw; an invalid argument (non-finite
-//    or non-positive sigma, non-finite s) returns kInvalidArgument and leaves outputs untouched.
+//    or negative sigma, non-finite s) returns kInvalidArgument and leaves outputs untouched. A sigma
+//    of 0 is a point footprint: exact on assets with flakes (formats/SPEC.md 10.5), level 0 otherwise.
 #pragma once
 
 #include <glintbake/format/container.h>

@@ -4,12 +4,11 @@
 // Using Tensor Decomposition", ACM TOG, sec. 4). Layout:
 // formats/SPEC.md section 10.4 and tensor_ndf_layout.h.
 //
-// Geometry and blending are exactly those of NdfPyramid (ndf_pyramid.h): level coordinate
-// t = log2(sigma / sigma_0) between the two bracketing levels, bilinear over the four nearest
-// centres of each level (repeat maps wrap the centre grid, clamp maps clamp to the edge centres).
-// A point, a bin or a block of the s-plane has the same block index in all 8 blended images, so
-// every query blends at most 8 (group, row, weight) terms of one block (CpMix, cp_block.h); blank
-// blocks contribute 0.
+// Geometry and blending are exactly those of NdfPyramid (ndf_pyramid.h): the footprint blend of
+// formats/SPEC.md 10.1 (bilinear at and below sigma_0, a Gaussian-weighted mean of one or two
+// levels' centres above). A point, a bin or a block of the s-plane has the same block index in all
+// blended images, so every query blends the (group, row, weight) terms of one block (CpMix,
+// cp_block.h), summed per group first; blank blocks contribute 0.
 //
 // Queries (Footprint in texels, SPoint/SRect in the s-plane, values per unit s-plane area):
 //  - eval: max(0, blended model value) of the bin containing s; 0 outside [-1, 1]^2. Bins whose

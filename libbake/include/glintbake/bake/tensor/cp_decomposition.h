@@ -1,6 +1,7 @@
-// CP (CANDECOMP/PARAFAC) compression of groups of angular NDF blocks (Deng et al. 2022, "Constant-
-// Cost Spatially-Varying Glints", sec. 4; algorithms after Kolda & Bader 2009, "Tensor
-// Decompositions and Applications", sec. 3.4).
+// CP (CANDECOMP/PARAFAC) compression of groups of angular NDF blocks (Deng et al. 2022,
+// "Constant-Cost Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition",
+// ACM TOG, sec. 4; algorithms after Kolda & Bader 2009, "Tensor Decompositions and Applications",
+// sec. 3.4).
 //
 // A group tensor T is B x B x K: K angular blocks of B x B bins each (bin column i, row j, block k).
 // A rank-R CP model approximates it by
@@ -14,15 +15,12 @@
 //     the result is expanded and refined by at most `refine_sweeps` full extrapolated sweeps.
 //     The core ALS runs from the HOSVD and from core_starts - 1 seeded random points and keeps the
 //     best (core sweeps cost L/K of a full sweep; local minima are real).
-//     Measured on NDF-like 32 x 32 x 1024 groups at rank 16 (the survey test in tests/unit/tensor):
-//     with one start, 35-55x faster than 500 plain sweeps but up to +0.9% error (the HOSVD-started
-//     full ALS lands in the same minima); with 3 starts, 19-26x faster and -1.2..+0.02% error.
-//     L = 32 is about 1.5x faster but its small core misses the better minima; L = 96 gains
-//     nothing. Defaults: L = max(64, 2 R), 3 starts, up to 10 refinement sweeps.
+//     Defaults: L = max(64, 2 R), 3 starts, up to 10 refinement sweeps (chosen by the survey in
+//     bench/cp-survey.md).
 //   kAls ("als"): deterministic HOSVD start and full-tensor sweeps with extrapolation.
 //   kAlsPlain ("als-plain"): the published method: seeded uniform random start, plain ALS sweeps,
 //     stop when the fit changes by less than `tol` or after `max_iters` sweeps.
-// Every sweep uses the dimension tree of algorithms.md sec. 2: W = C^T X once, A and B from W,
+// Every sweep uses a dimension tree: W = C^T X once, A and B from W,
 // C from X (B kr A): the tensor is read twice per sweep. The R x R normal equations are solved by
 // Cholesky with a ridge of `ridge` * trace / R; Gram matrices and the error are accumulated in
 // double (error^2 = |X|^2 - 2 <M_C, C> + 1^T (A^T A .* B^T B .* C^T C) 1).
@@ -36,18 +34,9 @@
 // uniform random for kAlsPlain). kCompressed runs its HALS sweeps against the mode-3 compressed
 // tensor X~ = core x_3 Q (contractions through the B x B x L core and Q, the constraint on the
 // full K x R matrix C), then up to refine_sweeps full HALS sweeps against X. Its defaults differ
-// from the signed path's, each chosen by measurement (a survey of 12 real groups cut as
-// bench_tensorpack cuts them: 4 mapgen kinds x 3 seeds, 32 x 32 x K, K = 1024-3836, rank 16,
-// against 500 plain HALS sweeps):
-//   - sparse sign sketch + one power iteration: as accurate as the Gaussian sketch + one power
-//     iteration and one GEMM cheaper; without the power iteration either sketch lands up to +5.5%;
-//   - L = max(24, 3 R / 2): the core sweeps cost O(K L R); L = 32 gained nothing over 24;
-//   - core sweeps stop at a fit change of 1e-4 (3e-4 cost up to +3.3% on two groups);
-//   - 2 refinement sweeps (a third gained at most 0.12%; the tol is never reached before).
-// With these the error stays within -2.6..+0.5% of 500 plain sweeps on all 12 groups, in a median
-// 0.11 (0.055-0.17; 0.38 on one group whose plain run stopped after 18 sweeps) of the time of the
-// published non-negative baseline (random start, plain HALS, its stopping rule) and at most 0.13 of
-// the signed als-plain's. Every reconstructed value and every range sum is >= 0.
+// from the signed path's (sparse sign sketch with one power iteration, L = max(24, 3 R / 2), core
+// sweeps to a fit change of 1e-4, 2 refinement sweeps), each chosen by measurement
+// (bench/cp-survey.md). Every reconstructed value and every range sum is >= 0.
 //
 // Rank-deficient groups: when R exceeds the rank of an unfolding (e.g. a map whose normals vary
 // along one axis only: its NDF images are thin lines, so one mode of the group spans a few bins),

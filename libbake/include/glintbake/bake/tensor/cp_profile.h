@@ -1,6 +1,5 @@
 // Kernel timing of the CP sweep, for benchmarks: how close a full ALS sweep comes to the cost of
-// its two large contractions (W = C^T X and X (B kr A)), the GEMM-bound floor of algorithms.md
-// sec. 2.
+// its two large contractions (W = C^T X and X (B kr A)), the GEMM-bound floor of a sweep.
 #pragma once
 
 #include <glintbake/bake/tensor/cp_decomposition.h>
