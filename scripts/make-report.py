@@ -329,6 +329,8 @@ def main():
         info["pyramid"]["levels"] = levels
         info["pyramid"]["top_sigma"] = FLAKES_UP_TO * 2 ** (levels - 1)
         info["pyramid"]["flakes"] = any(sec["type_name"] == "flakes" for sec in layout["sections"])
+        layout, _ = runner.run([tool("glintinfo"), "info", tensor, "--json"], inputs=[tensor], capture_json=True)
+        info["tensor16"]["flakes"] = any(sec["type_name"] == "flakes" for sec in layout["sections"])
         # The whole map's NDF (what one smooth lobe gives): one footprint of half the map's side,
         # splatted from every flake (periodic: its weights vary by under 1% over the map).
         side = CROP if kind == "real" else int(source[source.index("--size") + 1])
@@ -633,8 +635,9 @@ Images are shown on one linear scale per footprint: the reference's maximum is w
         p = entry["pyramid"]
         parts.append(f"<h2 id='map-{e(entry['map'])}'>{e(entry['map'])}</h2>\n<p>{e(entry['kind'])}: "
                      f"{e(entry['source'])}; assets baked by {e(entry['baked_by'])}; pyramid levels "
-                     f"{p['levels']} (top level sigma {fmt(p['top_sigma'])} texels), flakes section: "
-                     f"{'yes' if p['flakes'] else 'no'}.</p>\n")
+                     f"{p['levels']} (top level sigma {fmt(p['top_sigma'])} texels); flakes section in the pyramid: "
+                     f"{'yes' if p['flakes'] else 'no'}, in the tensor asset: "
+                     f"{'yes' if t.get('flakes') else 'no (small footprints come from its level 0)'}.</p>\n")
         parts.append("<table>\n<tr><th class='l'>asset</th><th>bake time (s)</th><th>size (bytes)</th>"
                      "<th>ratio to raw float32 NDF images</th><th>CP relative error</th></tr>\n")
         raw = t.get("raw_bytes")
