@@ -1,5 +1,6 @@
 """The HTML report (scripts/make-report.py) on a small example map, checked in a real headless
-browser: the page loads and every <img> decodes (the page's script records the counts on <body>)."""
+browser: the page loads and every <img> decodes (the page's script records the counts on <body>),
+including the NDF images side by side and the SVG plots of NDF error against the footprint."""
 
 import json
 import os
@@ -28,24 +29,51 @@ class ReportTest(clitest.ToolTestCase):
         self.run_ok("mapgen", "flakes", "-o", os.path.join(maps, "flakes.exr"), "--size", "64", "--seed", "12",
                     "--cone", "12", "--cell", "8", "--quiet")
         out = self.path("report")
+        # Real maps of ../shared are left out: the suite must not depend on that folder.
         proc = subprocess.run(["/usr/bin/python3", SCRIPT, "--bin", clitest.BIN_DIR, "--maps", maps, "--out", out,
-                               "--only", "flakes", "--image-size", "32,32"], capture_output=True, text=True,
-                              timeout=600)
+                               "--only", "flakes", "--image-size", "32,32", "--no-real",
+                               "--ndf-sigmas", "0.5,2,16", "--show-sigmas", "2,16"],
+                              capture_output=True, text=True, timeout=600)
         self.assertEqual(proc.returncode, 0, proc.stderr)
         index = os.path.join(out, "index.html")
         with open(index) as f:
             page = f.read()
-        sources = re.findall(r"<img src='([^']+)'", page)
-        # 3 distances x (4 renders + 3 heat maps).
-        self.assertEqual(len(sources), 21)
+        sources = re.findall(r"<img(?: class='[^']*')? src='([^']+)'", page)
+        # 6 views x (4 renders + 3 heat maps) + 2 footprints x 4 NDF images + the map's plot and the
+        # median plot.
+        self.assertEqual(len(sources), 6 * 7 + 2 * 4 + 2)
         for src in sources:
             self.assertTrue(os.path.exists(os.path.join(out, src)), src)
+        self.assertIn("No real maps in this report", page)
         with open(os.path.join(out, "report.json")) as f:
             report = json.load(f)
-        far = report["assets"][0]["renders"]["far"]
-        for mode in ("pyramid", "tensor16", "smooth"):
-            self.assertGreater(far[mode]["speedup"], 0.0)
-            self.assertGreaterEqual(far[mode]["relative_mse"], 0.0)
+        self.assertEqual(report["views"], ["s0.5", "s2", "s5", "s9.5", "s24", "s64"])
+        asset = report["assets"][0]
+        sigmas = [asset["renders"][v]["reference"]["sigma_mean"] for v in report["views"]]
+        # The views span a factor of about 128 in footprint (0.5 to 64 texels at the scenes' 256 x 256
+        # pixels; 8 times wider footprints at 32 x 32).
+        self.assertEqual(sigmas, sorted(sigmas))
+        self.assertGreater(sigmas[-1] / sigmas[0], 100.0)
+        self.assertLess(sigmas[0], 2.0)
+        for view in report["views"]:
+            for mode in ("pyramid", "tensor16", "smooth"):
+                r = asset["renders"][view][mode]
+                self.assertGreater(r["speedup"], 0.0)
+                self.assertGreaterEqual(r["relative_mse"], 0.0)
+        # On the flakes path the asset answers from the normal map exactly: its render is the reference's.
+        self.assertLess(asset["renders"]["s0.5"]["pyramid"]["relative_mse"], 1e-6)
+        self.assertEqual([r["sigma"] for r in asset["ndf"]], [0.5, 2.0, 16.0])
+        for r in asset["ndf"]:
+            for key in ("pyramid", "tensor16", "whole_map"):
+                self.assertGreaterEqual(r[key], 0.0)
+        self.assertLess(asset["ndf"][0]["pyramid"], 1e-3)
+        # The whole-map NDF is a poor answer for a small footprint of a glinty map.
+        self.assertGreater(asset["ndf"][0]["whole_map"], 0.5)
+        for plot in (asset["ndf_plot"], report["ndf_median_plot"]):
+            with open(os.path.join(out, plot)) as f:
+                svg = f.read()
+            self.assertTrue(svg.startswith("<svg"), plot)
+            self.assertEqual(svg.count("<path "), 3, plot)
 
         browser = find_browser()
         self.assertIsNotNone(browser, "chromium is required (scripts/install-deps.sh --browser)")
