@@ -137,8 +137,8 @@ void referenceBench(benchmark::State& state, size_t subject, double sigma) {
   const std::vector<Query> q = queries(s, sigma);
   size_t i = 0;
   for (auto _ : state) {
-    const double v = glintbake::reference::evalPndf(s.set, {q[i].fp.x, q[i].fp.y, std::max(sigma, 1e-6)}, q[i].s.x,
-                                                    q[i].s.y, 0.005);
+    const double v =
+        glintbake::reference::evalPndf(s.set, {q[i].fp.x, q[i].fp.y, std::max(sigma, 1e-6)}, q[i].s.x, q[i].s.y, 0.005);
     benchmark::DoNotOptimize(v);
     i = (i + 1) & 1023;
   }

@@ -1,8 +1,8 @@
 // validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
 // its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
 #include <glintbake/format/kinds.h>
-#include <glintbake/format/validate.h>
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/validate.h>
 
 #include "byte_source.h"
 #include "container_parse.h"

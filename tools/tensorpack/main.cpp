@@ -273,7 +273,8 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
     std::vector<uint8_t> flakes;
     format::Status st = in.reader.readSection(size_t(idx), &flakes);
-    if (st == format::Status::kOk) st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
+    if (st == format::Status::kOk)
+      st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
     if (st != format::Status::kOk)
       throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
   }

@@ -267,7 +267,8 @@ void FlakeNdf::Impl::buildTree(uint32_t id, FlakeRec* f, uint32_t count, double 
   node.child = 0;
   node.block = 0;
   if (count > uint32_t(kLeafFlakes)) {
-    const float extent[3] = {node.hi[0] - node.lo[0], node.hi[1] - node.lo[1], (node.jmax - jmin) * kJacobianSplitScale};
+    const float extent[3] = {node.hi[0] - node.lo[0], node.hi[1] - node.lo[1],
+                             (node.jmax - jmin) * kJacobianSplitScale};
     const int axis = extent[2] > std::max(extent[0], extent[1]) ? 2 : (extent[0] >= extent[1] ? 0 : 1);
     auto key = [axis](const FlakeRec& p) { return axis == 2 ? p.jnorm : p.n[axis]; };
     const uint32_t half = count / 2;
@@ -527,8 +528,9 @@ Status FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* 
     auto reach = [&](const Node& node, double dmax, double) {
       const double shift = double(node.jmax) * t.a * dmax;
       const double sd = std::sqrt(m.sigma_r2 + t.b * double(node.jmax) * double(node.jmax)) * 8.5;
-      return double(node.hi[0]) + shift + sd > x0 && double(node.lo[0]) - shift - sd < x1 &&
-             double(node.hi[1]) + shift + sd > y0 && double(node.lo[1]) - shift - sd < y1;
+      return double(node.hi[0]) + shift + sd > x0 &&
+             double(node.lo[0]) - shift - sd<x1&& double(node.hi[1]) + shift + sd> y0 &&
+             double(node.lo[1]) - shift - sd < y1;
     };
     m.forEachLeaf(t, reach, [&](const LeafVisit& leaf) {
       m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {

@@ -56,16 +56,26 @@ struct F4 {
     for (int i = 0; i < 4; ++i) r.v[i] = op(a.v[i], b.v[i]);
     return r;
   }
-  friend F4 operator+(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x + y; }); }
-  friend F4 operator-(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x - y; }); }
-  friend F4 operator*(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x * y; }); }
-  friend F4 operator/(F4 a, F4 b) { return map(a, b, [](float x, float y) { return x / y; }); }
+  friend F4 operator+(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x + y; });
+  }
+  friend F4 operator-(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x - y; });
+  }
+  friend F4 operator*(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x * y; });
+  }
+  friend F4 operator/(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return x / y; });
+  }
   friend F4 sqrt(F4 a) {
     F4 r;
     for (int i = 0; i < 4; ++i) r.v[i] = __builtin_sqrtf(a.v[i]);
     return r;
   }
-  friend F4 max(F4 a, F4 b) { return map(a, b, [](float x, float y) { return y > x ? y : x; }); }
+  friend F4 max(F4 a, F4 b) {
+    return map(a, b, [](float x, float y) { return y > x ? y : x; });
+  }
   friend F4 selectLess(F4 a, F4 b, F4 x) {
     F4 r;
     for (int i = 0; i < 4; ++i) r.v[i] = a.v[i] < b.v[i] ? x.v[i] : 0.0f;

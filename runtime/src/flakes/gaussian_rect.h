@@ -22,8 +22,8 @@ inline double normalCdf(double z) { return 0.5 * std::erfc(-z * 0.70710678118654
 // accumulated as weight * P into out[r * stride + c]. Bands beyond 8.5 standard deviations of the
 // mean are skipped (mass below 2e-17). Integration error below about 1e-10 of the lobe's mass.
 template <typename Acc>
-void integrateLobeOverGrid(const Lobe& g, double weight, const double* xs, int nc, const double* ys, int nr,
-                           Acc* out, int stride) {
+void integrateLobeOverGrid(const Lobe& g, double weight, const double* xs, int nc, const double* ys, int nr, Acc* out,
+                           int stride) {
   // 8-point Gauss-Legendre nodes and weights on [-1, 1].
   static constexpr double kNode[8] = {-0.96028985649753623, -0.79666647741362674, -0.52553240991632899,
                                       -0.18343464249564980, 0.18343464249564980,  0.52553240991632899,

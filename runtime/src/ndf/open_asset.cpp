@@ -50,8 +50,8 @@ Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* ou
     out->reset();
     return s;
   }
-  std::unique_ptr<NdfSource> handover(new (std::nothrow)
-                                          HandoverNdf(std::move(flakes), std::move(*out), rec.flakes_up_to, rec.pyramid_from));
+  std::unique_ptr<NdfSource> handover(
+      new (std::nothrow) HandoverNdf(std::move(flakes), std::move(*out), rec.flakes_up_to, rec.pyramid_from));
   if (!handover) {
     out->reset();
     return Status::kOutOfMemory;

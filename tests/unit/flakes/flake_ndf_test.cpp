@@ -63,7 +63,8 @@ std::vector<SPoint> probePoints(const Fixture& f, const reference::Footprint& fp
   std::normal_distribution<double> jitter(0.0, 0.01);
   for (int i = 0; i < 12; ++i) {
     const reference::FlakeLobe& l = lobes[pick(rng)];
-    points.push_back({std::clamp(l.mean[0] + jitter(rng), -0.999, 0.999), std::clamp(l.mean[1] + jitter(rng), -0.999, 0.999)});
+    points.push_back(
+        {std::clamp(l.mean[0] + jitter(rng), -0.999, 0.999), std::clamp(l.mean[1] + jitter(rng), -0.999, 0.999)});
   }
   std::uniform_real_distribution<double> any(-0.7, 0.7);
   for (int i = 0; i < 4; ++i) points.push_back({any(rng), any(rng)});
@@ -122,7 +123,8 @@ TEST(FlakeNdf, ImageMatchesReferenceBinAverages) {
     const Footprint fp{20.3, 41.7, sigma};
     std::vector<float> img(64 * 64);
     ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), Status::kOk);
-    const std::vector<double> ref = reference::binAveragedImage(f.set, {fp.x, fp.y, sigma}, reference::kDefaultSigmaR, 64);
+    const std::vector<double> ref =
+        reference::binAveragedImage(f.set, {fp.x, fp.y, sigma}, reference::kDefaultSigmaR, 64);
     double diff = 0.0, total = 0.0;
     for (size_t i = 0; i < img.size(); ++i) {
       diff += std::fabs(img[i] - ref[i]);

@@ -73,8 +73,9 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
     int l = 0;
     while (l + 1 < pyr.levelCount() && pyr.level(l + 1)->sigma_texels <= sigma) ++l;
     const int l2 = std::min(l + 1, pyr.levelCount() - 1);
-    const double t = l2 == l ? 0.0 : std::log(sigma / pyr.level(l)->sigma_texels) /
-                                         std::log(pyr.level(l2)->sigma_texels / pyr.level(l)->sigma_texels);
+    const double t = l2 == l ? 0.0
+                             : std::log(sigma / pyr.level(l)->sigma_texels) /
+                                   std::log(pyr.level(l2)->sigma_texels / pyr.level(l)->sigma_texels);
     for (int k = 0; k < 2; ++k) {
       const NdfLevelRecord* r = pyr.level(k == 0 ? l : l2);
       const double wl = k == 0 ? 1.0 - t : t;

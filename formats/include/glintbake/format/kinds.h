@@ -63,10 +63,11 @@ constexpr SectionRange kSectionRanges[] = {
 };
 
 constexpr SectionTypeInfo kSectionTypeRegistry[] = {
-    {kSectionMetadata, "metadata"},        {kSectionNdfLevel, "ndf-level"},     {kSectionNdfChunk, "ndf-chunk"},
-    {kSectionTensorIndex, "tensor-index"}, {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
-    {kSectionLtcTable, "ltc-table"},       {kSectionRoughness, "roughness"},    {kSectionFlakes, "flakes"},
-    {kSectionImage, "image"},
+    {kSectionMetadata, "metadata"},      {kSectionNdfLevel, "ndf-level"},
+    {kSectionNdfChunk, "ndf-chunk"},     {kSectionTensorIndex, "tensor-index"},
+    {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
+    {kSectionLtcTable, "ltc-table"},     {kSectionRoughness, "roughness"},
+    {kSectionFlakes, "flakes"},          {kSectionImage, "image"},
 };
 
 // True for the types readers and validators know: defined types, types of open blocks and

@@ -82,9 +82,9 @@ class CpMix {
  public:
   // Builds the blend of `count` terms (count in [0, kCpMaxBlend]). Terms with weight 0 are
   // skipped, and so are terms of groups beyond the first kCpMaxGroups distinct ones (only assets
-  // baked with spatial regions of fewer than 4 centres per side reach that); all groups must share B and hold valid views (validateCpGroupView) and the block
-  // index must be in [0, K). Returns kInvalidArgument otherwise (the mix is then empty: every query
-  // returns 0). Zero terms give an empty mix.
+  // baked with spatial regions of fewer than 4 centres per side reach that); all groups must share B and hold valid
+  // views (validateCpGroupView) and the block index must be in [0, K). Returns kInvalidArgument otherwise (the mix is
+  // then empty: every query returns 0). Zero terms give an empty mix.
   Status init(const CpBlendTerm* terms, int32_t count);
 
   int32_t bins() const { return bins_; }

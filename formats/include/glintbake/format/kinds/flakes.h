@@ -22,10 +22,10 @@ struct FlakesRecord {
   uint32_t rate = 1;        // flakes per texel side (1..16)
   uint32_t precision = 0;   // 0: float32 normals (the only value of version 1)
   uint32_t reserved = 0;
-  double sigma_r = 0.0;          // intrinsic roughness, s-plane std of every flake (0, 1]
-  double flakes_up_to = 0.0;     // footprints with sigma <= this (texels) are answered by the flakes alone
-  double pyramid_from = 0.0;     // footprints with sigma >= this are answered by the pyramid alone;
-                                 // in between the two are blended linearly in log(sigma)
+  double sigma_r = 0.0;       // intrinsic roughness, s-plane std of every flake (0, 1]
+  double flakes_up_to = 0.0;  // footprints with sigma <= this (texels) are answered by the flakes alone
+  double pyramid_from = 0.0;  // footprints with sigma >= this are answered by the pyramid alone;
+                              // in between the two are blended linearly in log(sigma)
   double reserved2 = 0.0;
 };
 static_assert(sizeof(FlakesRecord) == 64, "FlakesRecord is 64 bytes");

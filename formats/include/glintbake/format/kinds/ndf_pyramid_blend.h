@@ -119,8 +119,9 @@ struct NdfBlendAxis {
     int count = 0;
     double total = 0.0;
     const double inv_tau = 1.0 / tau;
-    auto ramp = [](double z) { return z * 0.5 * std::erfc(-z * 0.70710678118654752) +
-                                      0.39894228040143267794 * std::exp(-0.5 * z * z); };
+    auto ramp = [](double z) {
+      return z * 0.5 * std::erfc(-z * 0.70710678118654752) + 0.39894228040143267794 * std::exp(-0.5 * z * z);
+    };
     for (int i = first; i <= last; ++i) {
       const double d = (g - double(i)) * inv_tau;
       const double wi = tau * (ramp(d + inv_tau) - 2.0 * ramp(d) + ramp(d - inv_tau));
