@@ -27,7 +27,7 @@
 namespace glintbake::format {
 
 // Most centres blend() emits for one footprint (two levels of at most kMaxBlendAxis^2 centres).
-constexpr int kMaxBlendAxis = 14;
+constexpr int kMaxBlendAxis = 16;
 constexpr int kMaxBlendCentres = 2 * kMaxBlendAxis * kMaxBlendAxis;
 
 // One axis of a level's centre grid, with the divisions of the blend done once at init.
