@@ -139,6 +139,26 @@ class GlintinfoTest(clitest.ToolTestCase):
         self.assertIn("image", out)
         self.assertIn('"tool": "pytest"', out)
 
+    def test_info_footprint_ranges(self):
+        # NDF assets say their map and which footprints each path answers.
+        nmap = self.mapgen("beckmann", "b.exr", "--size", "32", "--seed", "3")
+        for flakes in (True, False):
+            asset = self.path("a.gbk")
+            self.run_ok("ndfgen", nmap, "-o", asset, "--stride", "8", "--sigma0", "4", "--levels", "2", "--ndf-res", "32",
+                        "--quiet", *([] if flakes else ["--no-flakes"]))
+            doc = self.run_json("glintinfo", "info", asset, schema="glintinfo-info.schema.json")
+            self.assertEqual(doc["map"], {"width": 32, "height": 32, "wrap": "repeat"})
+            fp = doc["footprints"]
+            self.assertEqual((fp["levels"], fp["pyramid_min_sigma"], fp["pyramid_max_sigma"]), (2, 4.0, 8.0))
+            self.assertEqual(fp["exact_max_sigma"], 4.0 if flakes else 0.0)
+            self.assertAlmostEqual(fp["handover_max_sigma"], 4.0 * 2 ** 0.5 if flakes else 0.0)
+            self.assertTrue(fp["unbounded_above_top"])
+            out, _ = self.run_ok("glintinfo", "info", asset)
+            self.assertIn("exact from the flakes" if flakes else "no flakes", out)
+        # Containers without levels have neither.
+        doc = self.run_json("glintinfo", "info", self.image_container("c.gbk"), schema="glintinfo-info.schema.json")
+        self.assertNotIn("footprints", doc)
+
     def test_info_frozen(self):
         doc = self.run_json("glintinfo", "info", self.frozen("v1_0_image.gbk"), schema="glintinfo-info.schema.json")
         self.assertEqual([s["codec"] for s in doc["sections"]], ["zstd", "zstd", "raw"])

@@ -2,8 +2,12 @@
 #include "commands.h"
 #include "container_access.h"
 
+#include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/kinds/ndf_pyramid.h>
+
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 
 namespace glintbake::glintinfo {
@@ -18,6 +22,51 @@ std::string hex64(uint64_t v) {
 std::string kindLabel(uint32_t kind) {
   const std::string name = format::assetKindString(format::AssetKind(kind));
   return name == "unknown" ? "unknown (" + std::to_string(kind) + ")" : name;
+}
+
+// The map and the footprints an NDF asset answers and how (ndf_source.h, FootprintRange), read
+// from its level records and its flakes record; null for containers without levels. Records that
+// fail their checks are left out (validate names them).
+cli::Json footprintSummary(const format::Reader& reader, const std::string& path) {
+  format::NdfLevelRecord first, top;
+  int levels = 0;
+  for (int l = 0; l < format::kMaxNdfLevels; ++l) {
+    const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));
+    if (idx < 0 || reader.sections()[size_t(idx)].raw_size != sizeof(format::NdfLevelRecord)) break;
+    const auto bytes = readSectionOrThrow(reader, path, size_t(idx));
+    format::NdfLevelRecord rec;
+    std::memcpy(&rec, bytes.data(), sizeof(rec));
+    if (!format::checkNdfLevelRecord(rec, uint32_t(l), levels > 0 ? &top : nullptr)) break;
+    if (l == 0) first = rec;
+    top = rec;
+    ++levels;
+  }
+  if (levels == 0) return nullptr;
+  cli::Json doc;
+  doc["map"] = {
+      {"width", first.map_width}, {"height", first.map_height}, {"wrap", first.wrap == 0 ? "repeat" : "clamp"}};
+  cli::Json fp;
+  fp["levels"] = levels;
+  fp["pyramid_min_sigma"] = first.sigma_texels;
+  fp["pyramid_max_sigma"] = top.sigma_texels;
+  fp["exact_max_sigma"] = 0.0;
+  fp["handover_max_sigma"] = 0.0;
+  const int flakes = reader.find(format::kSectionFlakes, 0);
+  if (flakes >= 0) {
+    const auto bytes = readSectionOrThrow(reader, path, size_t(flakes));
+    format::FlakesRecord rec;
+    if (bytes.size() >= sizeof(rec)) {
+      std::memcpy(&rec, bytes.data(), sizeof(rec));
+      if (format::checkFlakesRecord(rec, bytes.size()) == nullptr) {
+        fp["exact_max_sigma"] = rec.flakes_up_to;
+        fp["handover_max_sigma"] = rec.pyramid_from;
+      }
+    }
+  }
+  // Above the top level: a repeating map whose top grid fits the blend spreads to any width.
+  fp["unbounded_above_top"] = first.wrap == 0 && top.grid_width <= 16 && top.grid_height <= 16;
+  doc["footprints"] = fp;
+  return doc;
 }
 
 }  // namespace
@@ -71,6 +120,10 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
     }
     doc["sections"] = rows;
     doc["metadata"] = metadata;
+    if (const cli::Json summary = footprintSummary(*reader, options.file); !summary.is_null()) {
+      doc["map"] = summary["map"];
+      doc["footprints"] = summary["footprints"];
+    }
     tool.printJson(doc);
     return cli::kExitOk;
   }
@@ -80,7 +133,24 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
   std::printf("asset kind:     %s\n", kindLabel(header.asset_kind).c_str());
   std::printf("file size:      %" PRIu64 " bytes\n", header.file_size);
   std::printf("file checksum:  %s (XXH3-64)\n", hex64(header.file_checksum).c_str());
-  std::printf("sections:       %u\n\n", header.section_count);
+  std::printf("sections:       %u\n", header.section_count);
+  if (const cli::Json s = footprintSummary(*reader, options.file); !s.is_null()) {
+    const cli::Json& f = s["footprints"];
+    std::printf("map:            %d x %d texels, wrap %s\n", s["map"]["width"].get<int>(),
+                s["map"]["height"].get<int>(), s["map"]["wrap"].get<std::string>().c_str());
+    if (f["exact_max_sigma"].get<double>() > 0.0) {
+      std::printf("footprints:     exact from the flakes for sigma <= %g texels, blended into the pyramid up to %g\n",
+                  f["exact_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());
+    } else {
+      std::printf("footprints:     no flakes: sigma below %g texels answered by level 0\n",
+                  f["pyramid_min_sigma"].get<double>());
+    }
+    std::printf("                pyramid of %d levels, sigma %g to %g texels; above: %s\n", f["levels"].get<int>(),
+                f["pyramid_min_sigma"].get<double>(), f["pyramid_max_sigma"].get<double>(),
+                f["unbounded_above_top"].get<bool>() ? "the top level spread to any width"
+                                                     : "the top level spread up to 1.5 strides (a clamp)");
+  }
+  std::printf("\n");
   std::printf("%5s  %-12s  %-24s  %-5s  %12s  %12s  %7s\n", "index", "type", "key", "codec", "stored", "raw", "ratio");
   uint64_t total_stored = 0, total_raw = 0;
   for (size_t i = 0; i < sections.size(); ++i) {
