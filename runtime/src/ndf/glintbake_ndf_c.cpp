@@ -84,6 +84,26 @@ int32_t gb_ndf_asset_info(const gb_ndf_asset* a, int32_t* kind, int32_t* resolut
   return GB_OK;
 }
 
+int32_t gb_ndf_asset_map(const gb_ndf_asset* a, int32_t* width, int32_t* height, int32_t* wrap) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  const glintbake::runtime::MapSize size = a->source->mapSize();
+  if (width) *width = size.width;
+  if (height) *height = size.height;
+  if (wrap) *wrap = int32_t(a->source->wrap());
+  return GB_OK;
+}
+
+int32_t gb_ndf_asset_footprint_range(const gb_ndf_asset* a, double* exact_max, double* handover_max,
+                                     double* pyramid_min, double* pyramid_max) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  const glintbake::runtime::FootprintRange r = a->source->footprintRange();
+  if (exact_max) *exact_max = r.exact_max_sigma;
+  if (handover_max) *handover_max = r.handover_max_sigma;
+  if (pyramid_min) *pyramid_min = r.pyramid_min_sigma;
+  if (pyramid_max) *pyramid_max = r.pyramid_max_sigma;
+  return GB_OK;
+}
+
 int32_t gb_ndf_asset_eval(const gb_ndf_asset* a, double x, double y, double sigma, double sx, double sy,
                           double* value) {
   if (!a) return GB_INVALID_ARGUMENT;

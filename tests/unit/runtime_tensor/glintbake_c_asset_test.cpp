@@ -28,6 +28,20 @@ TEST(GlintbakeCAsset, TensorAndPyramidThroughOneHandle) {
   EXPECT_EQ(res, 32);
   ASSERT_EQ(gb_ndf_asset_info(pa, &kind, nullptr), GB_OK);
   EXPECT_EQ(kind, GB_KIND_NDF_PYRAMID);
+  // Map and footprint ranges, as the C++ interface reports them.
+  int32_t w = 0, h = 0, wrap = -1;
+  ASSERT_EQ(gb_ndf_asset_map(ta, &w, &h, &wrap), GB_OK);
+  EXPECT_EQ(w, t.mapSize().width);
+  EXPECT_EQ(h, t.mapSize().height);
+  EXPECT_EQ(wrap, int32_t(t.wrap()));
+  double exact = -1, band = -1, lo = -1, hi = -1;
+  ASSERT_EQ(gb_ndf_asset_footprint_range(ta, &exact, &band, &lo, &hi), GB_OK);
+  EXPECT_EQ(exact, t.footprintRange().exact_max_sigma);
+  EXPECT_EQ(band, t.footprintRange().handover_max_sigma);
+  EXPECT_EQ(lo, t.level(0)->sigma_texels);
+  EXPECT_EQ(hi, t.level(t.levelCount() - 1)->sigma_texels);
+  EXPECT_EQ(gb_ndf_asset_footprint_range(nullptr, nullptr, nullptr, nullptr, nullptr), GB_INVALID_ARGUMENT);
+  EXPECT_EQ(gb_ndf_asset_map(nullptr, nullptr, nullptr, nullptr), GB_INVALID_ARGUMENT);
 
   const NdfSource* sources[2] = {&t, &pyramid};
   gb_ndf_asset* handles[2] = {ta, pa};

@@ -48,6 +48,15 @@ void gb_ndf_asset_close(gb_ndf_asset* asset); /* NULL is allowed */
 /* Asset kind (GB_KIND_*) and NDF resolution R (bins per side); either pointer may be NULL. */
 int32_t gb_ndf_asset_info(const gb_ndf_asset* asset, int32_t* kind, int32_t* resolution);
 
+/* Source map size in texels and wrap mode (0 repeat, 1 clamp); any pointer may be NULL. */
+int32_t gb_ndf_asset_map(const gb_ndf_asset* asset, int32_t* width, int32_t* height, int32_t* wrap);
+
+/* The footprint std (texels) each path answers (ndf_source.h, FootprintRange): exact from the
+ * flakes for sigma <= exact_max (0: no flakes), blended into the pyramid up to handover_max, the
+ * pyramid's levels from pyramid_min to pyramid_max. Any pointer may be NULL. */
+int32_t gb_ndf_asset_footprint_range(const gb_ndf_asset* asset, double* exact_max, double* handover_max,
+                                     double* pyramid_min, double* pyramid_max);
+
 int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
                           double* value);
 int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0, double sy0,
