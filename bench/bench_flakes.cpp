@@ -24,20 +24,10 @@ namespace {
 namespace bake = glintbake::bake;
 namespace rt = glintbake::runtime;
 
-class MapTexels final : public rt::TexelSource {
- public:
-  explicit MapTexels(const bake::NormalMap& map) : map_(map) {}
-  int width() const override { return map_.width; }
-  int height() const override { return map_.height; }
-  bool repeats() const override { return map_.wrap == bake::Wrap::kRepeat; }
-  void normal(int x, int y, float out[2]) const override {
-    out[0] = map_.at(x, y)[0];
-    out[1] = map_.at(x, y)[1];
-  }
-
- private:
-  const bake::NormalMap& map_;
-};
+// A normal map seen through the runtime's texel-source interface.
+rt::InterleavedTexels mapTexels(const bake::NormalMap& map) {
+  return rt::InterleavedTexels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(), 3);
+}
 
 struct Subject {
   std::string name;
@@ -75,7 +65,7 @@ std::vector<std::unique_ptr<Subject>>& subjects() {
       }
     }
     for (auto& s : v) {
-      MapTexels texels(s->map);
+      const auto texels = mapTexels(s->map);
       if (s->ndf.build(texels, 1, 0.005, 128) != rt::Status::kOk) std::abort();
       s->set = glintbake::reference::buildFlakes(s->map, 1);
     }

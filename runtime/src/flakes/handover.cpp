@@ -10,27 +10,7 @@
 #include <new>
 
 namespace glintbake::runtime {
-namespace {
-
-// The stored normals of a flakes section as a texel source.
-class StoredTexels final : public TexelSource {
- public:
-  StoredTexels(const format::FlakesRecord& r, const float* normals) : rec_(r), normals_(normals) {}
-  int width() const override { return int(rec_.map_width); }
-  int height() const override { return int(rec_.map_height); }
-  bool repeats() const override { return rec_.wrap == 0; }
-  void normal(int x, int y, float out[2]) const override {
-    const float* n = normals_ + (size_t(y) * rec_.map_width + size_t(x)) * 2;
-    out[0] = n[0];
-    out[1] = n[1];
-  }
-
- private:
-  const format::FlakesRecord& rec_;
-  const float* normals_;
-};
-
-}  // namespace
+namespace {}  // namespace
 
 Status loadFlakes(const format::Reader& reader, int section, int resolution, std::unique_ptr<FlakeNdf>* flakes,
                   format::FlakesRecord* record) {
@@ -48,7 +28,7 @@ Status loadFlakes(const format::Reader& reader, int section, int resolution, std
   std::memcpy(&rec, section_bytes.data, sizeof(rec));
   if (format::checkFlakesRecord(rec, info.raw_size) != nullptr) return Status::kInvalidAsset;
   const float* normals = reinterpret_cast<const float*>(section_bytes.data + sizeof(rec));
-  StoredTexels texels(rec, normals);
+  const InterleavedTexels texels(int(rec.map_width), int(rec.map_height), rec.wrap == 0, normals, 2);
   std::unique_ptr<FlakeNdf> f(new (std::nothrow) FlakeNdf());
   if (!f) return Status::kOutOfMemory;
   const Status built = f->build(texels, int(rec.rate), rec.sigma_r, resolution);

@@ -22,20 +22,9 @@ using runtime::SPoint;
 using runtime::Status;
 
 // A normal map seen through the runtime's texel-source interface.
-class MapTexels final : public runtime::TexelSource {
- public:
-  explicit MapTexels(const bake::NormalMap& map) : map_(map) {}
-  int width() const override { return map_.width; }
-  int height() const override { return map_.height; }
-  bool repeats() const override { return map_.wrap == bake::Wrap::kRepeat; }
-  void normal(int x, int y, float out[2]) const override {
-    out[0] = map_.at(x, y)[0];
-    out[1] = map_.at(x, y)[1];
-  }
-
- private:
-  const bake::NormalMap& map_;
-};
+runtime::InterleavedTexels mapTexels(const bake::NormalMap& map) {
+  return runtime::InterleavedTexels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(), 3);
+}
 
 bake::NormalMap mapOf(bake::MapKind kind, int size, uint64_t seed) {
   bake::MapParams p;
@@ -50,7 +39,7 @@ struct Fixture {
   FlakeNdf ndf;
   Fixture(bake::NormalMap m, int rate = 1, int res = 64) : map(std::move(m)) {
     set = reference::buildFlakes(map, rate);
-    MapTexels texels(map);
+    const auto texels = mapTexels(map);
     EXPECT_EQ(ndf.build(texels, rate, reference::kDefaultSigmaR, res), Status::kOk);
   }
 };
@@ -231,7 +220,7 @@ TEST(FlakeNdf, RejectsBadArgumentsAndSources) {
   runtime::NdfSample smp;
   EXPECT_EQ(f.ndf.sample({1, 1, 1.0}, 1.0, 0.5, &smp), Status::kInvalidArgument);
   FlakeNdf other;
-  MapTexels texels(f.map);
+  const auto texels = mapTexels(f.map);
   EXPECT_EQ(other.build(texels, 0, 0.005, 64), Status::kInvalidArgument);
   EXPECT_EQ(other.build(texels, 1, 0.0, 64), Status::kInvalidArgument);
   EXPECT_EQ(other.build(texels, 1, 0.005, 1), Status::kInvalidArgument);

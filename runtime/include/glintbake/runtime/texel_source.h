@@ -18,4 +18,27 @@ class TexelSource {
   virtual void normal(int x, int y, float out[2]) const = 0;
 };
 
+// A texel source over a caller-owned row-major array holding `stride` floats per texel, (n_x, n_y)
+// first (stride 2: a flakes section's normals; stride 3: x, y, z normals). The array must outlive
+// the source; nothing is copied.
+class InterleavedTexels final : public TexelSource {
+ public:
+  InterleavedTexels(int width, int height, bool repeats, const float* data, int stride)
+      : width_(width), height_(height), repeats_(repeats), data_(data), stride_(stride) {}
+  int width() const override { return width_; }
+  int height() const override { return height_; }
+  bool repeats() const override { return repeats_; }
+  void normal(int x, int y, float out[2]) const override {
+    const float* n = data_ + (static_cast<long long>(y) * width_ + x) * stride_;
+    out[0] = n[0];
+    out[1] = n[1];
+  }
+
+ private:
+  int width_, height_;
+  bool repeats_;
+  const float* data_;
+  int stride_;
+};
+
 }  // namespace glintbake::runtime
