@@ -11,10 +11,41 @@
 
 namespace glintbake::bake::ndf {
 
-FlakesHandover defaultHandover(double sigma0) {
+namespace {
+constexpr double kFlakesUpTo = 4.0;       // texels: the flakes answer at least this far
+constexpr double kHalfOctave = 1.4142135623730951;
+constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
+}  // namespace
+
+FlakesHandover defaultHandover(double sigma0, int lobes_per_tile) {
   FlakesHandover h;
-  h.flakes_up_to = std::max(4.0, sigma0);
-  h.pyramid_from = h.flakes_up_to * std::sqrt(2.0);
+  if (lobes_per_tile <= 0) {
+    h.flakes_up_to = std::max(kFlakesUpTo, sigma0);
+    h.pyramid_from = h.flakes_up_to * kHalfOctave;
+    return h;
+  }
+  h.flakes_up_to = kFlakesUpTo;
+  h.lobes_per_tile = lobes_per_tile;
+  h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, sigma0 / kHalfOctave);
+  h.pyramid_from = std::max(sigma0, h.lobes_up_to);
+  return h;
+}
+
+FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
+                                  double max_level_error, int lobes_per_tile) {
+  if (lobes_per_tile <= 0 || levels <= 0) return defaultHandover(levels > 0 ? level_sigmas[0] : 0.0, lobes_per_tile);
+  int first = levels;  // the first level from which every level is faithful
+  while (first > 0 && level_errors[first - 1] <= max_level_error) --first;
+  if (first == 0) return defaultHandover(level_sigmas[0], lobes_per_tile);
+  FlakesHandover h;
+  h.flakes_up_to = kFlakesUpTo;
+  h.lobes_per_tile = lobes_per_tile;
+  if (first == levels) {
+    h.lobes_up_to = h.pyramid_from = kLobesUnbounded;
+  } else {
+    h.pyramid_from = std::max(level_sigmas[first], kFlakesUpTo * format::kLobesBand);
+    h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, h.pyramid_from / kHalfOctave);
+  }
   return h;
 }
 
@@ -28,6 +59,8 @@ Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate
   rec.sigma_r = sigma_r;
   rec.flakes_up_to = handover.flakes_up_to;
   rec.pyramid_from = handover.pyramid_from;
+  rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
+  rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
   const uint64_t size = format::flakesSectionSize(rec);
   if (const char* why = format::checkFlakesRecord(rec, size)) return makeError(ErrorCode::kBadArgument, why);
   std::vector<uint8_t> section;

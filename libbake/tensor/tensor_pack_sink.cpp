@@ -92,6 +92,7 @@ Status TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   lrep.level = level_;
   lrep.grid_width = grid_width_;
   lrep.grid_height = grid_height_;
+  lrep.sigma = record.sigma_texels;
   report_.levels.push_back(lrep);
   return writeSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
 }

@@ -14,7 +14,9 @@ class RenderTensorTest(clitest.ToolTestCase):
         # sigma_r = 0.02 (lobes about 1.3 bins wide at R = 128): the pyramid's own error against the
         # reference (bin averaging of much sharper lobes) then stays below the compression error, so
         # the rank ordering is visible against the reference too.
-        self.run_ok("ndfgen", nmap, "-o", pyramid, "--sigma-r", "0.02", "--quiet")
+        # No flakes: the compressed levels themselves answer these footprints (with flakes, the clustered
+        # lobes would answer them whatever the rank).
+        self.run_ok("ndfgen", nmap, "-o", pyramid, "--sigma-r", "0.02", "--no-flakes", "--quiet")
         # A tilted plane whose pixel footprints (std about 8 texels) sit at the pyramid's level 0.
         scene = self.path("rank.json")
         with open(scene, "w") as f:

@@ -51,6 +51,8 @@ cli::Json footprintSummary(const format::Reader& reader, const std::string& path
   fp["pyramid_max_sigma"] = top.sigma_texels;
   fp["exact_max_sigma"] = 0.0;
   fp["handover_max_sigma"] = 0.0;
+  fp["clustered_min_sigma"] = 0.0;
+  fp["clustered_max_sigma"] = 0.0;
   const int flakes = reader.find(format::kSectionFlakes, 0);
   if (flakes >= 0) {
     const auto bytes = readSectionOrThrow(reader, path, size_t(flakes));
@@ -60,6 +62,11 @@ cli::Json footprintSummary(const format::Reader& reader, const std::string& path
       if (format::checkFlakesRecord(rec, bytes.size()) == nullptr) {
         fp["exact_max_sigma"] = rec.flakes_up_to;
         fp["handover_max_sigma"] = rec.pyramid_from;
+        if (format::hasLobes(rec)) {
+          fp["clustered_min_sigma"] = rec.flakes_up_to * format::kLobesBand;
+          fp["clustered_max_sigma"] = rec.lobes_up_to;
+          fp["lobes_per_tile"] = rec.lobes_per_tile;
+        }
       }
     }
   }
@@ -138,7 +145,13 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
     const cli::Json& f = s["footprints"];
     std::printf("map:            %d x %d texels, wrap %s\n", s["map"]["width"].get<int>(),
                 s["map"]["height"].get<int>(), s["map"]["wrap"].get<std::string>().c_str());
-    if (f["exact_max_sigma"].get<double>() > 0.0) {
+    if (f["exact_max_sigma"].get<double>() > 0.0 && f["clustered_max_sigma"].get<double>() > 0.0) {
+      std::printf("footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile) from %g "
+                  "to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
+                  f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(),
+                  f["clustered_min_sigma"].get<double>(), f["clustered_max_sigma"].get<double>(),
+                  f["handover_max_sigma"].get<double>());
+    } else if (f["exact_max_sigma"].get<double>() > 0.0) {
       std::printf("footprints:     exact from the flakes for sigma <= %g texels, blended into the pyramid up to %g\n",
                   f["exact_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());
     } else {

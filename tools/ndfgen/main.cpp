@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
     const bake::Status built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
     progress.finish();
     cli::check(built);
-    const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid);
+    const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);
+    const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid, handover);
 
     Json params = cli::pyramidOptionsJson(pyramid);
     params["zstd_level"] = zstd_level;
@@ -82,10 +83,7 @@ int main(int argc, char** argv) {
     for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
     asset["stop_reason"] = report.stop_reason;
     if (report.next_level_mse >= 0) asset["converged_mse"] = report.next_level_mse;
-    if (pyramid.flakes) {
-      const bake::ndf::FlakesHandover h = bake::ndf::defaultHandover(opt.sigma0);
-      asset["flakes"] = {{"up_to", h.flakes_up_to}, {"pyramid_from", h.pyramid_from}, {"bytes", flake_bytes}};
-    }
+    if (pyramid.flakes) asset["flakes"] = cli::flakesJson(handover, flake_bytes);
     meta["asset"] = asset;
     out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

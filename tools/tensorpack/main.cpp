@@ -9,6 +9,7 @@
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/flakes.h>
 
 #include <algorithm>
 #include <chrono>
@@ -57,6 +58,10 @@ int exitCodeOf(const bake::Error& e) { return int(e.code); }
 // at 0.93 (flakes_voronoi_sharp_snail_512; the example flakes asset 0.88): an asset that far off has
 // lost most of its glints. 0.5 separates the two with room on both sides.
 constexpr double kDefaultErrorBound = 0.5;
+// Relative error (Frobenius, over a level's images) up to which a compressed level answers its
+// footprints; below the first level from which every level meets it, the clustered lobes answer
+// (README, "How an NDF asset answers a footprint").
+constexpr double kFaithfulLevelError = 0.15;
 
 std::string errorText(double e) {
   char text[32];
@@ -97,6 +102,7 @@ std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, doub
 Json levelJson(const tensor::TensorPackLevelReport& l) {
   Json j;
   j["level"] = l.level;
+  j["sigma"] = l.sigma;
   j["grid"] = {l.grid_width, l.grid_height};
   j["groups"] = l.groups;
   j["blocks_kept"] = l.blocks_kept;
@@ -255,7 +261,8 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
 }
 
 // Stage 3: packs the input into the (temporary) output container; nothing is in place yet.
-tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out) {
+tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out,
+                                   bake::ndf::FlakesHandover& handover, uint64_t* flake_bytes) {
   tensor::TensorPackReport report;
   bake::Status s = bake::okStatus();
   if (in.from_container) {
@@ -266,15 +273,37 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     progress.finish();
   }
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
-  // The flakes for exact small footprints (formats/SPEC.md 10.5): written from the map, or carried
-  // over from the source container.
+  // The flakes for exact small footprints (formats/SPEC.md 10.5), written from the map or carried
+  // over from the source container, with the hand-over this compression calls for: the pyramid
+  // answers only from the first level from which every level is faithful (kFaithfulLevelError),
+  // the clustered lobes below it.
+  std::vector<double> sigmas, errors;
+  for (const auto& l : report.levels) {
+    sigmas.push_back(l.sigma);
+    errors.push_back(l.relative_error);
+  }
+  const int lobes = in.from_container ? bake::ndf::kDefaultLobesPerTile : o.pyramid.lobes;
+  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), kFaithfulLevelError, lobes);
   if (!in.from_container) {
-    cli::writeFlakes(out.writer(), in.map, o.pyramid);
+    *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
     std::vector<uint8_t> flakes;
     format::Status st = in.reader.readSection(size_t(idx), &flakes);
-    if (st == format::Status::kOk)
+    if (st == format::Status::kOk) {
+      format::FlakesRecord rec;
+      if (flakes.size() < sizeof(rec)) throw Error(cli::kExitInvalidInput, o.input + ": the flakes section is truncated");
+      std::memcpy(&rec, flakes.data(), sizeof(rec));
+      rec.version = format::FlakesRecord().version;
+      rec.flakes_up_to = handover.flakes_up_to;
+      rec.lobes_per_tile = uint32_t(handover.lobes_per_tile);
+      rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
+      rec.pyramid_from = handover.pyramid_from;
+      if (const char* why = format::checkFlakesRecord(rec, flakes.size()))
+        throw Error(cli::kExitInvalidInput, o.input + ": " + why);
+      std::memcpy(flakes.data(), &rec, sizeof(rec));
       st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
+      *flake_bytes = flakes.size();
+    }
     if (st != format::Status::kOk)
       throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
   }
@@ -283,7 +312,7 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
 
 // Stage 4: the asset's metadata; adds it and renames the container into place.
 void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& params,
-                const tensor::TensorPackReport& report, cli::ContainerOutput& out) {
+                const tensor::TensorPackReport& report, const Json& flakes, cli::ContainerOutput& out) {
   Json asset;
   asset["ndf_res"] = report.ndf_res;
   asset["block"] = o.pack.block;
@@ -298,6 +327,7 @@ void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& par
   asset["precision"] = o.precision_text;
   asset["nonneg"] = o.pack.cp.nonneg;
   asset["blank_threshold"] = o.pack.blank_threshold;
+  if (!flakes.is_null()) asset["flakes"] = flakes;
   asset["relative_error"] = report.relative_error;
   if (!in.map_json.is_null()) asset["map"] = in.map_json;
   if (in.source_asset.is_object()) {
@@ -370,11 +400,14 @@ int main(int argc, char** argv) {
     Input in;
     readInput(t, o, in, params);
     cli::ContainerOutput out(t, o.output, format::AssetKind::kTensorNdf, o.zstd_level);
-    const tensor::TensorPackReport report = packAsset(t, o, in, out);
+    bake::ndf::FlakesHandover handover;
+    uint64_t flake_bytes = 0;
+    const tensor::TensorPackReport report = packAsset(t, o, in, out, handover, &flake_bytes);
     // The gate runs before anything is in place: a failure leaves no output.
     checkMaxError(report, o.max_error, o.input);
     const std::vector<std::string> warnings = qualityWarnings(report, o.error_target, o.pack.cp.rank);
-    writeAsset(t, o, in, params, report, out);
+    const Json flakes = flake_bytes > 0 ? cli::flakesJson(handover, flake_bytes) : Json(nullptr);
+    writeAsset(t, o, in, params, report, flakes, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     printReport(t, o, in, params, report, warnings, out.bytesWritten(), seconds);
     return cli::kExitOk;

@@ -13,7 +13,7 @@ uint64_t flakesSectionSize(const FlakesRecord& r) {
 
 const char* checkFlakesRecord(const FlakesRecord& r, uint64_t section_raw_size) {
   if (r.magic != FlakesRecord().magic) return "flakes record: bad magic";
-  if (r.version != 1) return "flakes record: unsupported version";
+  if (r.version != 1 && r.version != 2) return "flakes record: unsupported version";
   if (flakesSectionSize(r) == 0) return "flakes record: map size out of range";
   if (r.wrap > 1) return "flakes record: wrap is neither repeat nor clamp";
   if (r.rate < 1 || r.rate > kMaxFlakesRate) return "flakes record: rate out of range";
@@ -24,6 +24,13 @@ const char* checkFlakesRecord(const FlakesRecord& r, uint64_t section_raw_size) 
     return "flakes record: flakes_up_to out of range";
   if (!(std::isfinite(r.pyramid_from) && r.pyramid_from >= r.flakes_up_to && r.pyramid_from <= 1e6))
     return "flakes record: pyramid_from below flakes_up_to";
+  if (r.version >= 2) {
+    if (r.lobes_per_tile > kMaxLobesPerTile) return "flakes record: lobes_per_tile out of range";
+    if (r.lobes_per_tile > 0 && !(std::isfinite(r.lobes_up_to) && r.lobes_up_to >= r.flakes_up_to * kLobesBand &&
+                                  r.lobes_up_to <= r.pyramid_from))
+      return "flakes record: lobes_up_to outside [flakes_up_to x sqrt(2), pyramid_from]";
+    if (r.lobes_per_tile == 0 && r.lobes_up_to != 0.0) return "flakes record: lobes_up_to without lobes";
+  }
   if (section_raw_size != flakesSectionSize(r)) return "flakes record: section size does not match the map size";
   return nullptr;
 }

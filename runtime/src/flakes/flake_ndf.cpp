@@ -3,6 +3,7 @@
 
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
+#include "flake_model.h"
 #include "float4.h"
 #include "gaussian_rect.h"
 
@@ -61,37 +62,6 @@ uint32_t treeNodes(uint32_t count) {
 }
 uint32_t treeLeaves(uint32_t count) {
   return count <= uint32_t(kLeafFlakes) ? 1u : treeLeaves(count / 2) + treeLeaves(count - count / 2);
-}
-
-// Texel index with the source's wrap mode (repeat: modulo; clamp: nearest edge texel).
-int64_t wrapIndex(int64_t i, int64_t size, bool repeat) {
-  if (repeat) {
-    const int64_t m = i % size;
-    return m < 0 ? m + size : m;
-  }
-  return i < 0 ? 0 : (i >= size ? size - 1 : i);
-}
-
-// Bilinear interpolation of the texels' (n_x, n_y) at u (texel centres at +0.5), as the flake
-// model defines it.
-void interpolate(const float* normals, int w, int h, bool repeat, double ux, double uy, double out[2]) {
-  const double px = ux - 0.5, py = uy - 0.5;
-  const double fx0 = std::floor(px), fy0 = std::floor(py);
-  const double tx = px - fx0, ty = py - fy0;
-  const int64_t x0 = int64_t(fx0), y0 = int64_t(fy0);
-  const int64_t xs[2] = {wrapIndex(x0, w, repeat), wrapIndex(x0 + 1, w, repeat)};
-  const int64_t ys[2] = {wrapIndex(y0, h, repeat), wrapIndex(y0 + 1, h, repeat)};
-  const double wx[2] = {1.0 - tx, tx}, wy[2] = {1.0 - ty, ty};
-  double nx = 0.0, ny = 0.0;
-  for (int b = 0; b < 2; ++b) {
-    for (int a = 0; a < 2; ++a) {
-      const float* t = normals + (size_t(ys[b]) * size_t(w) + size_t(xs[a])) * 2;
-      nx += wx[a] * wy[b] * double(t[0]);
-      ny += wx[a] * wy[b] * double(t[1]);
-    }
-  }
-  out[0] = nx;
-  out[1] = ny;
 }
 
 // Constants of one footprint shared by every flake (Yan et al. 2016 closed form).
@@ -166,18 +136,7 @@ void FlakeNdf::Impl::buildFlakes(const float* normals, int tx, int ty, FlakeRec*
     for (int fx = tx * kTile; fx < std::min(fine_w, (tx + 1) * kTile); ++fx) {
       FlakeRec& k = out[c++];
       const double ux = flakePosition(fx), uy = flakePosition(fy);
-      double n[2], right[2], left[2], down[2], up[2];
-      interpolate(normals, width, height, repeat, ux, uy, n);
-      interpolate(normals, width, height, repeat, ux + 1.0, uy, right);
-      interpolate(normals, width, height, repeat, ux - 1.0, uy, left);
-      interpolate(normals, width, height, repeat, ux, uy + 1.0, down);
-      interpolate(normals, width, height, repeat, ux, uy - 1.0, up);
-      k.n[0] = float(n[0]);
-      k.n[1] = float(n[1]);
-      k.j[0] = float((right[0] - left[0]) * 0.5);
-      k.j[1] = float((down[0] - up[0]) * 0.5);
-      k.j[2] = float((right[1] - left[1]) * 0.5);
-      k.j[3] = float((down[1] - up[1]) * 0.5);
+      flakes::flakeAt(normals, width, height, repeat, ux, uy, k.n, k.j);
       double jj = 0.0;
       for (float j : k.j) jj += double(j) * j;
       k.jnorm = float(std::sqrt(jj) * (1.0 + 1e-6));
@@ -546,50 +505,6 @@ Status FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* 
   return Status::kOk;
 }
 
-namespace {
-
-// Whether bin (i, j) of an R x R image has its centre inside the unit disk: the others hold 0
-// (SPEC.md section 9) and receive nothing.
-bool binInDisk(int i, int j, int res) {
-  const double cx = -1.0 + (i + 0.5) * 2.0 / res, cy = 1.0 - (j + 0.5) * 2.0 / res;
-  return cx * cx + cy * cy <= 1.0;
-}
-
-// Adds weight * (the lobe's probability over each bin) to the bins of an R x R image (row 0 at
-// s_y = +1) whose centre lies inside the unit disk: the bins within 8.5 standard deviations of the
-// mean, or the one bin holding the whole lobe.
-void splatLobe(const flakes::Lobe& g, double weight, int res, float* out) {
-  const double bin = 2.0 / res, inv_bin = res / 2.0;
-  const double rx = 8.5 * std::sqrt(g.cxx), ry = 8.5 * std::sqrt(g.cyy);
-  const int i0 = std::max(0, int(std::floor((g.mx - rx + 1.0) * inv_bin)));
-  const int i1 = std::min(res - 1, int(std::floor((g.mx + rx + 1.0) * inv_bin)));
-  const int j0 = std::max(0, int(std::floor((1.0 - (g.my + ry)) * inv_bin)));
-  const int j1 = std::min(res - 1, int(std::floor((1.0 - (g.my - ry)) * inv_bin)));
-  if (i0 > i1 || j0 > j1) return;
-  if (i0 == i1 && j0 == j1 && g.mx - rx >= -1.0 + i0 * bin && g.mx + rx <= -1.0 + (i0 + 1) * bin &&
-      g.my + ry <= 1.0 - j0 * bin && g.my - ry >= 1.0 - (j0 + 1) * bin) {
-    if (binInDisk(i0, j0, res)) out[size_t(j0) * res + i0] += float(weight);
-    return;
-  }
-  constexpr int kSpan = 32;  // bins per side integrated at once
-  double xs[kSpan + 1], ys[kSpan + 1], acc[kSpan * kSpan];
-  for (int jb = j0; jb <= j1; jb += kSpan) {
-    const int nr = std::min(kSpan, j1 - jb + 1);
-    for (int ib = i0; ib <= i1; ib += kSpan) {
-      const int nc = std::min(kSpan, i1 - ib + 1);
-      for (int c = 0; c <= nc; ++c) xs[c] = -1.0 + (ib + c) * bin;
-      for (int r = 0; r <= nr; ++r) ys[r] = 1.0 - (jb + r) * bin;
-      std::fill(acc, acc + nr * kSpan, 0.0);
-      flakes::integrateLobeOverGrid(g, weight, xs, nc, ys, nr, acc, kSpan);
-      for (int r = 0; r < nr; ++r)
-        for (int c = 0; c < nc; ++c)
-          if (binInDisk(ib + c, jb + r, res)) out[size_t(jb + r) * res + size_t(ib + c)] += float(acc[r * kSpan + c]);
-    }
-  }
-}
-
-}  // namespace
-
 Status FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
   if (!impl_) return Status::kInvalidArgument;
   const int res = impl_->res;
@@ -616,7 +531,7 @@ Status FlakeNdf::addImage(const Footprint& footprint, double weight, float* out,
     m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {
       flakes::Lobe g;
       m.lobeOf(k, i, dx, dy, t, &g);
-      splatLobe(g, to_density * std::exp(-spatial), res, out);
+      flakes::splatLobe(g, to_density * std::exp(-spatial), res, out);
     });
   });
   return Status::kOk;

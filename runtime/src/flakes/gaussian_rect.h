@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace glintbake::runtime::flakes {
 
@@ -75,6 +76,46 @@ inline double lobeRectProbability(const Lobe& g, double x0, double x1, double y0
   double p = 0.0;
   integrateLobeOverGrid(g, 1.0, xs, 1, ys, 1, &p, 1);
   return p;
+}
+
+// Whether bin (i, j) of an R x R image has its centre inside the unit disk: the others hold 0
+// (SPEC.md section 9) and receive nothing.
+inline bool binInDisk(int i, int j, int res) {
+  const double cx = -1.0 + (i + 0.5) * 2.0 / res, cy = 1.0 - (j + 0.5) * 2.0 / res;
+  return cx * cx + cy * cy <= 1.0;
+}
+
+// Adds weight * (the lobe's probability over each bin) to the bins of an R x R image (row 0 at
+// s_y = +1) whose centre lies inside the unit disk: the bins within 8.5 standard deviations of the
+// mean, or the one bin holding the whole lobe.
+inline void splatLobe(const Lobe& g, double weight, int res, float* out) {
+  const double bin = 2.0 / res, inv_bin = res / 2.0;
+  const double rx = 8.5 * std::sqrt(g.cxx), ry = 8.5 * std::sqrt(g.cyy);
+  const int i0 = std::max(0, int(std::floor((g.mx - rx + 1.0) * inv_bin)));
+  const int i1 = std::min(res - 1, int(std::floor((g.mx + rx + 1.0) * inv_bin)));
+  const int j0 = std::max(0, int(std::floor((1.0 - (g.my + ry)) * inv_bin)));
+  const int j1 = std::min(res - 1, int(std::floor((1.0 - (g.my - ry)) * inv_bin)));
+  if (i0 > i1 || j0 > j1) return;
+  if (i0 == i1 && j0 == j1 && g.mx - rx >= -1.0 + i0 * bin && g.mx + rx <= -1.0 + (i0 + 1) * bin &&
+      g.my + ry <= 1.0 - j0 * bin && g.my - ry >= 1.0 - (j0 + 1) * bin) {
+    if (binInDisk(i0, j0, res)) out[size_t(j0) * res + i0] += float(weight);
+    return;
+  }
+  constexpr int kSpan = 32;  // bins per side integrated at once
+  double xs[kSpan + 1], ys[kSpan + 1], acc[kSpan * kSpan];
+  for (int jb = j0; jb <= j1; jb += kSpan) {
+    const int nr = std::min(kSpan, j1 - jb + 1);
+    for (int ib = i0; ib <= i1; ib += kSpan) {
+      const int nc = std::min(kSpan, i1 - ib + 1);
+      for (int c = 0; c <= nc; ++c) xs[c] = -1.0 + (ib + c) * bin;
+      for (int r = 0; r <= nr; ++r) ys[r] = 1.0 - (jb + r) * bin;
+      std::fill(acc, acc + nr * kSpan, 0.0);
+      integrateLobeOverGrid(g, weight, xs, nc, ys, nr, acc, kSpan);
+      for (int r = 0; r < nr; ++r)
+        for (int c = 0; c < nc; ++c)
+          if (binInDisk(ib + c, jb + r, res)) out[size_t(jb + r) * res + size_t(ib + c)] += float(acc[r * kSpan + c]);
+    }
+  }
 }
 
 }  // namespace glintbake::runtime::flakes

@@ -1,36 +1,47 @@
-// Loading the flakes section of an NDF asset and answering footprints across the hand-over from
-// the flakes to the asset's pyramid (internal to the runtime; formats/SPEC.md 10.5).
-//  - sigma <= flakes_up_to: the flakes alone (exact);
-//  - sigma >= pyramid_from: the pyramid alone;
-//  - in between: (1 - t) flakes + t pyramid, t = ln(sigma / flakes_up_to) / ln(pyramid_from /
-//    flakes_up_to). eval, average, image and mass blend linearly; sample picks a path in proportion
-//    to its weighted mass, so pdf = blended eval / blended mass exactly as for the other paths.
+// Loading the flakes section of an NDF asset and answering footprints across the hand-overs from
+// the flakes to the clustered lobes and to the asset's pyramid (internal to the runtime;
+// formats/SPEC.md 10.5). With f = flakes_up_to, a = kLobesBand f, b = lobes_up_to, p = pyramid_from:
+//  - sigma <= f: the flakes alone (exact);
+//  - with lobes: the flakes and the lobes blended over (f, a), the lobes alone over [a, b], the
+//    lobes and the pyramid blended over (b, p);
+//  - without lobes: the flakes and the pyramid blended over (f, p);
+//  - sigma >= p: the pyramid alone.
+// A blend is (1 - t) lower + t upper, t linear in log sigma across the band. eval, average, image
+// and mass blend linearly; sample picks a path in proportion to its weighted mass, so pdf = blended
+// eval / blended mass exactly as for the other paths.
 #pragma once
 
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/lobe_ndf.h>
 #include <glintbake/runtime/ndf_source.h>
 
 #include <memory>
 
 namespace glintbake::runtime {
 
-// Reads and checks the flakes section (index `section` of the reader) and builds its evaluator at
-// image resolution `resolution`. kInvalidAsset for a record the check refuses or non-finite
-// normals, kOutOfMemory. Safe on untrusted input.
-Status loadFlakes(const format::Reader& reader, int section, int resolution, std::unique_ptr<FlakeNdf>* flakes,
-                  format::FlakesRecord* record);
+// The evaluators of a flakes section.
+struct FlakePaths {
+  std::unique_ptr<FlakeNdf> flakes;
+  std::unique_ptr<LobeNdf> lobes;  // null when the record has no clustered path
+  format::FlakesRecord record;
+};
 
-// An NDF source that answers small footprints from the flakes and the others from a pyramid.
+// Reads and checks the flakes section (index `section` of the reader) and builds its evaluators
+// at image resolution `resolution`. kInvalidAsset for a record the check refuses or non-finite
+// normals, kOutOfMemory. Safe on untrusted input.
+Status loadFlakes(const format::Reader& reader, int section, int resolution, FlakePaths* paths);
+
+// An NDF source that answers small footprints from the flakes, mid-size ones from the clustered
+// lobes (when present) and the others from a pyramid.
 class HandoverNdf final : public NdfSource {
  public:
-  HandoverNdf(std::unique_ptr<FlakeNdf> flakes, std::unique_ptr<NdfSource> pyramid, double flakes_up_to,
-              double pyramid_from);
+  HandoverNdf(FlakePaths paths, std::unique_ptr<NdfSource> pyramid);
 
   format::AssetKind kind() const override { return pyramid_->kind(); }
   int resolution() const override { return pyramid_->resolution(); }
-  // The pyramid's range, with the flakes exact up to flakes_up_to and the band up to pyramid_from.
+  // The pyramid's range with the exact, clustered and hand-over bounds of the paths.
   FootprintRange footprintRange() const override;
   MapSize mapSize() const override { return pyramid_->mapSize(); }
   MapWrap wrap() const override { return pyramid_->wrap(); }
@@ -42,14 +53,20 @@ class HandoverNdf final : public NdfSource {
   Status image(const Footprint& footprint, float* out, size_t out_count) const override;
 
  private:
-  // Weight of the pyramid for a footprint: 0 on the flakes' side, 1 on the pyramid's.
-  double pyramidWeight(double sigma) const;
+  // The two paths of a footprint and the weight t of the upper one (t = 0: the lower alone, no
+  // upper; t = 1: the upper alone).
+  struct Mix {
+    const AccumulatingNdfSource* lower;
+    const NdfSource* upper;
+    double t;
+  };
+  Mix mixFor(double sigma) const;
   template <typename Query>
   Status blend(const Footprint& footprint, double* value, Query&& query) const;
 
-  std::unique_ptr<FlakeNdf> flakes_;
+  FlakePaths paths_;
   std::unique_ptr<NdfSource> pyramid_;
-  double flakes_up_to_, pyramid_from_, inv_log_band_;
+  double flakes_up_to_, lobes_from_, lobes_up_to_, pyramid_from_;
 };
 
 }  // namespace glintbake::runtime

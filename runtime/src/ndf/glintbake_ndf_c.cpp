@@ -104,6 +104,14 @@ int32_t gb_ndf_asset_footprint_range(const gb_ndf_asset* a, double* exact_max, d
   return GB_OK;
 }
 
+int32_t gb_ndf_asset_clustered_range(const gb_ndf_asset* a, double* clustered_min, double* clustered_max) {
+  if (!a) return GB_INVALID_ARGUMENT;
+  const glintbake::runtime::FootprintRange r = a->source->footprintRange();
+  if (clustered_min) *clustered_min = r.clustered_min_sigma;
+  if (clustered_max) *clustered_max = r.clustered_max_sigma;
+  return GB_OK;
+}
+
 int32_t gb_ndf_asset_eval(const gb_ndf_asset* a, double x, double y, double sigma, double sx, double sy,
                           double* value) {
   if (!a) return GB_INVALID_ARGUMENT;

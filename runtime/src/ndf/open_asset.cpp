@@ -38,11 +38,11 @@ Status loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
 Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   const int idx = reader.find(format::kSectionFlakes, 0);
   if (idx < 0) return Status::kOk;
-  std::unique_ptr<FlakeNdf> flakes;
-  format::FlakesRecord rec;
-  Status s = loadFlakes(reader, idx, (*out)->resolution(), &flakes, &rec);
+  FlakePaths paths;
+  Status s = loadFlakes(reader, idx, (*out)->resolution(), &paths);
   // The flakes must be those of the pyramid's map.
   const MapSize size = (*out)->mapSize();
+  const format::FlakesRecord& rec = paths.record;
   if (s == Status::kOk && (int64_t(rec.map_width) != size.width || int64_t(rec.map_height) != size.height ||
                            rec.wrap != uint32_t((*out)->wrap())))
     s = Status::kInvalidAsset;
@@ -50,8 +50,7 @@ Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* ou
     out->reset();
     return s;
   }
-  std::unique_ptr<NdfSource> handover(
-      new (std::nothrow) HandoverNdf(std::move(flakes), std::move(*out), rec.flakes_up_to, rec.pyramid_from));
+  std::unique_ptr<NdfSource> handover(new (std::nothrow) HandoverNdf(std::move(paths), std::move(*out)));
   if (!handover) {
     out->reset();
     return Status::kOutOfMemory;

@@ -39,7 +39,7 @@ std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
   if (with_flakes) {
     EXPECT_TRUE(
-        bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0), nullptr)
+        bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0, 0), nullptr)
             .ok());
   }
   EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);

@@ -26,7 +26,11 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& r
       app.add_option("--region", o.region_size, region_help)->capture_default_str(),
       app.add_flag("!--no-flakes", p.flakes,
                    "Leave out the flakes section (the normal map, float32) that answers footprints up to "
-                   "max(4, sigma0) texels exactly"),
+                   "4 texels exactly and mid-size ones from clustered lobes"),
+      app.add_option("--lobes", p.lobes,
+                     "Lobes per tile of the clustered path between the flakes and the pyramid (0..16; 0: the "
+                     "flakes hand over to the pyramid at max(4, sigma0))")
+          ->capture_default_str(),
   };
 }
 
@@ -43,6 +47,7 @@ void resolvePyramidOptions(PyramidCliOptions& p) {
     }
   }
   check(bake::ndf::validatePyramidOptions(p.options));
+  if (p.lobes < 0 || p.lobes > bake::ndf::kMaxLobesPerTile) throw Error(kExitBadArguments, "--lobes must be in [0, 16]");
 }
 
 Json pyramidOptionsJson(const PyramidCliOptions& p) {
@@ -58,16 +63,29 @@ Json pyramidOptionsJson(const PyramidCliOptions& p) {
   j["region"] = o.region_size;
   j["footprint_truncation"] = o.splat.footprint_truncation;
   j["flakes"] = p.flakes;
+  j["lobes"] = p.lobes;
   return j;
 }
 
-uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p) {
+bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& p) {
+  return bake::ndf::defaultHandover(p.options.sigma0, p.lobes);
+}
+
+uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p,
+                     const bake::ndf::FlakesHandover& handover) {
   if (!p.flakes) return 0;
   uint64_t bytes = 0;
-  const bake::Status s = bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r,
-                                                       bake::ndf::defaultHandover(p.options.sigma0), &bytes);
+  const bake::Status s =
+      bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r, handover, &bytes);
   if (!s) throw Error(int(s.error().code), s.error().message);
   return bytes;
+}
+
+Json flakesJson(const bake::ndf::FlakesHandover& h, uint64_t bytes) {
+  Json j = {{"up_to", h.flakes_up_to}, {"pyramid_from", h.pyramid_from}, {"bytes", bytes}};
+  j["lobes_per_tile"] = h.lobes_per_tile;
+  if (h.lobes_per_tile > 0) j["lobes_up_to"] = h.lobes_up_to;
+  return j;
 }
 
 void requireBakeableMap(const bake::NormalMap& map, const std::string& path) {

@@ -43,7 +43,7 @@ namespace glintbake::runtime {
 // larger footprints return kInvalidArgument (answer them from a pyramid).
 constexpr int64_t kMaxFlakeWindow = 4096;
 
-class FlakeNdf final : public NdfSource {
+class FlakeNdf final : public AccumulatingNdfSource {
  public:
   FlakeNdf();
   ~FlakeNdf() override;
@@ -73,9 +73,7 @@ class FlakeNdf final : public NdfSource {
   Status mass(const Footprint& footprint, double* value) const override;
   // Cost: every flake of the window (no pruning by s); a few milliseconds at sigma_p = 8 texels.
   Status image(const Footprint& footprint, float* out, size_t out_count) const override;
-  // Adds weight * image() to out (R * R floats); bins whose centre lies outside the unit disk are
-  // left as they are. For blending with another source's image without a second buffer.
-  Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const;
+  Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
   struct Impl;

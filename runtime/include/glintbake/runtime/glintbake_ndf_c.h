@@ -57,6 +57,10 @@ int32_t gb_ndf_asset_map(const gb_ndf_asset* asset, int32_t* width, int32_t* hei
 int32_t gb_ndf_asset_footprint_range(const gb_ndf_asset* asset, double* exact_max, double* handover_max,
                                      double* pyramid_min, double* pyramid_max);
 
+/* The footprints the clustered lobes answer alone (both 0: no clustered path); the flakes hand over
+ * to them from exact_max, and they to the pyramid up to handover_max. Any pointer may be NULL. */
+int32_t gb_ndf_asset_clustered_range(const gb_ndf_asset* asset, double* clustered_min, double* clustered_max);
+
 int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
                           double* value);
 int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0, double sy0,

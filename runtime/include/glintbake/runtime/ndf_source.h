@@ -37,6 +37,12 @@ struct FootprintRange {
   // Between exact_max_sigma and this the exact path and the pyramid are blended (linearly in
   // log sigma); from here on the pyramid answers alone (0: no hand-over band).
   double handover_max_sigma = 0.0;
+  // Footprints answered by the clustered lobes (lobe_ndf.h) alone: [clustered_min_sigma,
+  // clustered_max_sigma]; the exact path hands over to them across [exact_max_sigma,
+  // clustered_min_sigma], and they to the pyramid across [clustered_max_sigma, handover_max_sigma].
+  // Both 0: no clustered path.
+  double clustered_min_sigma = 0.0;
+  double clustered_max_sigma = 0.0;
 };
 
 // Texels of the source normal map, and how positions outside it are read (formats/SPEC.md 9).
@@ -72,6 +78,15 @@ class NdfSource {
   virtual Status mass(const Footprint& footprint, double* value) const = 0;
   // The R x R image of eval() (bin averages, row 0 at s_y = +1); out_count >= R * R.
   virtual Status image(const Footprint& footprint, float* out, size_t out_count) const = 0;
+};
+
+// An NDF source whose image can be added, scaled, into a caller's buffer (the flakes and the
+// clustered lobes), so that an asset blends two paths across a hand-over without a second buffer.
+class AccumulatingNdfSource : public NdfSource {
+ public:
+  // Adds weight * image() to out (R * R floats); bins whose centre lies outside the unit disk are
+  // left as they are.
+  virtual Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const = 0;
 };
 
 // Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf), chosen by the container's

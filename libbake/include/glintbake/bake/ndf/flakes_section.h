@@ -11,17 +11,35 @@
 
 namespace glintbake::bake::ndf {
 
-// Footprints (std, texels) the flakes answer alone, and from which the pyramid answers alone; the
-// two are blended linearly in log(sigma) in between.
+// Footprints (std, texels) the flakes answer alone, the clustered lobes alone (from sqrt(2) x
+// flakes_up_to to lobes_up_to) and the pyramid alone (from pyramid_from); neighbouring paths are
+// blended linearly in log(sigma) in between. lobes_per_tile 0: no clustered path, the flakes hand
+// over to the pyramid directly.
 struct FlakesHandover {
   double flakes_up_to = 0.0;
+  int lobes_per_tile = 0;
+  double lobes_up_to = 0.0;
   double pyramid_from = 0.0;
 };
 
-// The default hand-over for a pyramid whose finest level has footprint std sigma0 (texels): the
-// flakes answer every footprint up to max(4, sigma0), where the finest level is exact, and the
-// pyramid takes over across a band of half an octave (to sqrt(2) times that).
-FlakesHandover defaultHandover(double sigma0);
+// Lobes per tile of the clustered path: the default and the largest (formats/SPEC.md 10.5).
+constexpr int kDefaultLobesPerTile = 16;
+constexpr int kMaxLobesPerTile = 16;
+
+// The hand-over for a pyramid whose finest level has footprint std sigma0 (texels) and is faithful
+// from there on (an uncompressed pyramid). With lobes (1..16 per tile): the flakes answer up to 4
+// texels, the lobes from 4 sqrt(2) and hand over to the pyramid across the half octave below
+// sigma0. Without (lobes_per_tile 0): the flakes answer up to max(4, sigma0) and the pyramid takes
+// over across a half octave above that.
+FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
+
+// The hand-over for a compressed pyramid: level_sigmas[l] is the footprint std of level l and
+// level_errors[l] the relative error of its compression. The pyramid answers from the first level
+// from which every level's error is at most max_level_error; the lobes answer below it, down to
+// 4 sqrt(2) texels. When no such level exists the lobes answer every footprint they can (the
+// runtime bounds them by their window) and the pyramid only above.
+FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
+                                  double max_level_error, int lobes_per_tile);
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
 // mode, rate (1..16) and sigma_r, and the hand-over. The record is checked by

@@ -74,6 +74,7 @@ Status validateTensorPackOptions(const TensorPackOptions& options);
 struct TensorPackLevelReport {
   int level = 0;
   int grid_width = 0, grid_height = 0;
+  double sigma = 0.0;  // footprint std of the level, texels
   uint64_t groups = 0;
   uint64_t blocks_kept = 0;
   uint64_t blocks_dropped = 0;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
@@ -18,6 +19,7 @@ struct PyramidCliOptions {
   bake::ndf::PyramidOptions options;
   std::string levels_text = "auto";  // "auto" or a positive integer; resolvePyramidOptions fills options.levels
   bool flakes = true;                // write the flakes section (formats/SPEC.md 10.5); --no-flakes
+  int lobes = bake::ndf::kDefaultLobesPerTile;  // lobes per tile of the clustered path; --lobes
   std::vector<CLI::Option*> flags;   // the registered options (to reject them where they do not apply)
 };
 
@@ -30,9 +32,16 @@ void resolvePyramidOptions(PyramidCliOptions& pyramid);
 // Canonical JSON form of the options (for provenance metadata and --json reports).
 Json pyramidOptionsJson(const PyramidCliOptions& pyramid);
 
-// Writes the flakes section of the map (unless --no-flakes) with the default hand-over for the
-// pyramid's sigma0; returns its raw size in bytes (0 when left out). Error exit 4 on failure.
-uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& pyramid);
+// The hand-over of an uncompressed pyramid with these options (--sigma0, --lobes).
+bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& pyramid);
+
+// Writes the flakes section of the map (unless --no-flakes) with this hand-over; returns its raw
+// size in bytes (0 when left out). Error exit 4 on failure.
+uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& pyramid,
+                     const bake::ndf::FlakesHandover& handover);
+
+// The hand-over and size of a flakes section as the tools report them (metadata and --json).
+Json flakesJson(const bake::ndf::FlakesHandover& handover, uint64_t bytes);
 
 // Rejects maps too small to bake (exit 3, naming the file and its size).
 void requireBakeableMap(const bake::NormalMap& map, const std::string& path);

@@ -1,0 +1,86 @@
+// The P-NDF of mid-size footprints from clustered position-normal lobes: a hierarchy over tiles
+// of a normal map's flakes in which every tile keeps a few 4D Gaussians in (position, normal) that
+// stand for all of its flakes (formats/SPEC.md 10.5).
+//
+// A flake of the exact path (flake_ndf.h) is itself a 4D Gaussian: position u ~ N(u_k, sigma_h^2 I)
+// and normal s = n_k + J_k (u - u_k) + N(0, sigma_r^2 I), so that its covariance is
+//   S_uu = sigma_h^2 I,  S_su = sigma_h^2 J_k,  S_ss = sigma_r^2 I + sigma_h^2 J_k J_k^T
+// (Yan et al. 2016, "Position-Normal Distributions for Efficient Rendering of Specular
+// Microstructure", section 4). A group of flakes is replaced by the Gaussian with the group's
+// weight, mean and covariance (the moments of the mixture, so a group keeps exactly the first two
+// moments of its flakes, and a group of one flake is that flake). Seen through a Gaussian footprint
+// of std sigma_p centred at u_Q, a lobe with weight W, mean (c, m) and covariance S contributes
+//   W N(u_Q; c, A) N(s; m + S_su A^-1 (u_Q - c), S_ss - S_su A^-1 S_us),   A = S_uu + sigma_p^2 I,
+// which is the exact closed form of flake_ndf.h for a single flake.
+//
+// The hierarchy: level 0 tiles hold 4 x 4 flakes, every level doubles the tile side up to the
+// whole map. A tile of level 0 groups its flakes, a tile above groups the lobes of its four
+// children, each into at most `lobes_per_tile` lobes by k-means (deterministic farthest-point
+// seeds, four Lloyd passes) on the lobe normal means and spreads (the std of a lobe's normals, so
+// that the narrow inside of a flake and its wide edges stay apart), then moment matching. A
+// footprint is answered on the level whose tiles are at most half its std (so the footprint weight
+// varies little across a tile and 12-24 tiles span the window per side), from every lobe within
+// 3 standard deviations of the footprint centre; tiles whose lobes cannot reach s are skipped.
+// The cost is then about constant in the footprint size: a few thousand lobes per query.
+//
+// What it gives up against the exact path: the shape of each group beyond its covariance. It is
+// close where a tile's flakes form a few tight groups (sharp flakes, scratches) or vary smoothly,
+// and measured against the reference evaluator by scripts/fidelity.py (README, "Figures").
+//
+// Queries follow the NdfSource contract as the exact path does (eval the sum of the lobes, average
+// and image their exact integrals over rectangles and bins, mass the sum of the footprint weights,
+// sample a lobe by weight then its Gaussian with pdf = eval / mass). Queries never allocate, never
+// throw and are thread-safe (const).
+#pragma once
+
+#include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/texel_source.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace glintbake::runtime {
+
+// Lobes a tile keeps at most (the width of the evaluator's blocks).
+constexpr int kMaxLobesPerTile = 16;
+
+class LobeNdf final : public AccumulatingNdfSource {
+ public:
+  LobeNdf();
+  ~LobeNdf() override;
+  LobeNdf(const LobeNdf&) = delete;
+  LobeNdf& operator=(const LobeNdf&) = delete;
+
+  // Builds the lobe hierarchy from a texel source with the flake model of flake_ndf.h: rate flakes
+  // per texel side (1..16), intrinsic roughness sigma_r in (0, 1], lobes_per_tile in
+  // [1, kMaxLobesPerTile], image resolution R (2..4096). Memory: about 80 bytes per flake (at 16
+  // lobes per tile, where level 0 keeps every flake). kInvalidArgument for parameters out of range, non-finite normals or a source
+  // larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
+  Status build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution);
+  bool isBuilt() const;
+
+  format::AssetKind kind() const override { return format::AssetKind::kUnknown; }
+  int resolution() const override;
+  // The footprints the hierarchy answers: up to where its window would span more than 40 tiles of
+  // the top level per side (clustered_max_sigma); larger footprints return kInvalidArgument.
+  FootprintRange footprintRange() const override;
+  MapSize mapSize() const override;
+  MapWrap wrap() const override;
+  // Tile side (flakes) of the level that answers a footprint of this sigma.
+  int tileFor(double sigma) const;
+
+  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  Status mass(const Footprint& footprint, double* value) const override;
+  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+  Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glintbake::runtime

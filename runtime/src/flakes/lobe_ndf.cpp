@@ -1,0 +1,653 @@
+// Clustered position-normal lobes for mid-size footprints (see lobe_ndf.h).
+#include <glintbake/runtime/lobe_ndf.h>
+
+#include "../heap_array.h"
+#include "../pyramid_blend.h"
+#include "flake_model.h"
+#include "float4.h"
+#include "gaussian_rect.h"
+
+#include <algorithm>
+#include <cmath>
+#include <new>
+
+namespace glintbake::runtime {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+constexpr int kLanes = kMaxLobesPerTile;
+constexpr int kFinestTile = 4;         // flakes per side of a level-0 tile
+constexpr double kTileRatio = 0.5;     // a footprint is answered on tiles of at most this x its std
+// Spatial truncation, in standard deviations of a lobe's footprint weight: the lobes beyond hold
+// about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
+constexpr double kWindowSigmas = 3.0;
+constexpr double kMaxSpatial = kWindowSigmas * kWindowSigmas / 2;
+constexpr double kMaxExponent = 18.0;  // lobes below e^-18 of their peak at s are left out
+constexpr int kMaxWindowTiles = 40;    // tiles per side of a window at most
+constexpr int kLloydPasses = 4;
+constexpr int kMaxSide = 1 << 16;
+constexpr uint64_t kMaxFlakes = uint64_t(1) << 30;
+constexpr float kPaddingPosition = 1e15f;  // position of unused lanes: weight 0
+
+// A 4D Gaussian in (position u, normal s) while the hierarchy is built: weight, means, and the
+// covariance blocks uu {xx, xy, yy}, su {s_x u_x, s_x u_y, s_y u_x, s_y u_y}, ss {xx, xy, yy}.
+struct Gauss4 {
+  double w;
+  double c[2], m[2];
+  double uu[3], su[4], ss[3];
+};
+
+// The lobes of one tile, one lane each (structure of arrays for the four-lane loop). Positions
+// are relative to the tile's origin, in texels.
+struct Block {
+  float w[kLanes], cx[kLanes], cy[kLanes], mx[kLanes], my[kLanes];
+  float uxx[kLanes], uxy[kLanes], uyy[kLanes];
+  float s00[kLanes], s01[kLanes], s10[kLanes], s11[kLanes];
+  float sxx[kLanes], sxy[kLanes], syy[kLanes];
+};
+
+// Bounds over a tile's lobes for skipping it: the box of the normal means, the largest Frobenius
+// norm of S_su, the largest trace of S_ss and of S_uu.
+struct Bound {
+  float lo[2], hi[2];
+  float su, ss, uu;
+  uint32_t count;
+};
+
+struct Level {
+  int tile = 0;  // flakes per side
+  int tiles_x = 0, tiles_y = 0;
+  size_t first = 0;  // index of its first block
+};
+
+// The moments of the mixture of items[idx[0..n)] (n >= 1).
+Gauss4 momentMatch(const Gauss4* items, const int* idx, int n) {
+  Gauss4 g{};
+  for (int a = 0; a < n; ++a) {
+    const Gauss4& x = items[idx[a]];
+    g.w += x.w;
+    for (int d = 0; d < 2; ++d) {
+      g.c[d] += x.w * x.c[d];
+      g.m[d] += x.w * x.m[d];
+    }
+  }
+  const double inv = 1.0 / g.w;
+  for (int d = 0; d < 2; ++d) {
+    g.c[d] *= inv;
+    g.m[d] *= inv;
+  }
+  for (int a = 0; a < n; ++a) {
+    const Gauss4& x = items[idx[a]];
+    const double dc[2] = {x.c[0] - g.c[0], x.c[1] - g.c[1]}, dm[2] = {x.m[0] - g.m[0], x.m[1] - g.m[1]};
+    const double f = x.w * inv;
+    g.uu[0] += f * (x.uu[0] + dc[0] * dc[0]);
+    g.uu[1] += f * (x.uu[1] + dc[0] * dc[1]);
+    g.uu[2] += f * (x.uu[2] + dc[1] * dc[1]);
+    g.su[0] += f * (x.su[0] + dm[0] * dc[0]);
+    g.su[1] += f * (x.su[1] + dm[0] * dc[1]);
+    g.su[2] += f * (x.su[2] + dm[1] * dc[0]);
+    g.su[3] += f * (x.su[3] + dm[1] * dc[1]);
+    g.ss[0] += f * (x.ss[0] + dm[0] * dm[0]);
+    g.ss[1] += f * (x.ss[1] + dm[0] * dm[1]);
+    g.ss[2] += f * (x.ss[2] + dm[1] * dm[1]);
+  }
+  return g;
+}
+
+// Where k-means places a lobe: its normal mean and its spread (the std of its normals), so that
+// narrow and wide lobes of the same mean (the inside of a flake and its edges) stay apart.
+struct Feature {
+  double v[3];
+};
+Feature featureOf(const Gauss4& a) { return {{a.m[0], a.m[1], std::sqrt(std::max(a.ss[0] + a.ss[2], 0.0))}}; }
+double distance2(const Feature& a, const double* c) {
+  const double dx = a.v[0] - c[0], dy = a.v[1] - c[1], dz = a.v[2] - c[2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+// Groups items[0..n) (weights > 0) into at most k lobes: k-means on the normal means, seeded with
+// the heaviest item and then the items farthest from every seed (ties to the lower index), then the
+// moments of every group. Writes the lobes to out and returns their count.
+int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
+  constexpr int kMaxItems = 4 * kLanes * kLanes;
+  if (n <= k) {
+    for (int i = 0; i < n; ++i) out[i] = items[i];
+    return n;
+  }
+  Feature f[kMaxItems];
+  for (int i = 0; i < n; ++i) f[i] = featureOf(items[i]);
+  double centre[kLanes][3];
+  int seeds = 0, heaviest = 0;
+  for (int i = 1; i < n; ++i)
+    if (items[i].w > items[heaviest].w) heaviest = i;
+  auto seed = [&](int i) {
+    for (int d = 0; d < 3; ++d) centre[seeds][d] = f[i].v[d];
+    ++seeds;
+  };
+  seed(heaviest);
+  double nearest[kMaxItems];
+  for (int i = 0; i < n; ++i) nearest[i] = distance2(f[i], centre[0]);
+  while (seeds < k) {
+    int far = -1;
+    for (int i = 0; i < n; ++i)
+      if (nearest[i] > 0.0 && (far < 0 || nearest[i] > nearest[far])) far = i;
+    if (far < 0) break;  // every item sits on a seed
+    seed(far);
+    for (int i = 0; i < n; ++i) nearest[i] = std::min(nearest[i], distance2(f[i], centre[seeds - 1]));
+  }
+  int group[kMaxItems];
+  for (int pass = 0; pass <= kLloydPasses; ++pass) {
+    for (int i = 0; i < n; ++i) {
+      int best = 0;
+      double bd = distance2(f[i], centre[0]);
+      for (int c = 1; c < seeds; ++c) {
+        const double d = distance2(f[i], centre[c]);
+        if (d < bd) bd = d, best = c;
+      }
+      group[i] = best;
+    }
+    if (pass == kLloydPasses) break;
+    double sum[kLanes][4] = {};
+    for (int i = 0; i < n; ++i) {
+      for (int d = 0; d < 3; ++d) sum[group[i]][d] += items[i].w * f[i].v[d];
+      sum[group[i]][3] += items[i].w;
+    }
+    for (int c = 0; c < seeds; ++c)
+      if (sum[c][3] > 0.0)
+        for (int d = 0; d < 3; ++d) centre[c][d] = sum[c][d] / sum[c][3];
+  }
+  int idx[kMaxItems];
+  int count = 0;
+  for (int c = 0; c < seeds; ++c) {
+    int members = 0;
+    for (int i = 0; i < n; ++i)
+      if (group[i] == c) idx[members++] = i;
+    if (members > 0) out[count++] = momentMatch(items, idx, members);
+  }
+  return count;
+}
+
+// The footprint terms of one query: centre (reduced into the map for repeating maps), sigma_p^2,
+// the answering level and the window.
+struct Terms {
+  double ux, uy, sp2;
+  const Level* level;
+  double tile_texels;
+  double reach;
+};
+
+}  // namespace
+
+struct LobeNdf::Impl {
+  int width = 0, height = 0, rate = 1, fine_w = 0, fine_h = 0;
+  bool repeat = true;
+  double step = 1.0, sigma_h2 = 0.0, sigma_r2 = 0.0;
+  int res = 128, lobes = kLanes;
+  Level levels[20];
+  int level_count = 0;
+  Array<Block> blocks;
+  Array<Bound> bounds;
+
+  Status build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in);
+  void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
+  void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
+  int levelFor(double sigma) const;
+  bool terms(const Footprint& fp, Terms* t) const;
+  // Calls visit(block, bound, base_x, base_y) for every tile of the window within the spatial
+  // truncation, base = u_Q - the origin of the tile's periodic image.
+  template <typename Visit>
+  void forEachTile(const Terms& t, Visit&& visit) const;
+  // Calls visit(lobe, weight) for every lane of the block within the spatial truncation, with the
+  // footprint-conditioned s-plane lobe and its footprint weight.
+  template <typename Visit>
+  void forEachLobe(const Block& b, const Bound& bound, double bx, double by, double sp2, Visit&& visit) const;
+  double evalAt(const Terms& t, double sx, double sy) const;
+  double massOf(const Terms& t) const;
+};
+
+Status LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in) {
+  width = src.width();
+  height = src.height();
+  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return Status::kInvalidArgument;
+  if (rate_in < 1 || rate_in > 16 || !(sigma_r > 0.0 && sigma_r <= 1.0) || lobes_in < 1 || lobes_in > kLanes ||
+      res_in < 2 || res_in > 4096)
+    return Status::kInvalidArgument;
+  if (uint64_t(width) * uint64_t(height) * uint64_t(rate_in) * uint64_t(rate_in) > kMaxFlakes)
+    return Status::kInvalidArgument;
+  rate = rate_in;
+  repeat = src.repeats();
+  res = res_in;
+  lobes = lobes_in;
+  sigma_r2 = sigma_r * sigma_r;
+  step = 1.0 / rate;
+  const double sigma_h = step * 1.5 / std::sqrt(12.0);
+  sigma_h2 = sigma_h * sigma_h;
+  fine_w = width * rate;
+  fine_h = height * rate;
+
+  size_t total = 0;
+  for (int tile = kFinestTile;; tile *= 2) {
+    Level& l = levels[level_count++];
+    l.tile = tile;
+    l.tiles_x = (fine_w + tile - 1) / tile;
+    l.tiles_y = (fine_h + tile - 1) / tile;
+    l.first = total;
+    total += size_t(l.tiles_x) * size_t(l.tiles_y);
+    if (l.tiles_x == 1 && l.tiles_y == 1) break;
+  }
+  Array<float> normals;
+  if (!normals.allocate(size_t(width) * size_t(height) * 2) || !blocks.allocate(total) || !bounds.allocate(total))
+    return Status::kOutOfMemory;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      float* n = normals.data + (size_t(y) * size_t(width) + size_t(x)) * 2;
+      src.normal(x, y, n);
+      if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return Status::kInvalidArgument;
+    }
+  }
+  // Level 0: the flakes of every tile as 4D Gaussians, grouped.
+  const double area = step * step;
+  Gauss4 items[4 * kLanes * kLanes], grouped[kLanes];
+  const Level& l0 = levels[0];
+  for (int ty = 0; ty < l0.tiles_y; ++ty) {
+    for (int tx = 0; tx < l0.tiles_x; ++tx) {
+      int n = 0;
+      for (int fy = ty * kFinestTile; fy < std::min(fine_h, (ty + 1) * kFinestTile); ++fy) {
+        for (int fx = tx * kFinestTile; fx < std::min(fine_w, (tx + 1) * kFinestTile); ++fx) {
+          float nk[2], jk[4];
+          flakes::flakeAt(normals.data, width, height, repeat, (fx + 0.5) * step, (fy + 0.5) * step, nk, jk);
+          Gauss4& g = items[n++];
+          g.w = area;
+          g.c[0] = (fx - tx * kFinestTile + 0.5) * step;
+          g.c[1] = (fy - ty * kFinestTile + 0.5) * step;
+          g.m[0] = nk[0];
+          g.m[1] = nk[1];
+          g.uu[0] = sigma_h2;
+          g.uu[1] = 0.0;
+          g.uu[2] = sigma_h2;
+          for (int a = 0; a < 4; ++a) g.su[a] = sigma_h2 * double(jk[a]);
+          g.ss[0] = sigma_r2 + sigma_h2 * (double(jk[0]) * jk[0] + double(jk[1]) * jk[1]);
+          g.ss[1] = sigma_h2 * (double(jk[0]) * jk[2] + double(jk[1]) * jk[3]);
+          g.ss[2] = sigma_r2 + sigma_h2 * (double(jk[2]) * jk[2] + double(jk[3]) * jk[3]);
+        }
+      }
+      storeTile(l0.first + size_t(ty) * size_t(l0.tiles_x) + size_t(tx), grouped, clusterLobes(items, n, lobes, grouped));
+    }
+  }
+  // Every level above: the lobes of the four children, grouped again.
+  for (int li = 1; li < level_count; ++li) {
+    const Level& l = levels[li];
+    for (int ty = 0; ty < l.tiles_y; ++ty) {
+      for (int tx = 0; tx < l.tiles_x; ++tx) {
+        int n = 0;
+        gatherChildren(levels[li - 1], tx, ty, items, &n);
+        storeTile(l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx), grouped,
+                  clusterLobes(items, n, lobes, grouped));
+      }
+    }
+  }
+  return Status::kOk;
+}
+
+// The lobes of the (up to four) children of tile (tx, ty) of the level above `child`, positions
+// relative to the parent's origin.
+void LobeNdf::Impl::gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const {
+  int n = 0;
+  const double side = child.tile * step;
+  for (int cy = 2 * ty; cy < std::min(child.tiles_y, 2 * ty + 2); ++cy) {
+    for (int cx = 2 * tx; cx < std::min(child.tiles_x, 2 * tx + 2); ++cx) {
+      const size_t index = child.first + size_t(cy) * size_t(child.tiles_x) + size_t(cx);
+      const Block& b = blocks.data[index];
+      const double ox = (cx - 2 * tx) * side, oy = (cy - 2 * ty) * side;
+      for (uint32_t i = 0; i < bounds.data[index].count; ++i) {
+        Gauss4& g = out[n++];
+        g.w = b.w[i];
+        g.c[0] = ox + b.cx[i];
+        g.c[1] = oy + b.cy[i];
+        g.m[0] = b.mx[i];
+        g.m[1] = b.my[i];
+        g.uu[0] = b.uxx[i];
+        g.uu[1] = b.uxy[i];
+        g.uu[2] = b.uyy[i];
+        g.su[0] = b.s00[i];
+        g.su[1] = b.s01[i];
+        g.su[2] = b.s10[i];
+        g.su[3] = b.s11[i];
+        g.ss[0] = b.sxx[i];
+        g.ss[1] = b.sxy[i];
+        g.ss[2] = b.syy[i];
+      }
+    }
+  }
+  *count = n;
+}
+
+void LobeNdf::Impl::storeTile(size_t index, const Gauss4* g, int count) {
+  Block& b = blocks.data[index];
+  Bound& d = bounds.data[index];
+  d.lo[0] = d.lo[1] = 1e30f;
+  d.hi[0] = d.hi[1] = -1e30f;
+  d.su = d.ss = d.uu = 0.0f;
+  d.count = uint32_t(count);
+  for (int i = 0; i < kLanes; ++i) {
+    const bool used = i < count;
+    const Gauss4 x = used ? g[i] : Gauss4{0.0, {0, 0}, {0, 0}, {1, 0, 1}, {0, 0, 0, 0}, {1, 0, 1}};
+    b.w[i] = float(x.w);
+    b.cx[i] = used ? float(x.c[0]) : kPaddingPosition;
+    b.cy[i] = used ? float(x.c[1]) : kPaddingPosition;
+    b.mx[i] = float(x.m[0]);
+    b.my[i] = float(x.m[1]);
+    b.uxx[i] = float(x.uu[0]);
+    b.uxy[i] = float(x.uu[1]);
+    b.uyy[i] = float(x.uu[2]);
+    b.s00[i] = float(x.su[0]);
+    b.s01[i] = float(x.su[1]);
+    b.s10[i] = float(x.su[2]);
+    b.s11[i] = float(x.su[3]);
+    b.sxx[i] = float(x.ss[0]);
+    b.sxy[i] = float(x.ss[1]);
+    b.syy[i] = float(x.ss[2]);
+    if (!used) continue;
+    for (int a = 0; a < 2; ++a) {
+      d.lo[a] = std::min(d.lo[a], float(x.m[a]));
+      d.hi[a] = std::max(d.hi[a], float(x.m[a]));
+    }
+    const double su = std::sqrt(x.su[0] * x.su[0] + x.su[1] * x.su[1] + x.su[2] * x.su[2] + x.su[3] * x.su[3]);
+    d.su = std::max(d.su, float(su * (1.0 + 1e-6)));
+    d.ss = std::max(d.ss, float((x.ss[0] + x.ss[2]) * (1.0 + 1e-6)));
+    d.uu = std::max(d.uu, float((x.uu[0] + x.uu[2]) * (1.0 + 1e-6)));
+  }
+}
+
+int LobeNdf::Impl::levelFor(double sigma) const {
+  const double want = kTileRatio * sigma * rate;
+  int l = 0;
+  while (l + 1 < level_count && double(levels[l + 1].tile) <= want) ++l;
+  return l;
+}
+
+bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
+  t->sp2 = fp.sigma * fp.sigma;
+  t->level = &levels[levelFor(fp.sigma)];
+  t->tile_texels = t->level->tile * step;
+  t->ux = fp.x;
+  t->uy = fp.y;
+  if (repeat) {
+    t->ux -= format::NdfBlendAxis::floorOf(t->ux / width) * width;
+    t->uy -= format::NdfBlendAxis::floorOf(t->uy / height) * height;
+  } else if (!(std::fabs(t->ux) < 1e15 && std::fabs(t->uy) < 1e15)) {
+    return false;
+  }
+  t->reach = kWindowSigmas * std::sqrt(t->sp2 + sigma_h2) + t->tile_texels;
+  return 2.0 * t->reach / t->tile_texels + 2.0 <= double(kMaxWindowTiles);
+}
+
+template <typename Visit>
+void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
+  const Level& l = *t.level;
+  const double side = t.tile_texels;
+  auto periods = [&](double u, double size, int64_t* p0, int64_t* p1) {
+    if (!repeat) {
+      *p0 = *p1 = 0;
+      return;
+    }
+    *p0 = int64_t(std::floor((u - t.reach) / size));
+    *p1 = int64_t(std::floor((u + t.reach) / size));
+  };
+  int64_t py0, py1, px0, px1;
+  periods(t.uy, double(height), &py0, &py1);
+  periods(t.ux, double(width), &px0, &px1);
+  const double inv_a = 1.0 / (t.sp2 + sigma_h2);
+  for (int64_t py = py0; py <= py1; ++py) {
+    const double oy = double(py) * height;
+    const double ly0 = t.uy - t.reach - oy, ly1 = t.uy + t.reach - oy;
+    const int ty0 = int(std::max(0.0, std::floor(ly0 / side))), ty1 = int(std::min(double(l.tiles_y - 1), std::floor(ly1 / side)));
+    for (int64_t px = px0; px <= px1; ++px) {
+      const double ox = double(px) * width;
+      const double lx0 = t.ux - t.reach - ox, lx1 = t.ux + t.reach - ox;
+      const int tx0 = int(std::max(0.0, std::floor(lx0 / side))), tx1 = int(std::min(double(l.tiles_x - 1), std::floor(lx1 / side)));
+      for (int ty = ty0; ty <= ty1; ++ty) {
+        const double by = t.uy - oy - ty * side;
+        const double dy = by < 0.0 ? -by : (by > side ? by - side : 0.0);
+        for (int tx = tx0; tx <= tx1; ++tx) {
+          const double bx = t.ux - ox - tx * side;
+          const double dx = bx < 0.0 ? -bx : (bx > side ? bx - side : 0.0);
+          const size_t index = l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx);
+          const Bound& bound = bounds.data[index];
+          if (bound.count == 0) continue;
+          // Smallest spatial exponent of the tile: A <= (sigma_p^2 + tr S_uu) I.
+          const double spatial_min = 0.5 * (dx * dx + dy * dy) / (t.sp2 + double(bound.uu));
+          if (spatial_min > kMaxSpatial) continue;
+          visit(blocks.data[index], bound, bx, by, spatial_min, inv_a);
+        }
+      }
+    }
+  }
+}
+
+template <typename Visit>
+void LobeNdf::Impl::forEachLobe(const Block& b, const Bound& bound, double bx, double by, double sp2,
+                                Visit&& visit) const {
+  for (uint32_t i = 0; i < bound.count; ++i) {
+    const double a00 = double(b.uxx[i]) + sp2, a01 = b.uxy[i], a11 = double(b.uyy[i]) + sp2;
+    const double det_a = a00 * a11 - a01 * a01;
+    const double i00 = a11 / det_a, i01 = -a01 / det_a, i11 = a00 / det_a;
+    const double dx = bx - double(b.cx[i]), dy = by - double(b.cy[i]);
+    const double gx = i00 * dx + i01 * dy, gy = i01 * dx + i11 * dy;
+    const double spatial = 0.5 * (dx * gx + dy * gy);
+    if (spatial > kMaxSpatial) continue;
+    const double s00 = b.s00[i], s01 = b.s01[i], s10 = b.s10[i], s11 = b.s11[i];
+    const double h00 = s00 * i00 + s01 * i01, h01 = s00 * i01 + s01 * i11;
+    const double h10 = s10 * i00 + s11 * i01, h11 = s10 * i01 + s11 * i11;
+    flakes::Lobe g;
+    g.mx = double(b.mx[i]) + s00 * gx + s01 * gy;
+    g.my = double(b.my[i]) + s10 * gx + s11 * gy;
+    g.cxx = std::max(double(b.sxx[i]) - (h00 * s00 + h01 * s01), 1e-12);
+    g.cxy = double(b.sxy[i]) - (h00 * s10 + h01 * s11);
+    g.cyy = std::max(double(b.syy[i]) - (h10 * s10 + h11 * s11), 1e-12);
+    const double lim = std::sqrt(g.cxx * g.cyy) * 0.999999;
+    g.cxy = std::clamp(g.cxy, -lim, lim);
+    visit(g, double(b.w[i]) * std::exp(-spatial) / (kTwoPi * std::sqrt(det_a)));
+  }
+}
+
+double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
+  using flakes::F4;
+  const F4 sp2 = F4::splat(float(t.sp2)), vsx = F4::splat(float(sx)), vsy = F4::splat(float(sy));
+  const F4 half = F4::splat(0.5f), two = F4::splat(2.0f), cutoff = F4::splat(float(kMaxExponent));
+  const F4 spatial_cut = F4::splat(float(kMaxSpatial)), tiny = F4::splat(1e-12f);
+  double sum = 0.0;
+  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double spatial_min, double inv_a) {
+    // The lobes' means lie within the box widened by |S_su A^-1 (u_Q - c)| and their covariance
+    // below tr S_ss: skip the tile when none can reach s.
+    const double ddx = std::fabs(bx) + t.tile_texels, ddy = std::fabs(by) + t.tile_texels;
+    const double shift = double(bound.su) * inv_a * std::sqrt(ddx * ddx + ddy * ddy);
+    const double ex = std::max(std::max(double(bound.lo[0]) - shift - sx, sx - double(bound.hi[0]) - shift), 0.0);
+    const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
+    if ((ex * ex + ey * ey) > 2.0 * (kMaxExponent - spatial_min) * double(bound.ss)) return;
+    const F4 vbx = F4::splat(float(bx)), vby = F4::splat(float(by));
+    F4 acc = F4::splat(0.0f);
+    for (uint32_t h = 0; h < bound.count; h += 4) {
+      const F4 a00 = F4::load(b.uxx + h) + sp2, a01 = F4::load(b.uxy + h), a11 = F4::load(b.uyy + h) + sp2;
+      const F4 det_a = a00 * a11 - a01 * a01;
+      const F4 inv = F4::splat(1.0f) / det_a;
+      const F4 i00 = a11 * inv, i01 = (F4::splat(0.0f) - a01) * inv, i11 = a00 * inv;
+      const F4 dx = vbx - F4::load(b.cx + h), dy = vby - F4::load(b.cy + h);
+      const F4 gx = i00 * dx + i01 * dy, gy = i01 * dx + i11 * dy;
+      const F4 spatial = half * (dx * gx + dy * gy);
+      if (!anyLess(spatial, spatial_cut)) continue;
+      const F4 s00 = F4::load(b.s00 + h), s01 = F4::load(b.s01 + h), s10 = F4::load(b.s10 + h),
+               s11 = F4::load(b.s11 + h);
+      const F4 h00 = s00 * i00 + s01 * i01, h01 = s00 * i01 + s01 * i11;
+      const F4 h10 = s10 * i00 + s11 * i01, h11 = s10 * i01 + s11 * i11;
+      const F4 cxx = max(F4::load(b.sxx + h) - (h00 * s00 + h01 * s01), tiny);
+      const F4 cxy = F4::load(b.sxy + h) - (h00 * s10 + h01 * s11);
+      const F4 cyy = max(F4::load(b.syy + h) - (h10 * s10 + h11 * s11), tiny);
+      const F4 det_c = max(cxx * cyy - cxy * cxy, tiny * tiny);
+      const F4 ex4 = vsx - (F4::load(b.mx + h) + s00 * gx + s01 * gy);
+      const F4 ey4 = vsy - (F4::load(b.my + h) + s10 * gx + s11 * gy);
+      const F4 q = (cyy * ex4 * ex4 - two * cxy * ex4 * ey4 + cxx * ey4 * ey4) / det_c;
+      const F4 e = spatial + half * q;
+      if (!anyLess(e, cutoff)) continue;
+      const F4 lane = F4::load(b.w + h) * flakes::expNeg4(e) / sqrt(det_a * det_c);
+      acc = acc + selectLess(spatial, spatial_cut, selectLess(e, cutoff, lane));
+    }
+    float lanes[4];
+    acc.store(lanes);
+    sum += (double(lanes[0]) + double(lanes[1])) + (double(lanes[2]) + double(lanes[3]));
+  });
+  return sum / (kTwoPi * kTwoPi);
+}
+
+double LobeNdf::Impl::massOf(const Terms& t) const {
+  double sum = 0.0;
+  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+    forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe&, double weight) { sum += weight; });
+  });
+  return sum;
+}
+
+LobeNdf::LobeNdf() = default;
+LobeNdf::~LobeNdf() = default;
+
+Status LobeNdf::build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution) {
+  impl_.reset();
+  auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
+  if (!impl) return Status::kOutOfMemory;
+  if (Status s = impl->build(source, rate, sigma_r, lobes_per_tile, resolution); s != Status::kOk) return s;
+  impl_ = std::move(impl);
+  return Status::kOk;
+}
+
+bool LobeNdf::isBuilt() const { return impl_ != nullptr; }
+int LobeNdf::resolution() const { return impl_ ? impl_->res : 0; }
+MapSize LobeNdf::mapSize() const { return impl_ ? MapSize{impl_->width, impl_->height} : MapSize{}; }
+MapWrap LobeNdf::wrap() const { return impl_ && !impl_->repeat ? MapWrap::kClamp : MapWrap::kRepeat; }
+int LobeNdf::tileFor(double sigma) const { return impl_ ? impl_->levels[impl_->levelFor(sigma)].tile : 0; }
+
+FootprintRange LobeNdf::footprintRange() const {
+  FootprintRange r;
+  if (!impl_) return r;
+  // The largest sigma whose window on the top level spans at most kMaxWindowTiles tiles per side:
+  // 2 (4 sqrt(sigma^2 + sigma_h^2) + side) / side + 2 <= kMaxWindowTiles.
+  const Impl& m = *impl_;
+  const double side = m.levels[m.level_count - 1].tile * m.step;
+  const double reach = (double(kMaxWindowTiles) - 2.0) * side / 2.0 - side;
+  r.clustered_min_sigma = 0.0;
+  r.clustered_max_sigma = std::floor(std::sqrt(std::max(0.0, reach * reach / (kWindowSigmas * kWindowSigmas) - m.sigma_h2)));
+  return r;
+}
+
+namespace {
+bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
+bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+}  // namespace
+
+Status LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+  Terms t;
+  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
+  return Status::kOk;
+}
+
+Status LobeNdf::mass(const Footprint& footprint, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint)) return Status::kInvalidArgument;
+  Terms t;
+  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  *value = impl_->massOf(t);
+  return Status::kOk;
+}
+
+Status LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+  Terms t;
+  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  const double m = impl_->massOf(t);
+  *value = (inSquare(s) && m > 0.0) ? impl_->evalAt(t, s.x, s.y) / m : 0.0;
+  return Status::kOk;
+}
+
+Status LobeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
+      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  Terms t;
+  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  double integral = 0.0;
+  if (x1 > x0 && y1 > y0) {
+    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+      m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double weight) {
+        integral += weight * flakes::lobeRectProbability(g, x0, x1, y0, y1);
+      });
+    });
+  }
+  *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return Status::kOk;
+}
+
+Status LobeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!impl_) return Status::kInvalidArgument;
+  const size_t n = size_t(impl_->res) * size_t(impl_->res);
+  if (!out || out_count < n) return Status::kInvalidArgument;
+  std::fill(out, out + n, 0.0f);
+  return addImage(footprint, 1.0, out, out_count);
+}
+
+Status LobeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
+  if (!impl_) return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  const size_t n = size_t(m.res) * size_t(m.res);
+  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight)) return Status::kInvalidArgument;
+  Terms t;
+  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  const double bin = 2.0 / m.res;
+  const double to_density = weight / (bin * bin);
+  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+    m.forEachLobe(b, bound, bx, by, t.sp2,
+                  [&](const flakes::Lobe& g, double w) { flakes::splatLobe(g, to_density * w, m.res, out); });
+  });
+  return Status::kOk;
+}
+
+Status LobeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+  if (!impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return Status::kInvalidArgument;
+  const Impl& m = *impl_;
+  Terms t;
+  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  const double total = m.massOf(t);
+  if (!(total > 0.0)) return Status::kInvalidArgument;
+  // A lobe in proportion to its weight (the same traversal as massOf), u1 rescaled within it.
+  double target = u1 * total, v1 = 0.5;
+  bool found = false;
+  flakes::Lobe picked{0.0, 0.0, 1.0, 0.0, 1.0}, last = picked;
+  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+    if (found) return;
+    m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double w) {
+      if (found || !(w > 0.0)) return;
+      last = g;
+      if (target < w) {
+        picked = g;
+        v1 = std::clamp(target / w, 0.0, 0.99999999999999989);
+        found = true;
+      } else {
+        target -= w;
+      }
+    });
+  });
+  if (!found) picked = last;  // rounding left the target past the last lobe
+  const double radius = std::sqrt(-2.0 * std::log1p(-v1));
+  const double z0 = radius * std::cos(kTwoPi * u2), z1 = radius * std::sin(kTwoPi * u2);
+  const double l11 = std::sqrt(picked.cxx), l21 = picked.cxy / l11;
+  const double l22 = std::sqrt(std::max(picked.cyy - l21 * l21, 0.0));
+  out->s.x = picked.mx + l11 * z0;
+  out->s.y = picked.my + l21 * z0 + l22 * z1;
+  out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
+  return Status::kOk;
+}
+
+}  // namespace glintbake::runtime
