@@ -18,8 +18,8 @@ FlakesHandover defaultHandover(double sigma0) {
   return h;
 }
 
-Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
-                          const FlakesHandover& handover, uint64_t* bytes) {
+BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
+                              const FlakesHandover& handover, uint64_t* bytes) {
   format::FlakesRecord rec;
   rec.map_width = uint32_t(std::max(map.width, 0));
   rec.map_height = uint32_t(std::max(map.height, 0));
@@ -43,8 +43,8 @@ Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate
     normals[t * 2 + 0] = map.normals[t * 3 + 0];
     normals[t * 2 + 1] = map.normals[t * 3 + 1];
   }
-  if (format::Status s = writer.addSection(format::kSectionFlakes, 0, section.data(), section.size());
-      s != format::Status::kOk)
+  if (format::ContainerStatus s = writer.addSection(format::kSectionFlakes, 0, section.data(), section.size());
+      s != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, std::string("cannot write the flakes section: ") + format::statusString(s));
   if (bytes) *bytes = size;
   return okStatus();

@@ -178,7 +178,7 @@ void resolveOptions(const CLI::App& app, Options& o) {
     throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
   }
   if (o.zstd_level < 1 || o.zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-  if (bake::Status s = tensor::validateTensorPackOptions(o.pack); !s)
+  if (bake::BakeStatus s = tensor::validateTensorPackOptions(o.pack); !s)
     throw Error(exitCodeOf(s.error()), s.error().message);
 }
 
@@ -219,10 +219,10 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
         throw Error(cli::kExitBadArguments, flag->get_name() + " applies to normal-map inputs only");
     }
     t.addInput(o.input);
-    if (format::Status st = in.reader.open(o.input); st != format::Status::kOk) {
-      const int code = st == format::Status::kIoError              ? cli::kExitIo
-                       : st == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
-                                                                   : cli::kExitInvalidInput;
+    if (format::ContainerStatus st = in.reader.open(o.input); st != format::ContainerStatus::kOk) {
+      const int code = st == format::ContainerStatus::kIoError              ? cli::kExitIo
+                       : st == format::ContainerStatus::kUnsupportedVersion ? cli::kExitUnsupported
+                                                                            : cli::kExitInvalidInput;
       throw Error(code, o.input + ": " + format::statusString(st));
     }
     if (in.reader.kind() != format::AssetKind::kNdfPyramid) {
@@ -230,7 +230,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
                                               format::assetKindString(in.reader.kind()) + ")");
     }
     std::string meta_text;
-    if (in.reader.readMetadata(&meta_text) == format::Status::kOk) {
+    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk) {
       const Json source = Json::parse(meta_text, nullptr, false);
       if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
       if (source.is_object() && source.contains("asset")) in.source_asset = source["asset"];
@@ -257,7 +257,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
 // Stage 3: packs the input into the (temporary) output container; nothing is in place yet.
 tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out) {
   tensor::TensorPackReport report;
-  bake::Status s = bake::okStatus();
+  bake::BakeStatus s = bake::okStatus();
   if (in.from_container) {
     s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
   } else {
@@ -272,10 +272,10 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     cli::writeFlakes(out.writer(), in.map, o.pyramid);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
     std::vector<uint8_t> flakes;
-    format::Status st = in.reader.readSection(size_t(idx), &flakes);
-    if (st == format::Status::kOk)
+    format::ContainerStatus st = in.reader.readSection(size_t(idx), &flakes);
+    if (st == format::ContainerStatus::kOk)
       st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
-    if (st != format::Status::kOk)
+    if (st != format::ContainerStatus::kOk)
       throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
   }
   return report;

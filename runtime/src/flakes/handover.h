@@ -19,8 +19,8 @@ namespace glintbake::runtime {
 // Reads and checks the flakes section (index `section` of the reader) and builds its evaluator at
 // image resolution `resolution`. kInvalidAsset for a record the check refuses or non-finite
 // normals, kOutOfMemory. Safe on untrusted input.
-Status loadFlakes(const format::Reader& reader, int section, int resolution, std::unique_ptr<FlakeNdf>* flakes,
-                  format::FlakesRecord* record);
+RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resolution, std::unique_ptr<FlakeNdf>* flakes,
+                         format::FlakesRecord* record);
 
 // An NDF source that answers small footprints from the flakes and the others from a pyramid.
 class HandoverNdf final : public NdfSource {
@@ -34,18 +34,18 @@ class HandoverNdf final : public NdfSource {
   FootprintRange footprintRange() const override;
   MapSize mapSize() const override { return pyramid_->mapSize(); }
   MapWrap wrap() const override { return pyramid_->wrap(); }
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status mass(const Footprint& footprint, double* value) const override;
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const override;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
 
  private:
   // Weight of the pyramid for a footprint: 0 on the flakes' side, 1 on the pyramid's.
   double pyramidWeight(double sigma) const;
   template <typename Query>
-  Status blend(const Footprint& footprint, double* value, Query&& query) const;
+  RuntimeStatus blend(const Footprint& footprint, double* value, Query&& query) const;
 
   std::unique_ptr<FlakeNdf> flakes_;
   std::unique_ptr<NdfSource> pyramid_;

@@ -64,8 +64,8 @@ Json pyramidOptionsJson(const PyramidCliOptions& p) {
 uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p) {
   if (!p.flakes) return 0;
   uint64_t bytes = 0;
-  const bake::Status s = bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r,
-                                                       bake::ndf::defaultHandover(p.options.sigma0), &bytes);
+  const bake::BakeStatus s = bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r,
+                                                           bake::ndf::defaultHandover(p.options.sigma0), &bytes);
   if (!s) throw Error(int(s.error().code), s.error().message);
   return bytes;
 }
