@@ -66,7 +66,7 @@ std::vector<std::unique_ptr<Subject>>& subjects() {
     }
     for (auto& s : v) {
       const auto texels = mapTexels(s->map);
-      if (s->ndf.build(texels, 1, 0.005, 128) != rt::Status::kOk) std::abort();
+      if (s->ndf.build(texels, 1, 0.005, 128) != rt::RuntimeStatus::kOk) std::abort();
       s->set = glintbake::reference::buildFlakes(s->map, 1);
     }
     return v;

@@ -72,14 +72,15 @@ const glintbake::runtime::NdfPyramid& benchPyramid() {
     o.levels = 3;
     const std::string path = "bench_ndf_pyramid.gbk";
     glintbake::format::Writer w;
-    if (w.open(path, glintbake::format::AssetKind::kNdfPyramid, 1) != glintbake::format::Status::kOk ||
-        !ndf::buildNdfPyramid(map, o, w, nullptr).ok() || w.addMetadata("{}") != glintbake::format::Status::kOk ||
-        w.finish() != glintbake::format::Status::kOk) {
+    if (w.open(path, glintbake::format::AssetKind::kNdfPyramid, 1) != glintbake::format::ContainerStatus::kOk ||
+        !ndf::buildNdfPyramid(map, o, w, nullptr).ok() ||
+        w.addMetadata("{}") != glintbake::format::ContainerStatus::kOk ||
+        w.finish() != glintbake::format::ContainerStatus::kOk) {
       std::fprintf(stderr, "cannot bake the benchmark pyramid\n");
       std::abort();
     }
     auto pyr = std::make_unique<glintbake::runtime::NdfPyramid>();
-    if (pyr->open(path.c_str()) != glintbake::runtime::Status::kOk) std::abort();
+    if (pyr->open(path.c_str()) != glintbake::runtime::RuntimeStatus::kOk) std::abort();
     std::remove(path.c_str());
     return pyr;
   }();

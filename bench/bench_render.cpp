@@ -42,9 +42,9 @@ struct Fixture {
     bake::ndf::PyramidOptions po;  // the ndfgen / tensorpack defaults
     {
       format::Writer w;
-      if (w.open(pyramid_path, format::AssetKind::kNdfPyramid, 3) != format::Status::kOk ||
-          !bake::ndf::buildNdfPyramid(map, po, w, nullptr).ok() || w.addMetadata("{}") != format::Status::kOk ||
-          w.finish() != format::Status::kOk) {
+      if (w.open(pyramid_path, format::AssetKind::kNdfPyramid, 3) != format::ContainerStatus::kOk ||
+          !bake::ndf::buildNdfPyramid(map, po, w, nullptr).ok() ||
+          w.addMetadata("{}") != format::ContainerStatus::kOk || w.finish() != format::ContainerStatus::kOk) {
         std::fprintf(stderr, "bench_render: cannot bake the pyramid\n");
         std::abort();
       }
@@ -53,15 +53,15 @@ struct Fixture {
       format::Writer w;
       bake::tensor::TensorPackOptions to;
       bake::tensor::TensorPackReport report;
-      if (w.open(tensor_path, format::AssetKind::kTensorNdf, 9) != format::Status::kOk ||
+      if (w.open(tensor_path, format::AssetKind::kTensorNdf, 9) != format::ContainerStatus::kOk ||
           !bake::tensor::packTensorNdfFromMap(map, po, to, w, &report).ok() ||
-          w.addMetadata("{}") != format::Status::kOk || w.finish() != format::Status::kOk) {
+          w.addMetadata("{}") != format::ContainerStatus::kOk || w.finish() != format::ContainerStatus::kOk) {
         std::fprintf(stderr, "bench_render: cannot bake the tensor asset\n");
         std::abort();
       }
     }
-    if (runtime::openNdfAsset(pyramid_path.c_str(), &pyramid) != runtime::Status::kOk ||
-        runtime::openNdfAsset(tensor_path.c_str(), &tensor) != runtime::Status::kOk) {
+    if (runtime::openNdfAsset(pyramid_path.c_str(), &pyramid) != runtime::RuntimeStatus::kOk ||
+        runtime::openNdfAsset(tensor_path.c_str(), &tensor) != runtime::RuntimeStatus::kOk) {
       std::fprintf(stderr, "bench_render: cannot open the assets\n");
       std::abort();
     }

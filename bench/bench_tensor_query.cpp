@@ -37,18 +37,18 @@ struct Assets {
 
 void pack(const std::string& pyramid_path, bool nonneg, const std::string& path, rt::TensorNdf* out) {
   fmt::Reader reader;
-  if (reader.open(pyramid_path) != fmt::Status::kOk) fail("read the pyramid");
+  if (reader.open(pyramid_path) != fmt::ContainerStatus::kOk) fail("read the pyramid");
   bake::tensor::TensorPackOptions o;
   o.cp.rank = 16;
   o.cp.nonneg = nonneg;
   o.block = 32;
   fmt::Writer w;
   bake::tensor::TensorPackReport report;
-  if (w.open(path, fmt::AssetKind::kTensorNdf, 1) != fmt::Status::kOk ||
-      !bake::tensor::packTensorNdfFromPyramid(reader, o, w, &report).ok() || w.addMetadata("{}") != fmt::Status::kOk ||
-      w.finish() != fmt::Status::kOk)
+  if (w.open(path, fmt::AssetKind::kTensorNdf, 1) != fmt::ContainerStatus::kOk ||
+      !bake::tensor::packTensorNdfFromPyramid(reader, o, w, &report).ok() ||
+      w.addMetadata("{}") != fmt::ContainerStatus::kOk || w.finish() != fmt::ContainerStatus::kOk)
     fail("pack the tensor asset");
-  if (out->open(path.c_str()) != rt::Status::kOk) fail("open the tensor asset");
+  if (out->open(path.c_str()) != rt::RuntimeStatus::kOk) fail("open the tensor asset");
   std::remove(path.c_str());
 }
 
@@ -67,11 +67,11 @@ const Assets& assets() {
     o.levels = 3;
     const std::string path = "bench_tensor_query_pyramid.gbk";
     fmt::Writer w;
-    if (w.open(path, fmt::AssetKind::kNdfPyramid, 1) != fmt::Status::kOk ||
-        !bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok() || w.addMetadata("{}") != fmt::Status::kOk ||
-        w.finish() != fmt::Status::kOk)
+    if (w.open(path, fmt::AssetKind::kNdfPyramid, 1) != fmt::ContainerStatus::kOk ||
+        !bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok() || w.addMetadata("{}") != fmt::ContainerStatus::kOk ||
+        w.finish() != fmt::ContainerStatus::kOk)
       fail("bake the pyramid");
-    if (x->pyramid.open(path.c_str()) != rt::Status::kOk) fail("open the pyramid");
+    if (x->pyramid.open(path.c_str()) != rt::RuntimeStatus::kOk) fail("open the pyramid");
     pack(path, false, "bench_tensor_query_cp.gbk", &x->tensor);
     pack(path, true, "bench_tensor_query_nn.gbk", &x->tensor_nn);
     std::remove(path.c_str());

@@ -43,8 +43,8 @@ class FirstGroupSink final : public ndf::PyramidSink {
  public:
   tensor::GroupTensor group;
 
-  bake::Status addLevel(const glintbake::runtime::NdfLevelRecord&) override { return bake::okStatus(); }
-  bake::Status addChunk(const ndf::PyramidChunk& chunk) override {
+  bake::BakeStatus addLevel(const glintbake::runtime::NdfLevelRecord&) override { return bake::okStatus(); }
+  bake::BakeStatus addChunk(const ndf::PyramidChunk& chunk) override {
     if (chunk.region != 0) return bake::okStatus();
     const int res = chunk.ndf_res, nb = res / kBins;
     group.bins = kBins;
@@ -109,7 +109,8 @@ void BM_PackFromMap(benchmark::State& state) {
   const std::string path = "bench_tensorpack_out.gbk";
   for (auto _ : state) {
     glintbake::format::Writer w;
-    if (w.open(path, glintbake::format::AssetKind::kTensorNdf, 9) != glintbake::format::Status::kOk) std::abort();
+    if (w.open(path, glintbake::format::AssetKind::kTensorNdf, 9) != glintbake::format::ContainerStatus::kOk)
+      std::abort();
     if (!tensor::packTensorNdfFromMap(map, pyr, o, w, &report).ok()) std::abort();
     w.abort();
   }

@@ -30,40 +30,40 @@ class Checker {
   explicit Checker(Diagnostics* diagnostics) : diagnostics_(diagnostics) {}
 
   // Records an error; returns true if parsing should stop now (no diagnostics sink).
-  bool fail(Status status, int id, const std::string& message) {
-    if (first_ == Status::kOk) first_ = status;
+  bool fail(ContainerStatus status, int id, const std::string& message) {
+    if (first_ == ContainerStatus::kOk) first_ = status;
     if (diagnostics_) diagnostics_->error(id, message);
     return diagnostics_ == nullptr;
   }
   void warn(int id, const std::string& message) {
     if (diagnostics_) diagnostics_->warning(id, message);
   }
-  Status status() const { return first_; }
+  ContainerStatus status() const { return first_; }
 
  private:
   Diagnostics* diagnostics_;
-  Status first_ = Status::kOk;
+  ContainerStatus first_ = ContainerStatus::kOk;
 };
 
 bool allZero(const uint8_t* p, size_t n) {
   return std::all_of(p, p + n, [](uint8_t b) { return b == 0; });
 }
 
-Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& check) {
+ContainerStatus parseHeader(const ByteSource& source, ParsedContainer* out, Checker& check) {
   const uint64_t actual_size = source.size();
   uint8_t h[kHeaderSize];
   const size_t head = size_t(std::min<uint64_t>(actual_size, kHeaderSize));
   if (!source.readAt(0, h, head)) {
-    check.fail(Status::kIoError, 1002, "cannot read the file header");
+    check.fail(ContainerStatus::kIoError, 1002, "cannot read the file header");
     return check.status();
   }
   // Magic first: a short file that is not a container is "not a container", not "truncated".
   if (std::memcmp(h, kMagic, std::min<size_t>(head, sizeof(kMagic))) != 0) {
-    check.fail(Status::kBadMagic, 2002, "not a glintbake container (bad magic bytes)");
+    check.fail(ContainerStatus::kBadMagic, 2002, "not a glintbake container (bad magic bytes)");
     return check.status();
   }
   if (head < kHeaderSize) {
-    check.fail(Status::kTruncated, 2001,
+    check.fail(ContainerStatus::kTruncated, 2001,
                "file is " + std::to_string(actual_size) + " bytes, shorter than the 128-byte header");
     return check.status();
   }
@@ -76,10 +76,10 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
     const std::string v = std::to_string(hi.version_major) + "." + std::to_string(hi.version_minor);
     const std::string mine = std::to_string(kFormatVersionMajor) + "." + std::to_string(kFormatVersionMinor);
     if (hi.version_major > kFormatVersionMajor) {
-      check.fail(Status::kUnsupportedVersion, 2003,
+      check.fail(ContainerStatus::kUnsupportedVersion, 2003,
                  "container format " + v + " is newer than this reader (" + mine + "); upgrade glintbake");
     } else {
-      check.fail(Status::kUnsupportedVersion, 2004, "container format " + v + " is not a released version");
+      check.fail(ContainerStatus::kUnsupportedVersion, 2004, "container format " + v + " is not a released version");
     }
     return check.status();
   }
@@ -90,7 +90,7 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
   const uint64_t header_checksum = load64(h + kOffHeaderChecksum);
   const uint64_t computed = hash64(zeroed, kHeaderSize);
   if (computed != header_checksum) {
-    check.fail(Status::kCorruptHeader, 2005,
+    check.fail(ContainerStatus::kCorruptHeader, 2005,
                "header checksum mismatch (stored " + hex64(header_checksum) + ", computed " + hex64(computed) + ")");
     return check.status();
   }
@@ -110,7 +110,8 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
   out->index_checksum = load64(h + kOffIndexChecksum);
 
   if (header_size != kHeaderSize) {
-    check.fail(Status::kCorruptHeader, 2006, "header_size is " + std::to_string(header_size) + ", expected 128");
+    check.fail(ContainerStatus::kCorruptHeader, 2006,
+               "header_size is " + std::to_string(header_size) + ", expected 128");
     return check.status();
   }
   if (out->header_flags != 0 || load32(h + kOffHeaderReserved) != 0 ||
@@ -118,35 +119,35 @@ Status parseHeader(const ByteSource& source, ParsedContainer* out, Checker& chec
     check.warn(2013, "reserved header fields or padding are not zero");
   }
   if (hi.section_count > kMaxSectionCount) {
-    check.fail(Status::kTooLarge, 2007,
+    check.fail(ContainerStatus::kTooLarge, 2007,
                "section_count " + std::to_string(hi.section_count) + " exceeds the reader limit " +
                    std::to_string(kMaxSectionCount));
     return check.status();
   }
   if (out->index_size != uint64_t(hi.section_count) * kIndexEntrySize) {
-    check.fail(Status::kCorruptHeader, 2008,
+    check.fail(ContainerStatus::kCorruptHeader, 2008,
                "index_size " + std::to_string(out->index_size) + " does not match section_count " +
                    std::to_string(hi.section_count) + " x 64");
     return check.status();
   }
   if (hi.index_offset < kHeaderSize || hi.index_offset % kSectionAlignment != 0) {
-    check.fail(Status::kCorruptHeader, 2009,
+    check.fail(ContainerStatus::kCorruptHeader, 2009,
                "index_offset " + std::to_string(hi.index_offset) + " is not a multiple of 64 at or after the header");
     return check.status();
   }
   if (hi.index_offset > UINT64_MAX - out->index_size || hi.index_offset + out->index_size != hi.file_size) {
-    check.fail(Status::kCorruptHeader, 2010,
+    check.fail(ContainerStatus::kCorruptHeader, 2010,
                "file_size " + std::to_string(hi.file_size) + " is not index_offset + index_size");
     return check.status();
   }
   if (actual_size < hi.file_size) {
     check.fail(
-        Status::kTruncated, 2011,
+        ContainerStatus::kTruncated, 2011,
         "file is truncated: " + std::to_string(actual_size) + " bytes, header says " + std::to_string(hi.file_size));
     return check.status();
   }
   if (actual_size > hi.file_size) {
-    check.fail(Status::kCorruptHeader, 2012,
+    check.fail(ContainerStatus::kCorruptHeader, 2012,
                "file has " + std::to_string(actual_size - hi.file_size) + " trailing bytes after the index");
     return check.status();
   }
@@ -158,12 +159,12 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
   // index_size <= file size was established by parseHeader, so this allocation is bounded by the file.
   std::vector<uint8_t> index(size_t(out->index_size));
   if (!source.readAt(hi.index_offset, index.data(), index.size())) {
-    check.fail(Status::kIoError, 1002, "cannot read the section index");
+    check.fail(ContainerStatus::kIoError, 1002, "cannot read the section index");
     return;
   }
   const uint64_t computed = hash64(index.data(), index.size());
   if (computed != out->index_checksum) {
-    check.fail(Status::kCorruptIndex, 3001,
+    check.fail(ContainerStatus::kCorruptIndex, 3001,
                "index checksum mismatch (stored " + hex64(out->index_checksum) + ", computed " + hex64(computed) + ")");
     return;
   }
@@ -188,32 +189,32 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
 
     const std::string name = "section " + std::to_string(i);
     if (s.offset % kSectionAlignment != 0) {
-      if (check.fail(Status::kCorruptIndex, 3002,
+      if (check.fail(ContainerStatus::kCorruptIndex, 3002,
                      name + ": offset " + std::to_string(s.offset) + " is not a multiple of 64"))
         return;
     }
     if (s.offset < kHeaderSize || s.offset > hi.index_offset || s.stored_size > hi.index_offset - s.offset) {
-      if (check.fail(Status::kCorruptIndex, 3003,
+      if (check.fail(ContainerStatus::kCorruptIndex, 3003,
                      name + ": bytes [" + std::to_string(s.offset) + ", +" + std::to_string(s.stored_size) +
                          ") lie outside the section area [128, " + std::to_string(hi.index_offset) + ")"))
         return;
     }
     if (s.raw_size > options.max_raw_section_size) {
-      if (check.fail(Status::kTooLarge, 3005,
+      if (check.fail(ContainerStatus::kTooLarge, 3005,
                      name + ": raw size " + std::to_string(s.raw_size) + " exceeds the reader limit " +
                          std::to_string(options.max_raw_section_size)))
         return;
     }
     if (s.codec == uint32_t(Codec::kRaw)) {
       if (s.stored_size != s.raw_size) {
-        if (check.fail(Status::kCorruptIndex, 3006, name + ": raw codec but stored_size != raw_size")) return;
+        if (check.fail(ContainerStatus::kCorruptIndex, 3006, name + ": raw codec but stored_size != raw_size")) return;
       }
     } else if (s.codec == uint32_t(Codec::kZstd)) {
       // ZSTD_compressBound is only meaningful below ZSTD_MAX_INPUT_SIZE; the cap above keeps
       // raw_size small enough on 64-bit hosts, the explicit test covers the rest.
       const size_t bound = s.raw_size <= uint64_t(SIZE_MAX / 2) ? ZSTD_compressBound(size_t(s.raw_size)) : 0;
       if (s.stored_size == 0 || bound == 0 || ZSTD_isError(bound) || s.stored_size > bound) {
-        if (check.fail(Status::kCorruptIndex, 3007,
+        if (check.fail(ContainerStatus::kCorruptIndex, 3007,
                        name + ": zstd stored_size " + std::to_string(s.stored_size) + " is impossible for raw_size " +
                            std::to_string(s.raw_size)))
           return;
@@ -236,7 +237,7 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
     const SectionInfo& cur = secs[order[k]];
     if (prev.stored_size == 0 || cur.stored_size == 0) continue;  // empty sections occupy no bytes
     if (prev.offset <= UINT64_MAX - prev.stored_size && prev.offset + prev.stored_size > cur.offset) {
-      if (check.fail(Status::kCorruptIndex, 3004,
+      if (check.fail(ContainerStatus::kCorruptIndex, 3004,
                      "sections " + std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + " overlap"))
         return;
     }
@@ -250,7 +251,7 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
     const SectionInfo& prev = secs[order[k - 1]];
     const SectionInfo& cur = secs[order[k]];
     if (prev.type == cur.type && prev.key == cur.key) {
-      if (check.fail(Status::kCorruptIndex, 3008,
+      if (check.fail(ContainerStatus::kCorruptIndex, 3008,
                      "sections " + std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) +
                          " have the same type " + std::to_string(cur.type) + " and key " + std::to_string(cur.key)))
         return;
@@ -260,75 +261,76 @@ void parseIndex(const ByteSource& source, const ReaderOptions& options, ParsedCo
 
 }  // namespace
 
-Status parseContainer(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out,
-                      Diagnostics* diagnostics) {
+ContainerStatus parseContainer(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out,
+                               Diagnostics* diagnostics) {
   *out = ParsedContainer{};
   Checker check(diagnostics);
-  if (parseHeader(source, out, check) != Status::kOk) return check.status();
+  if (parseHeader(source, out, check) != ContainerStatus::kOk) return check.status();
   parseIndex(source, options, out, check);
-  if (check.status() != Status::kOk && diagnostics == nullptr) out->sections.clear();
+  if (check.status() != ContainerStatus::kOk && diagnostics == nullptr) out->sections.clear();
   return check.status();
 }
 
-Status readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
-  if (dst_size != info.raw_size || (dst == nullptr && dst_size != 0)) return Status::kInvalidArgument;
-  if (info.codec != uint32_t(Codec::kRaw) && info.codec != uint32_t(Codec::kZstd)) return Status::kDecompressFailed;
+ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
+  if (dst_size != info.raw_size || (dst == nullptr && dst_size != 0)) return ContainerStatus::kInvalidArgument;
+  if (info.codec != uint32_t(Codec::kRaw) && info.codec != uint32_t(Codec::kZstd))
+    return ContainerStatus::kDecompressFailed;
   if (info.codec == uint32_t(Codec::kRaw)) {
-    if (info.stored_size != info.raw_size) return Status::kCorruptIndex;
-    if (!source.readAt(info.offset, dst, dst_size)) return Status::kTruncated;
-    if (hash64(dst, dst_size) != info.checksum) return Status::kChecksumMismatch;
-    return Status::kOk;
+    if (info.stored_size != info.raw_size) return ContainerStatus::kCorruptIndex;
+    if (!source.readAt(info.offset, dst, dst_size)) return ContainerStatus::kTruncated;
+    if (hash64(dst, dst_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
+    return ContainerStatus::kOk;
   }
 
   // zstd: stored bytes come straight from memory sources, or through a buffer bounded by the file.
   std::vector<uint8_t> buffer;
   const uint8_t* stored = source.data() ? source.data() + info.offset : nullptr;
   if (!stored) {
-    if (info.stored_size > source.size()) return Status::kTruncated;
+    if (info.stored_size > source.size()) return ContainerStatus::kTruncated;
     buffer.resize(size_t(info.stored_size));
-    if (!source.readAt(info.offset, buffer.data(), buffer.size())) return Status::kTruncated;
+    if (!source.readAt(info.offset, buffer.data(), buffer.size())) return ContainerStatus::kTruncated;
     stored = buffer.data();
   } else if (info.offset > source.size() || info.stored_size > source.size() - info.offset) {
-    return Status::kTruncated;
+    return ContainerStatus::kTruncated;
   }
   const size_t stored_size = size_t(info.stored_size);
-  if (hash64(stored, stored_size) != info.checksum) return Status::kChecksumMismatch;
+  if (hash64(stored, stored_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
 
   // One frame, exactly the stored bytes, announcing exactly raw_size: checked before decoding so
   // a hostile frame can neither overrun dst nor make the decoder produce more than asked.
   const size_t frame_size = ZSTD_findFrameCompressedSize(stored, stored_size);
-  if (ZSTD_isError(frame_size) || frame_size != stored_size) return Status::kDecompressFailed;
+  if (ZSTD_isError(frame_size) || frame_size != stored_size) return ContainerStatus::kDecompressFailed;
   const unsigned long long content = ZSTD_getFrameContentSize(stored, stored_size);
   if (content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR || content != info.raw_size) {
-    return Status::kDecompressFailed;
+    return ContainerStatus::kDecompressFailed;
   }
   ZSTD_DCtx* dctx = ZSTD_createDCtx();
-  if (!dctx) return Status::kDecompressFailed;
+  if (!dctx) return ContainerStatus::kDecompressFailed;
   const size_t got = ZSTD_decompressDCtx(dctx, dst, dst_size, stored, stored_size);
   ZSTD_freeDCtx(dctx);
-  if (ZSTD_isError(got) || got != dst_size) return Status::kDecompressFailed;
-  return Status::kOk;
+  if (ZSTD_isError(got) || got != dst_size) return ContainerStatus::kDecompressFailed;
+  return ContainerStatus::kOk;
 }
 
-Status verifyFileChecksumOf(const ByteSource& source, uint64_t expected) {
+ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected) {
   const uint64_t size = source.size();
-  if (size < kHeaderSize) return Status::kTruncated;
+  if (size < kHeaderSize) return ContainerStatus::kTruncated;
   uint64_t actual = 0;
   if (const uint8_t* data = source.data()) {
     actual = hash64(data + kHeaderSize, size_t(size - kHeaderSize));
   } else {
     XXH3Streamer hasher;
-    if (!hasher.ok()) return Status::kIoError;
+    if (!hasher.ok()) return ContainerStatus::kIoError;
     std::vector<uint8_t> chunk(size_t(1) << 20);
     for (uint64_t offset = kHeaderSize; offset < size;) {
       const size_t n = size_t(std::min<uint64_t>(chunk.size(), size - offset));
-      if (!source.readAt(offset, chunk.data(), n)) return Status::kIoError;
+      if (!source.readAt(offset, chunk.data(), n)) return ContainerStatus::kIoError;
       hasher.update(chunk.data(), n);
       offset += n;
     }
     actual = hasher.digest();
   }
-  return actual == expected ? Status::kOk : Status::kChecksumMismatch;
+  return actual == expected ? ContainerStatus::kOk : ContainerStatus::kChecksumMismatch;
 }
 
 }  // namespace glintbake::format::detail

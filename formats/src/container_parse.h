@@ -33,16 +33,16 @@ struct ParsedContainer {
 // failure. With diagnostics, reports every finding and still returns the first failing status;
 // header failures stop the parse (later fields cannot be trusted), index entry failures do not.
 // Never reads or allocates more than the source's size. Safe on untrusted input.
-Status parseContainer(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out,
-                      Diagnostics* diagnostics);
+ContainerStatus parseContainer(const ByteSource& source, const ReaderOptions& options, ParsedContainer* out,
+                               Diagnostics* diagnostics);
 
 // Reads section `info` of `source` into dst (exactly info.raw_size bytes): checks its checksum,
 // its codec and, for zstd, that it is one frame whose recorded content size equals raw_size
 // before decoding. `info` must come from parseContainer on the same source. Thread-safe.
-Status readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size);
+ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size);
 
 // Hashes bytes [kHeaderSize, size) of the source (streamed in fixed-size chunks) and compares
 // with `expected`.
-Status verifyFileChecksumOf(const ByteSource& source, uint64_t expected);
+ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected);
 
 }  // namespace glintbake::format::detail

@@ -16,16 +16,16 @@ struct Reader::Impl {
   // (type, key, index) sorted, for find() in O(log n).
   std::vector<std::tuple<uint32_t, uint64_t, uint32_t>> lookup;
 
-  Status adopt(std::unique_ptr<detail::ByteSource> src, const ReaderOptions& options) {
-    const Status status = detail::parseContainer(*src, options, &parsed, nullptr);
-    if (status == Status::kOk && options.verify_file_checksum) {
-      const Status checksum = detail::verifyFileChecksumOf(*src, parsed.header.file_checksum);
-      if (checksum != Status::kOk) {
+  ContainerStatus adopt(std::unique_ptr<detail::ByteSource> src, const ReaderOptions& options) {
+    const ContainerStatus status = detail::parseContainer(*src, options, &parsed, nullptr);
+    if (status == ContainerStatus::kOk && options.verify_file_checksum) {
+      const ContainerStatus checksum = detail::verifyFileChecksumOf(*src, parsed.header.file_checksum);
+      if (checksum != ContainerStatus::kOk) {
         parsed = {};
         return checksum;
       }
     }
-    if (status != Status::kOk) {
+    if (status != ContainerStatus::kOk) {
       parsed = {};
       return status;
     }
@@ -36,23 +36,23 @@ struct Reader::Impl {
       lookup.emplace_back(parsed.sections[i].type, parsed.sections[i].key, i);
     }
     std::sort(lookup.begin(), lookup.end());
-    return Status::kOk;
+    return ContainerStatus::kOk;
   }
 };
 
 Reader::Reader() : impl_(std::make_unique<Impl>()) {}
 Reader::~Reader() = default;
 
-Status Reader::open(const std::string& path, const ReaderOptions& options) {
+ContainerStatus Reader::open(const std::string& path, const ReaderOptions& options) {
   close();
   auto file = std::make_unique<detail::FileSource>();
-  if (!file->open(path)) return Status::kIoError;
+  if (!file->open(path)) return ContainerStatus::kIoError;
   return impl_->adopt(std::move(file), options);
 }
 
-Status Reader::openMemory(const void* data, size_t size, const ReaderOptions& options) {
+ContainerStatus Reader::openMemory(const void* data, size_t size, const ReaderOptions& options) {
   close();
-  if (data == nullptr && size != 0) return Status::kInvalidArgument;
+  if (data == nullptr && size != 0) return ContainerStatus::kInvalidArgument;
   static const uint8_t kEmpty = 0;
   return impl_->adopt(std::make_unique<detail::MemorySource>(data ? data : &kEmpty, size), options);
 }
@@ -88,48 +88,48 @@ int Reader::find(uint32_t type, uint64_t key) const {
   return -1;
 }
 
-Status Reader::readSection(size_t i, std::vector<uint8_t>* out) const {
-  if (!impl_->source || out == nullptr) return Status::kInvalidArgument;
-  if (i >= impl_->parsed.sections.size()) return Status::kNotFound;
+ContainerStatus Reader::readSection(size_t i, std::vector<uint8_t>* out) const {
+  if (!impl_->source || out == nullptr) return ContainerStatus::kInvalidArgument;
+  if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;
   const SectionInfo& info = impl_->parsed.sections[i];
   // raw_size was checked against ReaderOptions::max_raw_section_size by open().
   out->resize(size_t(info.raw_size));
-  const Status status = detail::readSectionFrom(*impl_->source, info, out->data(), out->size());
-  if (status != Status::kOk) out->clear();
+  const ContainerStatus status = detail::readSectionFrom(*impl_->source, info, out->data(), out->size());
+  if (status != ContainerStatus::kOk) out->clear();
   return status;
 }
 
-Status Reader::readSectionInto(size_t i, void* dst, size_t dst_size) const {
-  if (!impl_->source) return Status::kInvalidArgument;
-  if (i >= impl_->parsed.sections.size()) return Status::kNotFound;
+ContainerStatus Reader::readSectionInto(size_t i, void* dst, size_t dst_size) const {
+  if (!impl_->source) return ContainerStatus::kInvalidArgument;
+  if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;
   return detail::readSectionFrom(*impl_->source, impl_->parsed.sections[i], dst, dst_size);
 }
 
-Status Reader::readStored(size_t i, std::vector<uint8_t>* out) const {
-  if (!impl_->source || out == nullptr) return Status::kInvalidArgument;
-  if (i >= impl_->parsed.sections.size()) return Status::kNotFound;
+ContainerStatus Reader::readStored(size_t i, std::vector<uint8_t>* out) const {
+  if (!impl_->source || out == nullptr) return ContainerStatus::kInvalidArgument;
+  if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;
   const SectionInfo& info = impl_->parsed.sections[i];
   out->resize(size_t(info.stored_size));
   if (!impl_->source->readAt(info.offset, out->data(), out->size())) {
     out->clear();
-    return Status::kTruncated;
+    return ContainerStatus::kTruncated;
   }
-  return Status::kOk;
+  return ContainerStatus::kOk;
 }
 
-Status Reader::readMetadata(std::string* json_utf8) const {
-  if (json_utf8 == nullptr) return Status::kInvalidArgument;
+ContainerStatus Reader::readMetadata(std::string* json_utf8) const {
+  if (json_utf8 == nullptr) return ContainerStatus::kInvalidArgument;
   const int i = find(kSectionMetadata);
-  if (i < 0) return Status::kNotFound;
+  if (i < 0) return ContainerStatus::kNotFound;
   std::vector<uint8_t> bytes;
-  const Status status = readSection(size_t(i), &bytes);
-  if (status != Status::kOk) return status;
+  const ContainerStatus status = readSection(size_t(i), &bytes);
+  if (status != ContainerStatus::kOk) return status;
   json_utf8->assign(bytes.begin(), bytes.end());
-  return Status::kOk;
+  return ContainerStatus::kOk;
 }
 
-Status Reader::verifyFileChecksum() const {
-  if (!impl_->source) return Status::kInvalidArgument;
+ContainerStatus Reader::verifyFileChecksum() const {
+  if (!impl_->source) return ContainerStatus::kInvalidArgument;
   return detail::verifyFileChecksumOf(*impl_->source, impl_->parsed.header.file_checksum);
 }
 

@@ -63,7 +63,7 @@ struct Writer::Impl {
     return append(kZeros, size_t(target - position));
   }
 
-  Status fail(Status status) {
+  ContainerStatus fail(ContainerStatus status) {
     failed = true;
     return status;
   }
@@ -75,9 +75,9 @@ Writer::~Writer() {
   if (!impl_->finished) abort();
 }
 
-Status Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
-  if (impl_->fd >= 0 || impl_->finished) return Status::kInvalidArgument;
-  if (path.empty() || zstd_level < 1 || zstd_level > 19) return Status::kInvalidArgument;
+ContainerStatus Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
+  if (impl_->fd >= 0 || impl_->finished) return ContainerStatus::kInvalidArgument;
+  if (path.empty() || zstd_level < 1 || zstd_level > 19) return ContainerStatus::kInvalidArgument;
   Impl& w = *impl_;
   w.final_path = path;
   w.kind = kind;
@@ -86,13 +86,13 @@ Status Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   const int fd = ::mkstemp(buffer.data());
-  if (fd < 0) return Status::kIoError;
+  if (fd < 0) return ContainerStatus::kIoError;
   w.fd = fd;
   w.tmp_path = buffer.data();
   // mkstemp creates 0600; assets are ordinary shareable files.
   ::fchmod(fd, 0644);
   w.cctx = ZSTD_createCCtx();
-  if (!w.cctx || !w.file_hash.ok()) return w.fail(Status::kIoError);
+  if (!w.cctx || !w.file_hash.ok()) return w.fail(ContainerStatus::kIoError);
   // Deterministic frames: fixed level, content size recorded, no checksum (the index has one),
   // no dictionary id, single-threaded.
   ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_compressionLevel, zstd_level);
@@ -105,22 +105,22 @@ Status Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
   while (left > 0) {
     const ssize_t n = ::write(fd, kZeroHeader + (kHeaderSize - left), left);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return w.fail(Status::kIoError);
+    if (n <= 0) return w.fail(ContainerStatus::kIoError);
     left -= size_t(n);
   }
   w.position = kHeaderSize;
-  return Status::kOk;
+  return ContainerStatus::kOk;
 }
 
-Status Writer::addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec) {
+ContainerStatus Writer::addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec) {
   Impl& w = *impl_;
-  if (w.fd < 0 || w.failed || w.finished) return Status::kInvalidArgument;
-  if (data == nullptr && size != 0) return Status::kInvalidArgument;
-  if (codec != Codec::kRaw && codec != Codec::kZstd) return Status::kInvalidArgument;
-  if (w.sections.size() >= kMaxSectionCount) return Status::kTooLarge;
-  if (uint64_t(size) > kDefaultMaxRawSectionSize) return Status::kTooLarge;
-  if (type == kSectionMetadata && w.has_metadata) return Status::kInvalidArgument;
-  if (!w.keys.insert({type, key}).second) return Status::kInvalidArgument;  // (type, key) is unique
+  if (w.fd < 0 || w.failed || w.finished) return ContainerStatus::kInvalidArgument;
+  if (data == nullptr && size != 0) return ContainerStatus::kInvalidArgument;
+  if (codec != Codec::kRaw && codec != Codec::kZstd) return ContainerStatus::kInvalidArgument;
+  if (w.sections.size() >= kMaxSectionCount) return ContainerStatus::kTooLarge;
+  if (uint64_t(size) > kDefaultMaxRawSectionSize) return ContainerStatus::kTooLarge;
+  if (type == kSectionMetadata && w.has_metadata) return ContainerStatus::kInvalidArgument;
+  if (!w.keys.insert({type, key}).second) return ContainerStatus::kInvalidArgument;  // (type, key) is unique
 
   SectionInfo info;
   info.type = type;
@@ -132,44 +132,44 @@ Status Writer::addSection(uint32_t type, uint64_t key, const void* data, size_t 
   if (codec == Codec::kZstd && size > 0) {
     w.compressed.resize(ZSTD_compressBound(size));
     const size_t n = ZSTD_compress2(w.cctx, w.compressed.data(), w.compressed.size(), data, size);
-    if (ZSTD_isError(n)) return w.fail(Status::kInvalidArgument);
+    if (ZSTD_isError(n)) return w.fail(ContainerStatus::kInvalidArgument);
     if (n < size) {  // keep zstd only when it shrinks the section
       info.codec = uint32_t(Codec::kZstd);
       stored = w.compressed.data();
       stored_size = n;
     }
   }
-  if (!w.padTo(kSectionAlignment)) return w.fail(Status::kIoError);
+  if (!w.padTo(kSectionAlignment)) return w.fail(ContainerStatus::kIoError);
   info.offset = w.position;
   info.stored_size = stored_size;
   info.checksum = hash64(stored, stored_size);
-  if (!w.append(stored, stored_size)) return w.fail(Status::kIoError);
+  if (!w.append(stored, stored_size)) return w.fail(ContainerStatus::kIoError);
   // Release a large compression buffer rather than keep it for the writer's lifetime.
   if (w.compressed.capacity() > (size_t(64) << 20)) std::vector<uint8_t>().swap(w.compressed);
   w.sections.push_back(info);
   if (type == kSectionMetadata) w.has_metadata = true;
-  return Status::kOk;
+  return ContainerStatus::kOk;
 }
 
-Status Writer::addMetadata(const std::string& json_utf8) {
+ContainerStatus Writer::addMetadata(const std::string& json_utf8) {
   return addSection(kSectionMetadata, 0, json_utf8.data(), json_utf8.size(), Codec::kZstd);
 }
 
-Status Writer::finish() {
+ContainerStatus Writer::finish() {
   Impl& w = *impl_;
-  if (w.fd < 0 || w.finished) return Status::kInvalidArgument;
+  if (w.fd < 0 || w.finished) return ContainerStatus::kInvalidArgument;
   if (w.failed) {
     abort();
-    return Status::kInvalidArgument;
+    return ContainerStatus::kInvalidArgument;
   }
   if (!w.has_metadata) {
     abort();
-    return Status::kInvalidArgument;
+    return ContainerStatus::kInvalidArgument;
   }
 
   if (!w.padTo(kSectionAlignment)) {
     abort();
-    return Status::kIoError;
+    return ContainerStatus::kIoError;
   }
   const uint64_t index_offset = w.position;
   std::vector<uint8_t> index(w.sections.size() * kIndexEntrySize, 0);
@@ -186,7 +186,7 @@ Status Writer::finish() {
   }
   if (!w.append(index.data(), index.size())) {
     abort();
-    return Status::kIoError;
+    return ContainerStatus::kIoError;
   }
 
   uint8_t h[kHeaderSize] = {};
@@ -209,7 +209,7 @@ Status Writer::finish() {
   w.fd = -1;
   if (!ok || std::rename(w.tmp_path.c_str(), w.final_path.c_str()) != 0) {
     abort();
-    return Status::kIoError;
+    return ContainerStatus::kIoError;
   }
   w.finished = true;
   w.tmp_path.clear();
@@ -221,7 +221,7 @@ Status Writer::finish() {
     ::fsync(dir_fd);
     ::close(dir_fd);
   }
-  return Status::kOk;
+  return ContainerStatus::kOk;
 }
 
 void Writer::abort() {

@@ -33,13 +33,13 @@ std::string canonicalHex(XXH128_hash_t hash) {
 
 std::string hash128Hex(const void* data, size_t size) { return canonicalHex(XXH3_128bits(data, size)); }
 
-Status hashFile128Hex(const std::string& path, std::string* hex_out) {
+ContainerStatus hashFile128Hex(const std::string& path, std::string* hex_out) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return Status::kIoError;
+  if (!file) return ContainerStatus::kIoError;
   XXH3_state_t* state = XXH3_createState();
   if (!state) {
     std::fclose(file);
-    return Status::kIoError;
+    return ContainerStatus::kIoError;
   }
   XXH3_128bits_reset(state);
   std::vector<unsigned char> chunk(size_t(1) << 20);
@@ -55,7 +55,7 @@ Status hashFile128Hex(const std::string& path, std::string* hex_out) {
   std::fclose(file);
   if (ok && hex_out) *hex_out = canonicalHex(XXH3_128bits_digest(state));
   XXH3_freeState(state);
-  return ok ? Status::kOk : Status::kIoError;
+  return ok ? ContainerStatus::kOk : ContainerStatus::kIoError;
 }
 
 namespace detail {

@@ -10,31 +10,31 @@
 
 namespace glintbake::format {
 
-const char* statusString(Status status) {
+const char* statusString(ContainerStatus status) {
   switch (status) {
-    case Status::kOk:
+    case ContainerStatus::kOk:
       return "ok";
-    case Status::kIoError:
+    case ContainerStatus::kIoError:
       return "i/o error";
-    case Status::kBadMagic:
+    case ContainerStatus::kBadMagic:
       return "not a glintbake container";
-    case Status::kUnsupportedVersion:
+    case ContainerStatus::kUnsupportedVersion:
       return "unsupported container version";
-    case Status::kCorruptHeader:
+    case ContainerStatus::kCorruptHeader:
       return "corrupt header";
-    case Status::kCorruptIndex:
+    case ContainerStatus::kCorruptIndex:
       return "corrupt section index";
-    case Status::kChecksumMismatch:
+    case ContainerStatus::kChecksumMismatch:
       return "checksum mismatch";
-    case Status::kDecompressFailed:
+    case ContainerStatus::kDecompressFailed:
       return "section does not decode";
-    case Status::kTooLarge:
+    case ContainerStatus::kTooLarge:
       return "exceeds a reader limit";
-    case Status::kNotFound:
+    case ContainerStatus::kNotFound:
       return "section not found";
-    case Status::kInvalidArgument:
+    case ContainerStatus::kInvalidArgument:
       return "invalid argument";
-    case Status::kTruncated:
+    case ContainerStatus::kTruncated:
       return "file is truncated";
   }
   return "unknown status";

@@ -292,20 +292,20 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       [](const ValidationMessage& m) { return m.severity == Severity::kError && (m.id < 3000 || m.id == 3001); });
   if (structure_unusable || parsed.sections.size() != parsed.header.section_count) return report;
 
-  auto noteStatus = [&](Status status) {
-    if (report.status == Status::kOk) report.status = status;
+  auto noteStatus = [&](ContainerStatus status) {
+    if (report.status == ContainerStatus::kOk) report.status = status;
   };
   const auto& sections = parsed.sections;
   const AssetKind kind = AssetKind(parsed.header.asset_kind);
-  const bool index_sound = report.status == Status::kOk;
+  const bool index_sound = report.status == ContainerStatus::kOk;
 
   // 4xxx: whole-file checksum, then every section's bytes.
   if (index_sound) {
-    const Status checksum = detail::verifyFileChecksumOf(source, parsed.header.file_checksum);
-    if (checksum == Status::kIoError) {
+    const ContainerStatus checksum = detail::verifyFileChecksumOf(source, parsed.header.file_checksum);
+    if (checksum == ContainerStatus::kIoError) {
       addError(&report.messages, 1002, "cannot read the file");
       noteStatus(checksum);
-    } else if (checksum != Status::kOk) {
+    } else if (checksum != ContainerStatus::kOk) {
       addError(&report.messages, 4001, "whole-file checksum mismatch");
       noteStatus(checksum);
     }
@@ -320,15 +320,15 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     const bool known_codec = s.codec == uint32_t(Codec::kRaw) || s.codec == uint32_t(Codec::kZstd);
     if (!index_sound || !known_codec || !options.check_payloads) continue;
     raw.resize(size_t(s.raw_size));
-    const Status status = detail::readSectionFrom(source, s, raw.data(), raw.size());
-    if (status == Status::kChecksumMismatch) {
+    const ContainerStatus status = detail::readSectionFrom(source, s, raw.data(), raw.size());
+    if (status == ContainerStatus::kChecksumMismatch) {
       addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
-    } else if (status == Status::kDecompressFailed) {
+    } else if (status == ContainerStatus::kDecompressFailed) {
       addError(&report.messages, 4003, describe(i, s) + ": zstd data does not decode to exactly raw_size bytes");
-    } else if (status != Status::kOk) {
+    } else if (status != ContainerStatus::kOk) {
       addError(&report.messages, 1002, describe(i, s) + ": cannot be read (" + statusString(status) + ")");
     }
-    if (status != Status::kOk) {
+    if (status != ContainerStatus::kOk) {
       noteStatus(status);
       continue;
     }
@@ -360,7 +360,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   for (size_t i = 0; i < sections.size(); ++i) {
     if (sections[i].type != kSectionMetadata || !readable[i]) continue;
     std::vector<uint8_t> bytes(size_t(sections[i].raw_size));
-    if (detail::readSectionFrom(source, sections[i], bytes.data(), bytes.size()) != Status::kOk) break;
+    if (detail::readSectionFrom(source, sections[i], bytes.data(), bytes.size()) != ContainerStatus::kOk) break;
     validateMetadata(std::string(bytes.begin(), bytes.end()), kind, &report.messages);
     break;
   }
@@ -394,7 +394,7 @@ ValidationReport validateFile(const std::string& path, const ValidateOptions& op
   detail::FileSource source;
   if (!source.open(path)) {
     ValidationReport report;
-    report.status = Status::kIoError;
+    report.status = ContainerStatus::kIoError;
     report.messages.push_back({1001, Severity::kError, "cannot open the file for reading"});
     return report;
   }

@@ -71,8 +71,8 @@ bool isFloatImagePath(const std::string& path) {
   return ext == "exr" || ext == "hdr" || ext == "pfm";
 }
 
-Status writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
-                  const ImageWriteOptions& options) {
+BakeStatus writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
+                      const ImageWriteOptions& options) {
   if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || pixels == nullptr) {
     return makeError(ErrorCode::kBadArgument, path + ": cannot write a " + std::to_string(width) + "x" +
                                                   std::to_string(height) + "x" + std::to_string(channels) + " image");
@@ -143,7 +143,7 @@ Status writeImage(const std::string& path, int width, int height, int channels, 
   return okStatus();
 }
 
-Status writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options) {
+BakeStatus writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options) {
   if (map.width <= 0 || map.height <= 0 || map.normals.size() != size_t(map.width) * size_t(map.height) * 3) {
     return makeError(ErrorCode::kBadArgument, path + ": empty or inconsistent normal map");
   }

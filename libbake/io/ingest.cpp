@@ -173,7 +173,7 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
 }
 
 // The size and channel checks of the opened part.
-Status checkImageSpec(const std::string& path, const OIIO::ImageSpec& spec, const IngestOptions& options) {
+BakeStatus checkImageSpec(const std::string& path, const OIIO::ImageSpec& spec, const IngestOptions& options) {
   const int width = spec.width, height = spec.height, channels = spec.nchannels;
   if (spec.deep) {
     return makeError(ErrorCode::kUnsupported, path + ": deep images are not supported");
@@ -223,8 +223,8 @@ Result<std::vector<float>> readPixels(const std::string& path, OIIO::ImageInput&
 
 // A height field's normals. Non-finite heights would spread into their neighbours' normals; they
 // are counted, replaced by 0 when asked, and their own normal is (0,0,1) as for normal maps.
-Status heightsToMap(const std::string& path, std::vector<float>& pixels, const IngestOptions& options, NormalMap* map,
-                    IngestReport* r) {
+BakeStatus heightsToMap(const std::string& path, std::vector<float>& pixels, const IngestOptions& options,
+                        NormalMap* map, IngestReport* r) {
   const size_t texels = size_t(map->width) * size_t(map->height);
   std::vector<size_t> bad_texels;
   for (size_t i = 0; i < texels; ++i) {
@@ -250,7 +250,7 @@ Status heightsToMap(const std::string& path, std::vector<float>& pixels, const I
     map->normals[i * 3 + 2] = 1.0f;
   }
   r->encoding_used = Encoding::kUnorm;
-  Status status = normaliseNormals(map, options, r);
+  BakeStatus status = normaliseNormals(map, options, r);
   if (!status) return makeError(status.error().code, path + ": " + status.error().message);
   r->nonfinite = bad;
   return okStatus();
@@ -271,8 +271,8 @@ Encoding chooseEncoding(const OIIO::ImageSpec& spec, const std::vector<float>& p
 }
 
 // A normal map's normals from `used` stored channels (2: z reconstructed).
-Status pixelsToMap(const std::string& path, const OIIO::ImageSpec& spec, const std::vector<float>& pixels, int used,
-                   const IngestOptions& options, NormalMap* map, IngestReport* r) {
+BakeStatus pixelsToMap(const std::string& path, const OIIO::ImageSpec& spec, const std::vector<float>& pixels, int used,
+                       const IngestOptions& options, NormalMap* map, IngestReport* r) {
   const Encoding encoding = chooseEncoding(spec, pixels, options.encoding);
   r->encoding_used = encoding;
   const float scale = encoding == Encoding::kUnorm ? 2.0f : 1.0f;
@@ -291,7 +291,7 @@ Status pixelsToMap(const std::string& path, const OIIO::ImageSpec& spec, const s
       n[2] = scale * p[2] + offset;
     }
   }
-  Status status = normaliseNormals(map, options, r);
+  BakeStatus status = normaliseNormals(map, options, r);
   if (!status) return makeError(status.error().code, path + ": " + status.error().message);
   return okStatus();
 }
@@ -311,7 +311,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   r->file_format = input.format_name();
   r->pixel_type = pixelTypeName(spec.format);
   r->channels_in = spec.nchannels;
-  if (Status s = checkImageSpec(path, spec, options); !s) return s.error();
+  if (BakeStatus s = checkImageSpec(path, spec, options); !s) return s.error();
 
   // Alpha and any extra channels are never read; height fields use the first channel only.
   const int used = options.height ? 1 : std::min(spec.nchannels, 3);
@@ -324,12 +324,12 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   map.height = spec.height;
   map.wrap = options.wrap;
   map.normals.resize(size_t(spec.width) * size_t(spec.height) * 3);
-  const Status decoded = options.height ? heightsToMap(path, pixels, options, &map, r)
-                                        : pixelsToMap(path, spec, pixels, used, options, &map, r);
+  const BakeStatus decoded = options.height ? heightsToMap(path, pixels, options, &map, r)
+                                            : pixelsToMap(path, spec, pixels, used, options, &map, r);
   if (!decoded) return decoded.error();
 
   std::string hex;
-  if (format::hashFile128Hex(path, &hex) != format::Status::kOk) {
+  if (format::hashFile128Hex(path, &hex) != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, path + ": cannot read file to hash it");
   }
   r->content_hash = hex.rfind("xxh3-128:", 0) == 0 ? hex : "xxh3-128:" + hex;

@@ -64,7 +64,7 @@ struct RowTally {
 
 }  // namespace
 
-Status normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report) {
+BakeStatus normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report) {
   GLINTBAKE_CHECK(map != nullptr);
   GLINTBAKE_CHECK(map->width > 0 && map->height > 0);
   GLINTBAKE_CHECK(map->normals.size() == size_t(map->width) * size_t(map->height) * 3);
@@ -201,7 +201,7 @@ Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const
   r->channels_in = channels;
   r->encoding_used = Encoding::kSnorm;
   r->content_hash.clear();
-  Status status = normaliseNormals(&map, options, r);
+  BakeStatus status = normaliseNormals(&map, options, r);
   if (!status) return status.error();
   return map;
 }

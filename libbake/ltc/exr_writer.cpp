@@ -23,7 +23,7 @@ std::string temporaryName(const std::string& path) {
   return path + suffix;
 }
 
-Status commit(const std::string& tmp, const std::string& path) {
+BakeStatus commit(const std::string& tmp, const std::string& path) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     return makeError(ErrorCode::kIo, "cannot write " + path + ": rename failed");
@@ -33,7 +33,7 @@ Status commit(const std::string& tmp, const std::string& path) {
 
 }  // namespace
 
-Status writeExr(const std::string& path, const std::vector<std::string>& channel_names, const ExrLevel& image) {
+BakeStatus writeExr(const std::string& path, const std::vector<std::string>& channel_names, const ExrLevel& image) {
   const std::string tmp = temporaryName(path);
   const size_t channels = channel_names.size();
   try {
@@ -55,8 +55,8 @@ Status writeExr(const std::string& path, const std::vector<std::string>& channel
   return commit(tmp, path);
 }
 
-Status writeMipmappedExr(const std::string& path, const std::string& channel_name,
-                         const std::vector<ExrLevel>& levels) {
+BakeStatus writeMipmappedExr(const std::string& path, const std::string& channel_name,
+                             const std::vector<ExrLevel>& levels) {
   if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no image levels to write");
   const std::string tmp = temporaryName(path);
   try {

@@ -17,10 +17,11 @@ struct ExrLevel {
 };
 
 // Writes a scanline EXR with the given channel names (ZIP compression).
-Status writeExr(const std::string& path, const std::vector<std::string>& channel_names, const ExrLevel& image);
+BakeStatus writeExr(const std::string& path, const std::vector<std::string>& channel_names, const ExrLevel& image);
 
 // Writes a tiled, mipmapped EXR (rounding mode up: level l is ceil(w / 2^l) x ceil(h / 2^l)) of one
 // channel; `levels` must hold exactly the full chain down to 1 x 1.
-Status writeMipmappedExr(const std::string& path, const std::string& channel_name, const std::vector<ExrLevel>& levels);
+BakeStatus writeMipmappedExr(const std::string& path, const std::string& channel_name,
+                             const std::vector<ExrLevel>& levels);
 
 }  // namespace glintbake::bake::ltc

@@ -82,7 +82,7 @@ Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const Ro
   return levels;
 }
 
-Status writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path) {
+BakeStatus writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path) {
   if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no roughness levels to write");
   std::vector<ExrLevel> images;
   for (const auto& level : levels) images.push_back({level.width, level.height, level.alpha.data()});

@@ -12,8 +12,8 @@ namespace glintbake::bake::ltc {
 namespace {
 
 // One image section (SPEC 3.1) of width x height x channels floats, zstd-compressed when smaller.
-Status addImage(format::Writer& writer, uint32_t type, uint64_t key, int width, int height, uint32_t channels,
-                const float* values) {
+BakeStatus addImage(format::Writer& writer, uint32_t type, uint64_t key, int width, int height, uint32_t channels,
+                    const float* values) {
   format::ImageSectionHeader header;
   header.width = uint32_t(width);
   header.height = uint32_t(height);
@@ -23,7 +23,8 @@ Status addImage(format::Writer& writer, uint32_t type, uint64_t key, int width, 
   std::vector<uint8_t> bytes(sizeof(header) + count * sizeof(float));
   std::memcpy(bytes.data(), &header, sizeof(header));
   std::memcpy(bytes.data() + sizeof(header), values, count * sizeof(float));
-  if (format::Status st = writer.addSection(type, key, bytes.data(), bytes.size()); st != format::Status::kOk) {
+  if (format::ContainerStatus st = writer.addSection(type, key, bytes.data(), bytes.size());
+      st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write section ") + format::sectionTypeString(type) + " " +
                                          std::to_string(key) + ": " + format::statusString(st));
   }
@@ -32,19 +33,19 @@ Status addImage(format::Writer& writer, uint32_t type, uint64_t key, int width, 
 
 }  // namespace
 
-Status writeLtcTableSections(const PublishedTable& table, format::Writer& writer) {
-  if (Status s = addImage(writer, format::kSectionLtcTable, format::kLtcTableKeyMatrix, table.size, table.size,
-                          format::kLtcTableChannels, table.ltc1.data());
+BakeStatus writeLtcTableSections(const PublishedTable& table, format::Writer& writer) {
+  if (BakeStatus s = addImage(writer, format::kSectionLtcTable, format::kLtcTableKeyMatrix, table.size, table.size,
+                              format::kLtcTableChannels, table.ltc1.data());
       !s)
     return s;
   return addImage(writer, format::kSectionLtcTable, format::kLtcTableKeyAmplitude, table.size, table.size,
                   format::kLtcTableChannels, table.ltc2.data());
 }
 
-Status writeRoughnessSections(const std::vector<RoughnessLevel>& levels, format::Writer& writer) {
+BakeStatus writeRoughnessSections(const std::vector<RoughnessLevel>& levels, format::Writer& writer) {
   for (size_t i = 0; i < levels.size(); ++i) {
-    if (Status s = addImage(writer, format::kSectionRoughness, uint64_t(i), levels[i].width, levels[i].height,
-                            format::kRoughnessChannels, levels[i].alpha.data());
+    if (BakeStatus s = addImage(writer, format::kSectionRoughness, uint64_t(i), levels[i].width, levels[i].height,
+                                format::kRoughnessChannels, levels[i].alpha.data());
         !s)
       return s;
   }

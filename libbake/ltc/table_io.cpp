@@ -42,9 +42,9 @@ Result<std::vector<float>> readRgba(const std::string& path, int* size) {
 
 }  // namespace
 
-Status writePublishedExr(const PublishedTable& table, const std::string& prefix) {
+BakeStatus writePublishedExr(const PublishedTable& table, const std::string& prefix) {
   const std::vector<std::string> rgba = {"R", "G", "B", "A"};
-  Status status = writeExr(prefix + "_1.exr", rgba, {table.size, table.size, table.ltc1.data()});
+  BakeStatus status = writeExr(prefix + "_1.exr", rgba, {table.size, table.size, table.ltc1.data()});
   if (!status.ok()) return status;
   status = writeExr(prefix + "_2.exr", rgba, {table.size, table.size, table.ltc2.data()});
   if (!status.ok()) std::remove((prefix + "_1.exr").c_str());

@@ -26,7 +26,7 @@ std::string number(double v) {
 }
 
 // Fails with "<name> must be in [lo, hi] (or (lo, hi]), got v"; NaN never passes.
-Status checkRange(const char* name, double v, double lo, double hi, bool open_low) {
+BakeStatus checkRange(const char* name, double v, double lo, double hi, bool open_low) {
   const bool ok = (open_low ? v > lo : v >= lo) && v <= hi;
   if (ok) return okStatus();
   return makeError(ErrorCode::kBadArgument, std::string(name) + " must be in " + (open_low ? "(" : "[") + number(lo) +
@@ -76,13 +76,13 @@ double effectiveCell(MapKind kind, const MapParams& params) {
   return std::min(kDefaultGaussianCell, std::max(0.5, params.size / 4.0));
 }
 
-Status validateMapParams(MapKind kind, const MapParams& params) {
+BakeStatus validateMapParams(MapKind kind, const MapParams& params) {
   if (params.size < 1) {
     return makeError(ErrorCode::kBadArgument, "size must be >= 1, got " + std::to_string(params.size));
   }
   const double size = params.size;
   const double cell = effectiveCell(kind, params);
-  Status status = okStatus();
+  BakeStatus status = okStatus();
   switch (kind) {
     case MapKind::kFlat:
       break;

@@ -12,7 +12,7 @@
 namespace glintbake::bake::ndf {
 
 namespace {
-constexpr double kFlakesUpTo = 4.0;       // texels: the flakes answer at least this far
+constexpr double kFlakesUpTo = 4.0;  // texels: the flakes answer at least this far
 constexpr double kHalfOctave = 1.4142135623730951;
 constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
 }  // namespace
@@ -49,8 +49,8 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   return h;
 }
 
-Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
-                          const FlakesHandover& handover, uint64_t* bytes) {
+BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
+                              const FlakesHandover& handover, uint64_t* bytes) {
   format::FlakesRecord rec;
   rec.map_width = uint32_t(std::max(map.width, 0));
   rec.map_height = uint32_t(std::max(map.height, 0));
@@ -76,8 +76,8 @@ Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate
     normals[t * 2 + 0] = map.normals[t * 3 + 0];
     normals[t * 2 + 1] = map.normals[t * 3 + 1];
   }
-  if (format::Status s = writer.addSection(format::kSectionFlakes, 0, section.data(), section.size());
-      s != format::Status::kOk)
+  if (format::ContainerStatus s = writer.addSection(format::kSectionFlakes, 0, section.data(), section.size());
+      s != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, std::string("cannot write the flakes section: ") + format::statusString(s));
   if (bytes) *bytes = size;
   return okStatus();

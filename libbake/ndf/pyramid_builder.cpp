@@ -104,8 +104,8 @@ std::vector<Sample> planSamples(const LevelGeometry& geo, const format::NdfLevel
 
 }  // namespace
 
-Status validatePyramidOptions(const PyramidOptions& o) {
-  auto bad = [](const std::string& m) { return Status(makeError(ErrorCode::kBadArgument, m)); };
+BakeStatus validatePyramidOptions(const PyramidOptions& o) {
+  auto bad = [](const std::string& m) { return BakeStatus(makeError(ErrorCode::kBadArgument, m)); };
   if (o.splat.ndf_res < 2 || o.splat.ndf_res > 4096) return bad("--ndf-res must be in [2, 4096]");
   if (!(o.splat.sigma_r > 0.0 && o.splat.sigma_r <= 1.0)) return bad("--sigma-r must be in (0, 1]");
   if (!(o.splat.footprint_truncation >= 1.0 && o.splat.footprint_truncation <= 10.0))
@@ -135,30 +135,32 @@ LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions&
   return g;
 }
 
-Status WriterPyramidSink::addLevel(const format::NdfLevelRecord& record) {
+BakeStatus WriterPyramidSink::addLevel(const format::NdfLevelRecord& record) {
   if (format::RecordCheck c = format::checkNdfLevelRecord(record, record.level, record.level > 0 ? &below_ : nullptr);
       !c) {
     return makeError(ErrorCode::kRuntime, std::string("level descriptor fails its check: ") + c.detail);
   }
   below_ = record;
-  if (format::Status st = writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
-      st != format::Status::kOk) {
+  if (format::ContainerStatus st =
+          writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
+      st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
   }
   return okStatus();
 }
 
-Status WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
+BakeStatus WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
   const uint64_t key = format::ndfChunkKey(uint32_t(chunk.level), uint64_t(chunk.region));
-  if (format::Status st = writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
-      st != format::Status::kOk) {
+  if (format::ContainerStatus st =
+          writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
+      st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
   }
   return okStatus();
 }
 
-Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
-                       PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
+BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
+                           PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
   WriterPyramidSink sink(writer);
   return buildNdfPyramid(map, options, sink, report, progress, cancel);
 }
@@ -183,7 +185,7 @@ class PyramidBuild {
         res_(options.splat.ndf_res),
         image_floats_(size_t(res_) * size_t(res_)) {}
 
-  Status run();
+  BakeStatus run();
 
  private:
   // The level being built: its plan and its convergence samples.
@@ -200,13 +202,13 @@ class PyramidBuild {
   };
 
   bool cancelled() const { return cancel_ && cancel_->load(std::memory_order_relaxed); }
-  static Status cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
+  static BakeStatus cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
 
-  Status prepare();
+  BakeStatus prepare();
   Level planLevel(int level, std::vector<Sample> samples);
   // Computes the probe images; *converged when the level below already predicts this one.
-  Status probe(Level& lv, bool* converged);
-  Status buildLevel(Level& lv);
+  BakeStatus probe(Level& lv, bool* converged);
+  BakeStatus buildLevel(Level& lv);
   void computeImage(const Level& lv, int i, int j, float* out);
   void computeRegion(const Level& lv, int r, int slot);
   void regionExtent(const Level& lv, int r, int* cx0, int* cy0, int* cw, int* ch) const;
@@ -228,7 +230,7 @@ class PyramidBuild {
   std::vector<std::vector<double>> part_acc_;  // row-set sums of a split footprint
 };
 
-Status PyramidBuild::prepare() {
+BakeStatus PyramidBuild::prepare() {
   const auto t_flakes = Clock::now();
   Result<FlakeSet> flakes_or = buildFlakes(map_, options_.rate);
   if (!flakes_or) return flakes_or.error();
@@ -288,7 +290,7 @@ void PyramidBuild::computeImage(const Level& lv, int i, int j, float* out) {
 // the runtime's prediction from the level below is already within converge_mse there, the level
 // would add little (queries above the top clamp to the level below), so it is not computed at all.
 // Otherwise the probed images are reused when their regions are computed.
-Status PyramidBuild::probe(Level& lv, bool* converged) {
+BakeStatus PyramidBuild::probe(Level& lv, bool* converged) {
   *converged = false;
   if (options_.levels != 0 || lv.samples.empty()) return okStatus();
   try {
@@ -406,11 +408,11 @@ void PyramidBuild::collectSamples(Level& lv, const PyramidChunk& chunk, double* 
 }
 
 // The region pipeline of one level: region r + 1 is computed while region r is in the sink.
-Status PyramidBuild::buildLevel(Level& lv) {
+BakeStatus PyramidBuild::buildLevel(Level& lv) {
   PyramidLevelReport lrep;
   lrep.level = lv.level;
   lrep.geometry = lv.geo;
-  if (Status s = sink_.addLevel(lv.rec); !s) return s;
+  if (BakeStatus s = sink_.addLevel(lv.rec); !s) return s;
 
   const int region_count = lv.geo.regions_x * lv.geo.regions_y;
   const uint64_t level_images = uint64_t(lv.geo.grid_width) * uint64_t(lv.geo.grid_height);
@@ -422,7 +424,7 @@ Status PyramidBuild::buildLevel(Level& lv) {
     tbb::task_group next;
     if (r + 1 < region_count) next.run([&, r] { computeRegion(lv, r + 1, (r + 1) % 2); });
     const PyramidChunk chunk = chunkOf(lv, r, buffers_[r % 2]);
-    Status sunk = sink_.addChunk(chunk);
+    BakeStatus sunk = sink_.addChunk(chunk);
     next.wait();
     if (!sunk) return sunk;
     collectSamples(lv, chunk, &mse_sum);
@@ -433,23 +435,23 @@ Status PyramidBuild::buildLevel(Level& lv) {
     if (progress_) progress_(lv.level, done, level_images);
   }
   if (!lv.samples.empty()) lrep.mse_vs_previous = mse_sum / double(lv.samples.size());
-  if (Status s = sink_.endLevel(lv.level); !s) return s;
+  if (BakeStatus s = sink_.endLevel(lv.level); !s) return s;
   lrep.stored_bytes = sink_.storedBytes() - lv.bytes_before;
   lrep.seconds = secondsSince(lv.start);
   rep_.levels.push_back(lrep);
   return okStatus();
 }
 
-Status PyramidBuild::run() {
-  if (Status s = prepare(); !s) return s;
+BakeStatus PyramidBuild::run() {
+  if (BakeStatus s = prepare(); !s) return s;
   const int max_levels = options_.levels > 0 ? options_.levels : kMaxPyramidLevels;
   std::vector<Sample> samples;  // level 0 has no level below
   for (int level = 0; level < max_levels; ++level) {
     if (cancelled()) return cancelError();
     Level lv = planLevel(level, std::move(samples));
     bool converged = false;
-    if (Status s = probe(lv, &converged); !s || converged) return s;
-    if (Status s = buildLevel(lv); !s) return s;
+    if (BakeStatus s = probe(lv, &converged); !s || converged) return s;
+    if (BakeStatus s = buildLevel(lv); !s) return s;
     if (options_.levels == 0 && lv.geo.grid_width == 1 && lv.geo.grid_height == 1) {
       rep_.stop_reason = "grid-1x1";
       return okStatus();
@@ -462,9 +464,9 @@ Status PyramidBuild::run() {
 
 }  // namespace
 
-Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport* report,
-                       const PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  if (Status s = validatePyramidOptions(options); !s) return s;
+BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink,
+                           PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  if (BakeStatus s = validatePyramidOptions(options); !s) return s;
   PyramidReport local_report;
   PyramidReport& rep = report ? *report : local_report;
   rep = PyramidReport{};

@@ -6,7 +6,7 @@
 
 namespace glintbake::bake::render {
 
-using runtime::Status;
+using runtime::RuntimeStatus;
 
 ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r)
     : map_size_{flakes.width, flakes.height},
@@ -45,25 +45,25 @@ runtime::FootprintRange ReferencePndf::footprintRange() const {
   return range;
 }
 
-Status ReferencePndf::eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
-  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return Status::kInvalidArgument;
+RuntimeStatus ReferencePndf::eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
+  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return RuntimeStatus::kInvalidArgument;
   *value = evalSum(s.x, s.y);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status ReferencePndf::average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const {
-  if (!(rect.x1 > rect.x0) || !(rect.y1 > rect.y0)) return Status::kInvalidArgument;
+RuntimeStatus ReferencePndf::average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const {
+  if (!(rect.x1 > rect.x0) || !(rect.y1 > rect.y0)) return RuntimeStatus::kInvalidArgument;
   double sum = 0.0;
   for (const Lobe& l : lobes_) {
     sum += l.lobe.weight *
            reference::gaussianRectangleIntegral(l.lobe.mean, l.lobe.cov, rect.x0, rect.x1, rect.y0, rect.y1);
   }
   *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status ReferencePndf::sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const {
-  if (lobes_.empty() || !(total_ > 0.0)) return Status::kInvalidArgument;
+RuntimeStatus ReferencePndf::sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const {
+  if (lobes_.empty() || !(total_ > 0.0)) return RuntimeStatus::kInvalidArgument;
   // Choose a lobe with u1 and reuse the remainder of u1 inside the lobe's interval.
   const double target = u1 * total_;
   const size_t k =
@@ -79,18 +79,18 @@ Status ReferencePndf::sample(const runtime::Footprint&, double u1, double u2, ru
   out->s.x = l.lobe.mean[0] + l.chol[0] * z0;
   out->s.y = l.lobe.mean[1] + l.chol[1] * z0 + l.chol[2] * z1;
   out->pdf = evalSum(out->s.x, out->s.y) / total_;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status ReferencePndf::pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
-  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return Status::kInvalidArgument;
+RuntimeStatus ReferencePndf::pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const {
+  if (!std::isfinite(s.x) || !std::isfinite(s.y)) return RuntimeStatus::kInvalidArgument;
   *value = total_ > 0.0 ? evalSum(s.x, s.y) / total_ : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status ReferencePndf::mass(const runtime::Footprint&, double* value) const {
+RuntimeStatus ReferencePndf::mass(const runtime::Footprint&, double* value) const {
   *value = total_;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::bake::render

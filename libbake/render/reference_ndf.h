@@ -28,13 +28,14 @@ class ReferencePndf final : public runtime::NdfSource {
   runtime::FootprintRange footprintRange() const override;
   runtime::MapSize mapSize() const override { return map_size_; }
   runtime::MapWrap wrap() const override { return wrap_; }
-  runtime::Status eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
-  runtime::Status average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const override;
-  runtime::Status sample(const runtime::Footprint&, double u1, double u2, runtime::NdfSample* out) const override;
-  runtime::Status pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
-  runtime::Status mass(const runtime::Footprint&, double* value) const override;
-  runtime::Status image(const runtime::Footprint&, float*, size_t) const override {
-    return runtime::Status::kInvalidArgument;
+  runtime::RuntimeStatus eval(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
+  runtime::RuntimeStatus average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const override;
+  runtime::RuntimeStatus sample(const runtime::Footprint&, double u1, double u2,
+                                runtime::NdfSample* out) const override;
+  runtime::RuntimeStatus pdf(const runtime::Footprint&, const runtime::SPoint& s, double* value) const override;
+  runtime::RuntimeStatus mass(const runtime::Footprint&, double* value) const override;
+  runtime::RuntimeStatus image(const runtime::Footprint&, float*, size_t) const override {
+    return runtime::RuntimeStatus::kInvalidArgument;
   }
 
  private:

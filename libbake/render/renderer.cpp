@@ -168,7 +168,7 @@ class Shader {
     if (!(d2 > 0.0)) return true;
     const Vec3 wi = frame.toLocal((1.0 / std::sqrt(d2)) * d);
     Rgb f;
-    if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+    if (brdf.eval(wi, wo, &f) != runtime::RuntimeStatus::kOk) return false;
     const double k = std::fmax(0.0, wi.z) / d2;
     total->r += f.r * light.color[0] * k;
     total->g += f.g * light.color[1] * k;
@@ -181,7 +181,7 @@ class Shader {
                         Rgb* total) const {
     const Vec3 wi = frame.toLocal(normalize(toVec(light.direction)));
     Rgb f;
-    if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+    if (brdf.eval(wi, wo, &f) != runtime::RuntimeStatus::kOk) return false;
     const double k = std::fmax(0.0, wi.z);
     total->r += f.r * light.color[0] * k;
     total->g += f.g * light.color[1] * k;
@@ -214,16 +214,16 @@ class Shader {
         const Vec3 wi = frame.toLocal(wi_world);
         Rgb f;
         double bpdf = 0.0;
-        if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+        if (brdf.eval(wi, wo, &f) != runtime::RuntimeStatus::kOk) return false;
         if (wi.z > 0.0 && (f.r > 0.0 || f.g > 0.0 || f.b > 0.0)) {
-          if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
+          if (brdf.pdf(wi, wo, &bpdf) != runtime::RuntimeStatus::kOk) return false;
           const double lpdf = d2 / (poly.area * cos_l);
           add(&acc, f, wi.z * powerHeuristic(lpdf, bpdf) / lpdf);
         }
       }
       // BRDF sample.
       BrdfSample s;
-      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::RuntimeStatus::kOk) return false;
       if (s.pdf > 0.0 && s.wi.z > 0.0) {
         const Vec3 wi_world2 = frame.toWorld(s.wi);
         const double t = hitPolygon(poly, hit.position, wi_world2);
@@ -256,7 +256,7 @@ class Shader {
       if (!(amp > 0.0)) return true;
       Rgb radiance;
       if (runtime::prefilteredSgShading(brdf, local, options_.sg_epsilon * amp, wo, &radiance) !=
-          runtime::Status::kOk) {
+          runtime::RuntimeStatus::kOk) {
         return false;
       }
       add(total, radiance, 1.0);
@@ -270,9 +270,9 @@ class Shader {
       if (wi.z > 0.0 && lpdf > 0.0) {
         Rgb f;
         double bpdf = 0.0;
-        if (brdf.eval(wi, wo, &f) != runtime::Status::kOk) return false;
+        if (brdf.eval(wi, wo, &f) != runtime::RuntimeStatus::kOk) return false;
         if (f.r > 0.0 || f.g > 0.0 || f.b > 0.0) {
-          if (brdf.pdf(wi, wo, &bpdf) != runtime::Status::kOk) return false;
+          if (brdf.pdf(wi, wo, &bpdf) != runtime::RuntimeStatus::kOk) return false;
           const Rgb le = runtime::evalSg(sg, wi_world);
           const double k = wi.z * powerHeuristic(lpdf, bpdf) / lpdf;
           acc.r += f.r * le.r * k;
@@ -281,7 +281,7 @@ class Shader {
         }
       }
       BrdfSample s;
-      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::RuntimeStatus::kOk) return false;
       if (s.pdf > 0.0 && s.wi.z > 0.0) {
         const Vec3 w = frame.toWorld(s.wi);
         const Rgb le = runtime::evalSg(sg, w);
@@ -301,7 +301,7 @@ class Shader {
     Rgb acc;
     for (int n = 0; n < options_.spp; ++n) {
       BrdfSample s;
-      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::Status::kOk) return false;
+      if (brdf.sample(wo, rng.next(), rng.next(), &s) != runtime::RuntimeStatus::kOk) return false;
       if (s.pdf > 0.0 && s.wi.z > 0.0) add(&acc, s.weight, 1.0);
     }
     total->r += acc.r * light.color[0] * inv_spp;
@@ -319,7 +319,7 @@ class Shader {
     runtime::ltcShadingFrame(n, v, fx, fy, fz);
     runtime::LtcCoefficients ltc;
     if (options_.ltc->lookup(float(std::sqrt(brdf.alpha())), runtime::ltcCosTheta(n, v), &ltc) !=
-        runtime::Status::kOk) {
+        runtime::RuntimeStatus::kOk) {
       return Rgb{};
     }
     float verts[runtime::kLtcMaxPolygonVertices][3];

@@ -37,7 +37,7 @@ std::optional<CpMethod> parseCpMethod(std::string_view name) {
   return std::nullopt;
 }
 
-Status validateCpOptions(const CpOptions& o) {
+BakeStatus validateCpOptions(const CpOptions& o) {
   auto bad = [](const std::string& what) { return makeError(ErrorCode::kBadArgument, what); };
   if (o.rank < 1 || o.rank > kMaxCpRank)
     return bad("rank " + std::to_string(o.rank) + " out of range [1, " + std::to_string(kMaxCpRank) + "]");
@@ -64,7 +64,7 @@ float CpFactors::value(int k, int i, int j) const {
 
 namespace {
 
-Status validateTensor(const GroupTensor& t) {
+BakeStatus validateTensor(const GroupTensor& t) {
   if (t.bins < 1 || t.bins > kMaxBlockBins)
     return makeError(ErrorCode::kInvalidInput, "block size " + std::to_string(t.bins) + " out of range [1, " +
                                                    std::to_string(kMaxBlockBins) + "]");
@@ -161,8 +161,8 @@ CpFactors packFactors(const CpState& s, int bins, int blocks, int rank) {
 }  // namespace
 
 Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& options) {
-  if (Status st = validateCpOptions(options); !st) return st.error();
-  if (Status st = validateTensor(tensor); !st) return st.error();
+  if (BakeStatus st = validateCpOptions(options); !st) return st.error();
+  if (BakeStatus st = validateTensor(tensor); !st) return st.error();
   const int bins = tensor.bins, blocks = tensor.blocks, rank = options.rank;
   const float* x = tensor.values.data();
 
@@ -265,9 +265,9 @@ Result<CpFactors> decomposeCp(const GroupTensor& tensor, const CpOptions& option
 Result<CpFactors> decomposeCpToError(const GroupTensor& tensor, const CpOptions& options, double target_error) {
   if (!(target_error >= 0.0 && target_error <= 1.0))
     return makeError(ErrorCode::kBadArgument, "error target must be in [0, 1]");
-  if (Status st = validateCpOptions(options); !st) return st.error();
+  if (BakeStatus st = validateCpOptions(options); !st) return st.error();
   std::map<int, CpFactors> tried;
-  auto attempt = [&](int rank) -> Status {
+  auto attempt = [&](int rank) -> BakeStatus {
     CpOptions o = options;
     o.rank = rank;
     Result<CpFactors> r = decomposeCp(tensor, o);
@@ -277,11 +277,11 @@ Result<CpFactors> decomposeCpToError(const GroupTensor& tensor, const CpOptions&
   };
   // Invariant: rank lo misses the target (rank 0 by definition), rank hi meets it.
   int lo = 0, hi = options.rank;
-  if (Status st = attempt(hi); !st) return st.error();
+  if (BakeStatus st = attempt(hi); !st) return st.error();
   if (tried.at(hi).relative_error > target_error) return std::move(tried.at(hi));
   while (hi - lo > 1) {
     const int mid = lo + (hi - lo) / 2;
-    if (Status st = attempt(mid); !st) return st.error();
+    if (BakeStatus st = attempt(mid); !st) return st.error();
     if (tried.at(mid).relative_error <= target_error) {
       hi = mid;
     } else {

@@ -22,10 +22,10 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 // Runs f in an arena of `threads` workers (0: the caller's arena, e.g. the tool's global limit).
 template <typename F>
-Status inArena(int threads, F&& f) {
+BakeStatus inArena(int threads, F&& f) {
   if (threads <= 0) return f();
   tbb::task_arena arena(threads);
-  Status result = okStatus();
+  BakeStatus result = okStatus();
   arena.execute([&] { result = f(); });
   return result;
 }
@@ -34,14 +34,14 @@ Error invalid(const std::string& message) { return makeError(ErrorCode::kInvalid
 
 // Maps a reader failure to the library's categories: unreadable files are I/O errors, everything
 // else (checksums, decoding, sizes) means the container is corrupt.
-Error readError(const std::string& what, format::Status st) {
-  const ErrorCode code = st == format::Status::kIoError ? ErrorCode::kIo : ErrorCode::kInvalidInput;
+Error readError(const std::string& what, format::ContainerStatus st) {
+  const ErrorCode code = st == format::ContainerStatus::kIoError ? ErrorCode::kIo : ErrorCode::kInvalidInput;
   return makeError(code, "cannot read " + what + ": " + format::statusString(st));
 }
 
 // Checks a level record read from an untrusted container (the format's record check, against the
 // level below), plus the packer's own limits on the grid and the region.
-Status checkLevelRecord(const format::NdfLevelRecord& rec, int level, const format::NdfLevelRecord* below) {
+BakeStatus checkLevelRecord(const format::NdfLevelRecord& rec, int level, const format::NdfLevelRecord* below) {
   const std::string where = "ndf-level " + std::to_string(level) + ": ";
   if (format::RecordCheck c = format::checkNdfLevelRecord(rec, uint32_t(level), below); !c)
     return invalid(where + c.detail);
@@ -53,9 +53,9 @@ Status checkLevelRecord(const format::NdfLevelRecord& rec, int level, const form
 
 }  // namespace
 
-Status validateTensorPackOptions(const TensorPackOptions& o) {
-  if (Status s = validateCpOptions(o.cp); !s) return s;
-  auto bad = [](const std::string& m) { return Status(makeError(ErrorCode::kBadArgument, m)); };
+BakeStatus validateTensorPackOptions(const TensorPackOptions& o) {
+  if (BakeStatus s = validateCpOptions(o.cp); !s) return s;
+  auto bad = [](const std::string& m) { return BakeStatus(makeError(ErrorCode::kBadArgument, m)); };
   if (o.block < 1 || o.block > kMaxBlockBins)
     return bad("--block must be in [1, " + std::to_string(kMaxBlockBins) + "]");
   if (!(o.blank_threshold >= 0.0 && o.blank_threshold <= 1.0)) return bad("--blank-threshold must be in [0, 1]");
@@ -65,12 +65,12 @@ Status validateTensorPackOptions(const TensorPackOptions& o) {
   return okStatus();
 }
 
-Status packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
-                            format::Writer& writer, TensorPackReport* report, const ndf::PyramidProgress& progress,
-                            const std::atomic<bool>* cancel) {
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
+                                const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
   const auto t0 = Clock::now();
-  if (Status s = validateTensorPackOptions(options); !s) return s;
-  if (Status s = ndf::validatePyramidOptions(pyramid); !s) return s;
+  if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
+  if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
   if (pyramid.splat.ndf_res % options.block != 0) {
     return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options.block) + " must divide --ndf-res " +
                                                   std::to_string(pyramid.splat.ndf_res));
@@ -78,21 +78,21 @@ Status packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyr
   TensorPackReport local;
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
-  return inArena(options.threads, [&]() -> Status {
+  return inArena(options.threads, [&]() -> BakeStatus {
     detail::TensorPackSink sink(writer, options, rep, cancel);
     const auto t_build = Clock::now();
-    if (Status s = ndf::buildNdfPyramid(map, pyramid, sink, &rep.pyramid, progress, cancel); !s) return s;
+    if (BakeStatus s = ndf::buildNdfPyramid(map, pyramid, sink, &rep.pyramid, progress, cancel); !s) return s;
     rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
-    if (Status s = sink.finish(); !s) return s;
+    if (BakeStatus s = sink.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
     return okStatus();
   });
 }
 
-Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOptions& options, format::Writer& writer,
-                                TensorPackReport* report, const std::atomic<bool>* cancel) {
+BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOptions& options,
+                                    format::Writer& writer, TensorPackReport* report, const std::atomic<bool>* cancel) {
   const auto t0 = Clock::now();
-  if (Status s = validateTensorPackOptions(options); !s) return s;
+  if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
   if (reader.kind() != format::AssetKind::kNdfPyramid) {
     return invalid(std::string("not an ndf-pyramid container (asset kind ") + format::assetKindString(reader.kind()) +
                    ")");
@@ -100,7 +100,7 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
   TensorPackReport local;
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
-  return inArena(options.threads, [&]() -> Status {
+  return inArena(options.threads, [&]() -> BakeStatus {
     detail::TensorPackSink sink(writer, options, rep, cancel);
     std::vector<uint8_t> bytes;
     std::vector<float> chunk_buffer;
@@ -114,12 +114,12 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
       if (reader.sections()[size_t(li)].raw_size != sizeof(format::NdfLevelRecord)) {
         return invalid("ndf-level " + std::to_string(level) + ": wrong section size");
       }
-      if (format::Status st = reader.readSection(size_t(li), &bytes); st != format::Status::kOk) {
+      if (format::ContainerStatus st = reader.readSection(size_t(li), &bytes); st != format::ContainerStatus::kOk) {
         return readError("ndf-level " + std::to_string(level), st);
       }
       format::NdfLevelRecord rec;
       std::memcpy(&rec, bytes.data(), sizeof(rec));
-      if (Status s = checkLevelRecord(rec, level, level > 0 ? &below : nullptr); !s) return s;
+      if (BakeStatus s = checkLevelRecord(rec, level, level > 0 ? &below : nullptr); !s) return s;
       below = rec;
       const int first_res = int(rec.ndf_res);
       if (first_res % options.block != 0) {
@@ -127,7 +127,7 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
                                                       " must divide the pyramid's NDF resolution " +
                                                       std::to_string(first_res));
       }
-      if (Status s = sink.addLevel(rec); !s) return s;
+      if (BakeStatus s = sink.addLevel(rec); !s) return s;
 
       const size_t image_floats = size_t(rec.ndf_res) * rec.ndf_res;
       const int regions = int(rec.regions_x * rec.regions_y);
@@ -152,8 +152,8 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
         } catch (const std::bad_alloc&) {
           return makeError(ErrorCode::kRuntime, "out of memory reading " + what);
         }
-        if (format::Status st = reader.readSectionInto(size_t(ci), chunk_buffer.data(), expected);
-            st != format::Status::kOk) {
+        if (format::ContainerStatus st = reader.readSectionInto(size_t(ci), chunk_buffer.data(), expected);
+            st != format::ContainerStatus::kOk) {
           return readError(what, st);
         }
         format::ImageSectionHeader header;
@@ -169,12 +169,12 @@ Status packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOp
         chunk.images = images;
         chunk.section = chunk_buffer.data();
         chunk.section_bytes = expected;
-        if (Status s = sink.addChunk(chunk); !s) return s;
+        if (BakeStatus s = sink.addChunk(chunk); !s) return s;
       }
-      if (Status s = sink.endLevel(level); !s) return s;
+      if (BakeStatus s = sink.endLevel(level); !s) return s;
     }
     if (level == 0) return invalid("the container has no ndf-level sections");
-    if (Status s = sink.finish(); !s) return s;
+    if (BakeStatus s = sink.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
     rep.ndf_seconds = rep.total_seconds - sink.secondsInside();
     return okStatus();

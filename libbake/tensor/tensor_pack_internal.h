@@ -46,13 +46,13 @@ class TensorPackSink final : public ndf::PyramidSink {
                  const std::atomic<bool>* cancel);
   ~TensorPackSink() override;
 
-  Status addLevel(const format::NdfLevelRecord& record) override;
-  Status addChunk(const ndf::PyramidChunk& chunk) override;
-  Status endLevel(int level) override;
+  BakeStatus addLevel(const format::NdfLevelRecord& record) override;
+  BakeStatus addChunk(const ndf::PyramidChunk& chunk) override;
+  BakeStatus endLevel(int level) override;
   uint64_t storedBytes() const override { return writer_.bytesWritten(); }
 
   // Writes the tensor-info record and completes the report. kInvalidInput when no block was kept.
-  Status finish();
+  BakeStatus finish();
   // Time spent inside this sink (the rest of the producer's time made NDF images).
   double secondsInside() const { return seconds_inside_; }
 
@@ -64,8 +64,8 @@ class TensorPackSink final : public ndf::PyramidSink {
     tbb::task_group task;
   };
 
-  Status writeFront();  // waits for the oldest pending group and writes it
-  Status writeSection(uint32_t type, uint64_t key, const void* data, size_t size);
+  BakeStatus writeFront();  // waits for the oldest pending group and writes it
+  BakeStatus writeSection(uint32_t type, uint64_t key, const void* data, size_t size);
 
   format::Writer& writer_;
   TensorPackOptions options_;

@@ -31,7 +31,7 @@ class ScopedTimer {
   Clock::time_point t0_;
 };
 
-Status cancelledError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
+BakeStatus cancelledError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
 
 }  // namespace
 
@@ -48,16 +48,16 @@ TensorPackSink::~TensorPackSink() {
   for (auto& p : pending_) p->task.wait();
 }
 
-Status TensorPackSink::writeSection(uint32_t type, uint64_t key, const void* data, size_t size) {
+BakeStatus TensorPackSink::writeSection(uint32_t type, uint64_t key, const void* data, size_t size) {
   ScopedTimer timer(report_.write_seconds);
-  if (format::Status st = writer_.addSection(type, key, data, size); st != format::Status::kOk) {
+  if (format::ContainerStatus st = writer_.addSection(type, key, data, size); st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write ") + format::sectionTypeString(type) +
                                          " section: " + format::statusString(st));
   }
   return okStatus();
 }
 
-Status TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
+BakeStatus TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   ScopedTimer inside(seconds_inside_);
   if (cancel_ && cancel_->load(std::memory_order_relaxed)) return cancelledError();
   const int res = int(record.ndf_res);
@@ -97,7 +97,7 @@ Status TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   return writeSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
 }
 
-Status TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
+BakeStatus TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
   ScopedTimer inside(seconds_inside_);
   if (cancel_ && cancel_->load(std::memory_order_relaxed)) return cancelledError();
   GLINTBAKE_CHECK(chunk.level == level_ && chunk.ndf_res == ndf_res_);
@@ -181,12 +181,12 @@ Status TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
   });
   pending_.push_back(std::move(p));
   while (pending_.size() > max_in_flight_) {
-    if (Status s = writeFront(); !s) return s;
+    if (BakeStatus s = writeFront(); !s) return s;
   }
   return okStatus();
 }
 
-Status TensorPackSink::writeFront() {
+BakeStatus TensorPackSink::writeFront() {
   Pending& p = *pending_.front();
   {
     ScopedTimer wait(report_.wait_seconds);
@@ -196,7 +196,7 @@ Status TensorPackSink::writeFront() {
   if (!result) return result.error();
   const EncodedGroup& g = result.value();
   const uint32_t group = uint32_t(report_.groups);
-  if (Status s = writeSection(format::kSectionTensorGroup, group, g.section.data(), g.section.size()); !s) return s;
+  if (BakeStatus s = writeSection(format::kSectionTensorGroup, group, g.section.data(), g.section.size()); !s) return s;
 
   TensorPackLevelReport& lrep = report_.levels.back();
   GLINTBAKE_CHECK(p.level == lrep.level);
@@ -214,14 +214,14 @@ Status TensorPackSink::writeFront() {
   return okStatus();
 }
 
-Status TensorPackSink::endLevel(int level) {
+BakeStatus TensorPackSink::endLevel(int level) {
   ScopedTimer inside(seconds_inside_);
   GLINTBAKE_CHECK(level == level_);
   while (!pending_.empty()) {
-    if (Status s = writeFront(); !s) return s;
+    if (BakeStatus s = writeFront(); !s) return s;
   }
-  if (Status s = writeSection(format::kSectionTensorIndex, uint64_t(level), index_.data(),
-                              index_.size() * sizeof(format::TensorIndexEntry));
+  if (BakeStatus s = writeSection(format::kSectionTensorIndex, uint64_t(level), index_.data(),
+                                  index_.size() * sizeof(format::TensorIndexEntry));
       !s) {
     return s;
   }
@@ -233,7 +233,7 @@ Status TensorPackSink::endLevel(int level) {
   return okStatus();
 }
 
-Status TensorPackSink::finish() {
+BakeStatus TensorPackSink::finish() {
   ScopedTimer inside(seconds_inside_);
   GLINTBAKE_CHECK(pending_.empty());
   if (report_.groups == 0) {
@@ -253,7 +253,7 @@ Status TensorPackSink::finish() {
   if (format::RecordCheck c = format::checkTensorInfoRecord(info); !c) {
     return makeError(ErrorCode::kRuntime, std::string("tensor-info record fails its check: ") + c.detail);
   }
-  if (Status s = writeSection(format::kSectionTensorInfo, 0, &info, sizeof(info)); !s) return s;
+  if (BakeStatus s = writeSection(format::kSectionTensorInfo, 0, &info, sizeof(info)); !s) return s;
 
   double error_squared = 0.0, norm_squared = 0.0;
   for (const TensorPackLevelReport& l : report_.levels) {

@@ -8,28 +8,28 @@
 
 namespace glintbake::runtime {
 
-inline Status fromFormatStatus(format::Status s) {
+inline RuntimeStatus fromFormatStatus(format::ContainerStatus s) {
   switch (s) {
-    case format::Status::kOk:
-      return Status::kOk;
-    case format::Status::kIoError:
-      return Status::kIoError;
-    case format::Status::kUnsupportedVersion:
-      return Status::kUnsupportedVersion;
+    case format::ContainerStatus::kOk:
+      return RuntimeStatus::kOk;
+    case format::ContainerStatus::kIoError:
+      return RuntimeStatus::kIoError;
+    case format::ContainerStatus::kUnsupportedVersion:
+      return RuntimeStatus::kUnsupportedVersion;
     default:
-      return Status::kInvalidAsset;
+      return RuntimeStatus::kInvalidAsset;
   }
 }
 
 // A record that fails its check makes the asset invalid, except an unknown record version.
-inline Status fromRecordCheck(const format::RecordCheck& check) {
+inline RuntimeStatus fromRecordCheck(const format::RecordCheck& check) {
   switch (check.status) {
     case format::RecordStatus::kOk:
-      return Status::kOk;
+      return RuntimeStatus::kOk;
     case format::RecordStatus::kUnsupportedVersion:
-      return Status::kUnsupportedVersion;
+      return RuntimeStatus::kUnsupportedVersion;
     default:
-      return Status::kInvalidAsset;
+      return RuntimeStatus::kInvalidAsset;
   }
 }
 

@@ -19,27 +19,27 @@ bool validRect(const SRect& r) {
 
 }  // namespace
 
-Status PyramidNdf::load(const format::Reader& reader) {
+RuntimeStatus PyramidNdf::load(const format::Reader& reader) {
   reset();
-  if (reader.kind() != kind()) return Status::kWrongKind;
-  const Status status = loadKind(reader);
-  if (status != Status::kOk) reset();
+  if (reader.kind() != kind()) return RuntimeStatus::kWrongKind;
+  const RuntimeStatus status = loadKind(reader);
+  if (status != RuntimeStatus::kOk) reset();
   return status;
 }
 
-Status PyramidNdf::open(const char* path) {
+RuntimeStatus PyramidNdf::open(const char* path) {
   reset();
-  if (!path) return Status::kInvalidArgument;
+  if (!path) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  if (Status s = fromFormatStatus(reader.open(path)); s != Status::kOk) return s;
+  if (RuntimeStatus s = fromFormatStatus(reader.open(path)); s != RuntimeStatus::kOk) return s;
   return load(reader);
 }
 
-Status PyramidNdf::openMemory(const void* data, size_t size) {
+RuntimeStatus PyramidNdf::openMemory(const void* data, size_t size) {
   reset();
-  if (!data) return Status::kInvalidArgument;
+  if (!data) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  if (Status s = fromFormatStatus(reader.openMemory(data, size)); s != Status::kOk) return s;
+  if (RuntimeStatus s = fromFormatStatus(reader.openMemory(data, size)); s != RuntimeStatus::kOk) return s;
   return load(reader);
 }
 
@@ -78,36 +78,36 @@ MapWrap PyramidNdf::wrap() const {
   return first && first->wrap == 1 ? MapWrap::kClamp : MapWrap::kRepeat;
 }
 
-Status PyramidNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return Status::kInvalidArgument;
+RuntimeStatus PyramidNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   return evalChecked(footprint, s, value);
 }
 
-Status PyramidNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!loaded() || !value || !validFootprint(footprint) || !validRect(rect)) return Status::kInvalidArgument;
+RuntimeStatus PyramidNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !validRect(rect)) return RuntimeStatus::kInvalidArgument;
   return averageChecked(footprint, rect, value);
 }
 
-Status PyramidNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+RuntimeStatus PyramidNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   if (!loaded() || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   return sampleChecked(footprint, u1, u2, out);
 }
 
-Status PyramidNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return Status::kInvalidArgument;
+RuntimeStatus PyramidNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   return pdfChecked(footprint, s, value);
 }
 
-Status PyramidNdf::mass(const Footprint& footprint, double* value) const {
-  if (!loaded() || !value || !validFootprint(footprint)) return Status::kInvalidArgument;
+RuntimeStatus PyramidNdf::mass(const Footprint& footprint, double* value) const {
+  if (!loaded() || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
   return massChecked(footprint, value);
 }
 
-Status PyramidNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!loaded()) return Status::kInvalidArgument;
+RuntimeStatus PyramidNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!loaded()) return RuntimeStatus::kInvalidArgument;
   const size_t n = size_t(resolution()) * size_t(resolution());
-  if (!out || out_count < n || !validFootprint(footprint)) return Status::kInvalidArgument;
+  if (!out || out_count < n || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
   return imageChecked(footprint, out);
 }
 

@@ -2,21 +2,21 @@
 
 namespace glintbake::runtime {
 
-const char* statusString(Status status) {
+const char* statusString(RuntimeStatus status) {
   switch (status) {
-    case Status::kOk:
+    case RuntimeStatus::kOk:
       return "ok";
-    case Status::kIoError:
+    case RuntimeStatus::kIoError:
       return "i/o error";
-    case Status::kInvalidAsset:
+    case RuntimeStatus::kInvalidAsset:
       return "invalid asset";
-    case Status::kWrongKind:
+    case RuntimeStatus::kWrongKind:
       return "asset kind not handled by this reader";
-    case Status::kUnsupportedVersion:
+    case RuntimeStatus::kUnsupportedVersion:
       return "unsupported container version";
-    case Status::kInvalidArgument:
+    case RuntimeStatus::kInvalidArgument:
       return "invalid argument";
-    case Status::kOutOfMemory:
+    case RuntimeStatus::kOutOfMemory:
       return "out of memory";
   }
   return "unknown status";

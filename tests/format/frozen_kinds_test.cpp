@@ -23,7 +23,7 @@ std::string frozenPath(const char* name) { return std::string(GLINTBAKE_TEST_DAT
 void openFrozen(const char* name, AssetKind kind, Reader* reader) {
   ReaderOptions options;
   options.verify_file_checksum = true;
-  ASSERT_EQ(reader->open(frozenPath(name), options), Status::kOk);
+  ASSERT_EQ(reader->open(frozenPath(name), options), ContainerStatus::kOk);
   EXPECT_EQ(reader->header().version_major, 1);
   EXPECT_EQ(reader->header().version_minor, 0);
   EXPECT_EQ(reader->kind(), kind);
@@ -37,7 +37,7 @@ std::vector<uint8_t> section(const Reader& reader, uint32_t type, uint64_t key) 
   const int index = reader.find(type, key);
   EXPECT_GE(index, 0) << "type " << type << " key " << key;
   if (index >= 0) {
-    EXPECT_EQ(reader.readSection(size_t(index), &bytes), Status::kOk);
+    EXPECT_EQ(reader.readSection(size_t(index), &bytes), ContainerStatus::kOk);
   }
   return bytes;
 }

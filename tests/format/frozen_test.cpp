@@ -17,7 +17,7 @@ TEST(FrozenV1_0, Minimal) {
   Reader reader;
   ReaderOptions options;
   options.verify_file_checksum = true;
-  ASSERT_EQ(reader.open(frozenPath("v1_0_minimal.gbk"), options), Status::kOk);
+  ASSERT_EQ(reader.open(frozenPath("v1_0_minimal.gbk"), options), ContainerStatus::kOk);
   EXPECT_EQ(reader.header().version_major, 1);
   EXPECT_EQ(reader.header().version_minor, 0);
   EXPECT_EQ(reader.kind(), AssetKind::kTest);
@@ -26,7 +26,7 @@ TEST(FrozenV1_0, Minimal) {
   EXPECT_EQ(reader.sections()[0].type, uint32_t(kSectionMetadata));
   EXPECT_EQ(reader.sections()[0].offset, 128u);
   std::string json;
-  ASSERT_EQ(reader.readMetadata(&json), Status::kOk);
+  ASSERT_EQ(reader.readMetadata(&json), ContainerStatus::kOk);
   EXPECT_EQ(json, frozen::minimalMetadata());
   const ValidationReport report = validateFile(frozenPath("v1_0_minimal.gbk"));
   EXPECT_TRUE(report.valid());
@@ -36,7 +36,7 @@ TEST(FrozenV1_0, Minimal) {
 TEST(FrozenV1_0, Image) {
   const std::string path = frozenPath("v1_0_image.gbk");
   Reader reader;
-  ASSERT_EQ(reader.open(path, {kDefaultMaxRawSectionSize, true}), Status::kOk);
+  ASSERT_EQ(reader.open(path, {kDefaultMaxRawSectionSize, true}), ContainerStatus::kOk);
   EXPECT_EQ(reader.header().version_major, 1);
   EXPECT_EQ(reader.kind(), AssetKind::kTest);
   ASSERT_EQ(reader.sections().size(), 3u);
@@ -49,7 +49,7 @@ TEST(FrozenV1_0, Image) {
   EXPECT_EQ(info.codec, uint32_t(Codec::kZstd));
   EXPECT_EQ(info.raw_size, 32u + 4 * 4 * 4 * 2);
   std::vector<uint8_t> bytes;
-  ASSERT_EQ(reader.readSection(size_t(image), &bytes), Status::kOk);
+  ASSERT_EQ(reader.readSection(size_t(image), &bytes), ContainerStatus::kOk);
   EXPECT_EQ(bytes, frozen::imageSection());
   ImageSectionHeader header;
   ASSERT_TRUE(parseImageSection(bytes.data(), bytes.size(), &header));
@@ -63,11 +63,11 @@ TEST(FrozenV1_0, Image) {
   const int raw = reader.find(kSectionFirstPrivate, frozen::kPrivateKey);
   ASSERT_EQ(raw, 2);
   EXPECT_EQ(reader.sections()[size_t(raw)].codec, uint32_t(Codec::kRaw));
-  ASSERT_EQ(reader.readSection(size_t(raw), &bytes), Status::kOk);
+  ASSERT_EQ(reader.readSection(size_t(raw), &bytes), ContainerStatus::kOk);
   EXPECT_EQ(bytes, frozen::privateSection());
 
   std::string json;
-  ASSERT_EQ(reader.readMetadata(&json), Status::kOk);
+  ASSERT_EQ(reader.readMetadata(&json), ContainerStatus::kOk);
   EXPECT_EQ(json, frozen::imageMetadata());
   EXPECT_TRUE(validateFile(path).messages.empty());
 }

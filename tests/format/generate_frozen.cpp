@@ -23,12 +23,12 @@ struct Section {
 bool writeKind(const char* path, AssetKind kind, const char* name, const char* tool,
                const std::vector<Section>& sections) {
   Writer writer;
-  if (writer.open(path, kind, 9) != Status::kOk) return false;
-  if (writer.addMetadata(frozen::kindMetadata(name, tool)) != Status::kOk) return false;
+  if (writer.open(path, kind, 9) != ContainerStatus::kOk) return false;
+  if (writer.addMetadata(frozen::kindMetadata(name, tool)) != ContainerStatus::kOk) return false;
   for (const Section& s : sections) {
-    if (writer.addSection(s.type, s.key, s.bytes.data(), s.bytes.size(), s.codec) != Status::kOk) return false;
+    if (writer.addSection(s.type, s.key, s.bytes.data(), s.bytes.size(), s.codec) != ContainerStatus::kOk) return false;
   }
-  return writer.finish() == Status::kOk;
+  return writer.finish() == ContainerStatus::kOk;
 }
 
 int writeKinds() {
@@ -58,22 +58,23 @@ int writeKinds() {
 int writeV1_0() {
   {
     Writer writer;
-    if (writer.open("v1_0_minimal.gbk", AssetKind::kTest) != Status::kOk) return 1;
-    if (writer.addMetadata(frozen::minimalMetadata()) != Status::kOk) return 1;
-    if (writer.finish() != Status::kOk) return 1;
+    if (writer.open("v1_0_minimal.gbk", AssetKind::kTest) != ContainerStatus::kOk) return 1;
+    if (writer.addMetadata(frozen::minimalMetadata()) != ContainerStatus::kOk) return 1;
+    if (writer.finish() != ContainerStatus::kOk) return 1;
   }
   {
     Writer writer;
-    if (writer.open("v1_0_image.gbk", AssetKind::kTest, 9) != Status::kOk) return 1;
-    if (writer.addMetadata(frozen::imageMetadata()) != Status::kOk) return 1;
+    if (writer.open("v1_0_image.gbk", AssetKind::kTest, 9) != ContainerStatus::kOk) return 1;
+    if (writer.addMetadata(frozen::imageMetadata()) != ContainerStatus::kOk) return 1;
     const auto image = frozen::imageSection();
-    if (writer.addSection(kSectionImage, frozen::kImageKey, image.data(), image.size(), Codec::kZstd) != Status::kOk)
+    if (writer.addSection(kSectionImage, frozen::kImageKey, image.data(), image.size(), Codec::kZstd) !=
+        ContainerStatus::kOk)
       return 1;
     const auto raw = frozen::privateSection();
     if (writer.addSection(kSectionFirstPrivate, frozen::kPrivateKey, raw.data(), raw.size(), Codec::kRaw) !=
-        Status::kOk)
+        ContainerStatus::kOk)
       return 1;
-    if (writer.finish() != Status::kOk) return 1;
+    if (writer.finish() != ContainerStatus::kOk) return 1;
   }
   std::puts("wrote v1_0_minimal.gbk and v1_0_image.gbk");
   return 0;

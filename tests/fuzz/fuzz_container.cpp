@@ -47,16 +47,16 @@ void check(const uint8_t* data, size_t size) {
   ReaderOptions reader_options;
   reader_options.max_raw_section_size = validate_options.max_raw_section_size;
   Reader reader;
-  const Status status = reader.openMemory(data, size, reader_options);
-  if (report.valid() && status != Status::kOk) __builtin_trap();
-  if (status != Status::kOk) return;
+  const ContainerStatus status = reader.openMemory(data, size, reader_options);
+  if (report.valid() && status != ContainerStatus::kOk) __builtin_trap();
+  if (status != ContainerStatus::kOk) return;
   std::vector<uint8_t> out;
   for (size_t i = 0; i < reader.sections().size(); ++i) {
-    const Status read = reader.readSection(i, &out);
+    const ContainerStatus read = reader.readSection(i, &out);
     const uint32_t codec = reader.sections()[i].codec;
     const bool known = codec == uint32_t(Codec::kRaw) || codec == uint32_t(Codec::kZstd);
-    if (report.valid() && known && read != Status::kOk) __builtin_trap();
-    if (read == Status::kOk && out.size() != reader.sections()[i].raw_size) __builtin_trap();
+    if (report.valid() && known && read != ContainerStatus::kOk) __builtin_trap();
+    if (read == ContainerStatus::kOk && out.size() != reader.sections()[i].raw_size) __builtin_trap();
   }
   std::string json;
   (void)reader.readMetadata(&json);

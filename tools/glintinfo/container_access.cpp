@@ -10,9 +10,9 @@ namespace glintbake::glintinfo {
 
 std::unique_ptr<format::Reader> openContainer(const std::string& path) {
   auto reader = std::make_unique<format::Reader>();
-  const format::Status status = reader->open(path);
-  if (status == format::Status::kOk) return reader;
-  if (status == format::Status::kIoError) {
+  const format::ContainerStatus status = reader->open(path);
+  if (status == format::ContainerStatus::kOk) return reader;
+  if (status == format::ContainerStatus::kIoError) {
     const int err = errno;
     throw cli::Error(cli::kExitIo, "cannot read " + path + (err ? std::string(": ") + std::strerror(err) : ""));
   }
@@ -32,8 +32,8 @@ std::unique_ptr<format::Reader> openContainer(const std::string& path) {
 
 std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i) {
   std::vector<uint8_t> bytes;
-  const format::Status status = reader.readSection(i, &bytes);
-  if (status != format::Status::kOk) {
+  const format::ContainerStatus status = reader.readSection(i, &bytes);
+  if (status != format::ContainerStatus::kOk) {
     throw cli::Error(cli::exitCodeOf(status),
                      path + ": section " + std::to_string(i) + ": " + format::statusString(status));
   }

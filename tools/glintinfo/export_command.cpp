@@ -148,7 +148,7 @@ int runExport(cli::Tool& tool, const ExportOptions& options) {
     for (float& v : out) v = std::isfinite(v) ? v * inv : 0.0f;
   }
 
-  const bake::Status status =
+  const bake::BakeStatus status =
       bake::writeImage(options.output, int(header.width), int(header.height), out_channels, out.data());
   cli::check(status);
   tool.addOutput(options.output);

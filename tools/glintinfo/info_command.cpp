@@ -146,11 +146,11 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
     std::printf("map:            %d x %d texels, wrap %s\n", s["map"]["width"].get<int>(),
                 s["map"]["height"].get<int>(), s["map"]["wrap"].get<std::string>().c_str());
     if (f["exact_max_sigma"].get<double>() > 0.0 && f["clustered_max_sigma"].get<double>() > 0.0) {
-      std::printf("footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile) from %g "
-                  "to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
-                  f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(),
-                  f["clustered_min_sigma"].get<double>(), f["clustered_max_sigma"].get<double>(),
-                  f["handover_max_sigma"].get<double>());
+      std::printf(
+          "footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile) from %g "
+          "to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
+          f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(), f["clustered_min_sigma"].get<double>(),
+          f["clustered_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());
     } else if (f["exact_max_sigma"].get<double>() > 0.0) {
       std::printf("footprints:     exact from the flakes for sigma <= %g texels, blended into the pyramid up to %g\n",
                   f["exact_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());

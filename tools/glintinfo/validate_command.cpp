@@ -18,7 +18,7 @@ CLI::App* addValidateCommand(CLI::App& app, ValidateOptions& options) {
 
 int runValidate(cli::Tool& tool, const ValidateOptions& options) {
   const format::ValidationReport report = format::validateFile(options.file);
-  if (report.status == format::Status::kIoError && !report.messages.empty() && report.messages[0].id == 1001) {
+  if (report.status == format::ContainerStatus::kIoError && !report.messages.empty() && report.messages[0].id == 1001) {
     throw cli::Error(cli::kExitIo, "cannot read " + options.file);
   }
 
@@ -48,9 +48,9 @@ int runValidate(cli::Tool& tool, const ValidateOptions& options) {
       break;
     }
   }
-  const int code = report.status == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
-                   : report.status == format::Status::kIoError          ? cli::kExitIo
-                                                                        : cli::kExitInvalidInput;
+  const int code = report.status == format::ContainerStatus::kUnsupportedVersion ? cli::kExitUnsupported
+                   : report.status == format::ContainerStatus::kIoError          ? cli::kExitIo
+                                                                                 : cli::kExitInvalidInput;
   throw cli::Error(code, options.file + " is not valid: error-" + std::to_string(first->id) + ": " + first->message);
 }
 

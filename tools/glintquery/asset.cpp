@@ -32,8 +32,8 @@ void parsePair(const std::string& text, const char* option, double* a, double* b
 Asset openAsset(cli::Tool& tool, const std::string& path) {
   tool.addInput(path);
   Asset asset;
-  const runtime::Status s = runtime::openNdfAsset(path.c_str(), &asset.source);
-  if (s == runtime::Status::kOk) {
+  const runtime::RuntimeStatus s = runtime::openNdfAsset(path.c_str(), &asset.source);
+  if (s == runtime::RuntimeStatus::kOk) {
     asset.kind = glintbake::format::assetKindString(asset.source->kind());
     return asset;
   }
@@ -55,8 +55,8 @@ runtime::Footprint parseFootprint(const FootprintOptions& options) {
   return fp;
 }
 
-void checkQuery(runtime::Status s, const char* what) {
-  if (s != runtime::Status::kOk)
+void checkQuery(runtime::RuntimeStatus s, const char* what) {
+  if (s != runtime::RuntimeStatus::kOk)
     throw Error(cli::kExitBadArguments, std::string(what) + ": " + runtime::statusString(s));
 }
 

@@ -52,13 +52,13 @@ Json answer(const rt::NdfSource& ndf, const Json& q) {
   Json out;
   out["op"] = op;
   if (q.contains("id")) out["id"] = q["id"];
-  auto fail = [](rt::Status s) { throw std::invalid_argument(rt::statusString(s)); };
+  auto fail = [](rt::RuntimeStatus s) { throw std::invalid_argument(rt::statusString(s)); };
   if (op == "point" || op == "pdf") {
     const std::vector<double> s = numbers(q, "s", 2);
     double v = 0.0;
-    const rt::Status st =
+    const rt::RuntimeStatus st =
         op == "point" ? ndf.eval(fp, rt::SPoint{s[0], s[1]}, &v) : ndf.pdf(fp, rt::SPoint{s[0], s[1]}, &v);
-    if (st != rt::Status::kOk) fail(st);
+    if (st != rt::RuntimeStatus::kOk) fail(st);
     if (op == "pdf") out["pdf"] = v;
     out["value"] = v;
   } else if (op == "range") {
@@ -79,7 +79,7 @@ Json answer(const rt::NdfSource& ndf, const Json& q) {
     if (!(rect.x1 > rect.x0 && rect.y1 > rect.y0))
       throw std::invalid_argument("a range needs s0 < s1 in both coordinates");
     double v = 0.0;
-    if (rt::Status st = ndf.average(fp, rect, &v); st != rt::Status::kOk) fail(st);
+    if (rt::RuntimeStatus st = ndf.average(fp, rect, &v); st != rt::RuntimeStatus::kOk) fail(st);
     out["average"] = v;
     out["value"] = v;
   } else if (op == "sample") {
@@ -87,15 +87,16 @@ Json answer(const rt::NdfSource& ndf, const Json& q) {
     if (!(u[0] >= 0.0 && u[0] < 1.0 && u[1] >= 0.0 && u[1] < 1.0))
       throw std::invalid_argument("'u' must hold two numbers in [0, 1)");
     rt::NdfSample smp;
-    if (rt::Status st = ndf.sample(fp, u[0], u[1], &smp); st != rt::Status::kOk) {
-      if (st == rt::Status::kInvalidArgument) throw std::invalid_argument("the footprint's NDF has no mass to sample");
+    if (rt::RuntimeStatus st = ndf.sample(fp, u[0], u[1], &smp); st != rt::RuntimeStatus::kOk) {
+      if (st == rt::RuntimeStatus::kInvalidArgument)
+        throw std::invalid_argument("the footprint's NDF has no mass to sample");
       fail(st);
     }
     out["s"] = {smp.s.x, smp.s.y};
     out["pdf"] = smp.pdf;
   } else if (op == "mass") {
     double v = 0.0;
-    if (rt::Status st = ndf.mass(fp, &v); st != rt::Status::kOk) fail(st);
+    if (rt::RuntimeStatus st = ndf.mass(fp, &v); st != rt::RuntimeStatus::kOk) fail(st);
     out["mass"] = v;
   } else {
     throw std::invalid_argument("unknown op '" + op + "' (point, range, sample, pdf, mass)");

@@ -55,6 +55,6 @@ void addFootprintOptions(CLI::App* cmd, FootprintOptions& options);
 // Checks --at and --sigma; the footprint they give.
 runtime::Footprint parseFootprint(const FootprintOptions& options);
 // kExitBadArguments naming the query when a runtime query failed.
-void checkQuery(runtime::Status status, const char* what);
+void checkQuery(runtime::RuntimeStatus status, const char* what);
 
 }  // namespace glintbake::glintquery

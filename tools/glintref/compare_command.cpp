@@ -62,7 +62,8 @@ int runCompare(cli::Tool& tool, CompareOptions& options) {
     wo.png_bits = 8;
     wo.temporary_path = out.temporaryPath();
     wo.rename = false;
-    const bake::Status st = bake::writeImage(options.heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
+    const bake::BakeStatus st =
+        bake::writeImage(options.heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
     if (!st) throw cli::Error(int(st.error().code), st.error().message);
     out.commit();
     tool.addOutput(options.heatmap);

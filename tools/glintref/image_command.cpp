@@ -61,7 +61,7 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
   std::vector<float> pixels(image.size());
   for (size_t k = 0; k < image.size(); ++k) pixels[k] = float(image[k] * scale);
 
-  const bake::Status written = bake::writeImage(options.output, res, res, 1, pixels.data());
+  const bake::BakeStatus written = bake::writeImage(options.output, res, res, 1, pixels.data());
   cli::check(written);
   tool.addOutput(options.output);
 

@@ -124,8 +124,8 @@ void loadRenderSources(cli::Tool& tool, const RenderOptions& options, bake::rend
       throw cli::Error(cli::kExitBadArguments, "--ndf asset needs material.asset (or --asset)");
     }
     tool.addInput(scene.material.asset);
-    const runtime::Status st = runtime::openNdfAsset(scene.material.asset.c_str(), &sources->asset);
-    if (st != runtime::Status::kOk) {
+    const runtime::RuntimeStatus st = runtime::openNdfAsset(scene.material.asset.c_str(), &sources->asset);
+    if (st != runtime::RuntimeStatus::kOk) {
       throw cli::Error(cli::exitCodeOf(st),
                        "cannot open asset " + scene.material.asset + ": " + runtime::statusString(st));
     }
@@ -136,8 +136,8 @@ void loadRenderSources(cli::Tool& tool, const RenderOptions& options, bake::rend
   }
   if (!options.ltc.empty()) {
     tool.addInput(options.ltc);
-    const runtime::Status st = sources->ltc.open(options.ltc.c_str());
-    if (st != runtime::Status::kOk) {
+    const runtime::RuntimeStatus st = sources->ltc.open(options.ltc.c_str());
+    if (st != runtime::RuntimeStatus::kOk) {
       throw cli::Error(cli::exitCodeOf(st), "cannot open LTC table " + options.ltc + ": " + runtime::statusString(st));
     }
   }

@@ -71,7 +71,7 @@ int runRoughness(cli::Tool& tool, const RoughnessArgs& args) {
     check(bake::ltc::writeRoughnessSections(levels, out.writer()));
     out.finish(metadata);
   }
-  const bake::Status status = bake::ltc::writeRoughnessExr(levels, args.output);
+  const bake::BakeStatus status = bake::ltc::writeRoughnessExr(levels, args.output);
   if (!status.ok()) {
     if (!args.container.empty()) std::remove(args.container.c_str());
     check(status);

@@ -76,7 +76,7 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
   cli::Json files = cli::Json::array();
   files.push_back(cli::baseName(args.output));
   if (!args.exr_prefix.empty()) {
-    const bake::Status status = bake::ltc::writePublishedExr(published, args.exr_prefix);
+    const bake::BakeStatus status = bake::ltc::writePublishedExr(published, args.exr_prefix);
     if (!status.ok()) {
       std::remove((args.exr_prefix + "_1.exr").c_str());
       std::remove(args.output.c_str());

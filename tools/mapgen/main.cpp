@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     if (ext != "exr" && ext != "png" && ext != "tif" && ext != "tiff") {
       throw Error(cli::kExitBadArguments, "output " + output + " must end in .exr, .png or .tif");
     }
-    const bake::Status valid = bake::validateMapParams(kind, params);
+    const bake::BakeStatus valid = bake::validateMapParams(kind, params);
     if (!valid) throw Error(cli::kExitBadArguments, valid.error().message);
 
     const bake::NormalMap map = bake::generateMap(kind, params);
@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     write_options.half_float = half;
     write_options.temporary_path = atomic.temporaryPath();
     write_options.rename = false;
-    const bake::Status written = bake::writeNormalMap(output, map, write_options);
+    const bake::BakeStatus written = bake::writeNormalMap(output, map, write_options);
     cli::check(written);
     atomic.commit();
     t.addOutput(output);

@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
 
     bake::ndf::PyramidReport report;
     cli::LevelProgress progress(t);
-    const bake::Status built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
     progress.finish();
     cli::check(built);
     const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);

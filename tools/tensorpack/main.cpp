@@ -184,7 +184,7 @@ void resolveOptions(const CLI::App& app, Options& o) {
     throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
   }
   if (o.zstd_level < 1 || o.zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-  if (bake::Status s = tensor::validateTensorPackOptions(o.pack); !s)
+  if (bake::BakeStatus s = tensor::validateTensorPackOptions(o.pack); !s)
     throw Error(exitCodeOf(s.error()), s.error().message);
 }
 
@@ -225,10 +225,10 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
         throw Error(cli::kExitBadArguments, flag->get_name() + " applies to normal-map inputs only");
     }
     t.addInput(o.input);
-    if (format::Status st = in.reader.open(o.input); st != format::Status::kOk) {
-      const int code = st == format::Status::kIoError              ? cli::kExitIo
-                       : st == format::Status::kUnsupportedVersion ? cli::kExitUnsupported
-                                                                   : cli::kExitInvalidInput;
+    if (format::ContainerStatus st = in.reader.open(o.input); st != format::ContainerStatus::kOk) {
+      const int code = st == format::ContainerStatus::kIoError              ? cli::kExitIo
+                       : st == format::ContainerStatus::kUnsupportedVersion ? cli::kExitUnsupported
+                                                                            : cli::kExitInvalidInput;
       throw Error(code, o.input + ": " + format::statusString(st));
     }
     if (in.reader.kind() != format::AssetKind::kNdfPyramid) {
@@ -236,7 +236,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
                                               format::assetKindString(in.reader.kind()) + ")");
     }
     std::string meta_text;
-    if (in.reader.readMetadata(&meta_text) == format::Status::kOk) {
+    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk) {
       const Json source = Json::parse(meta_text, nullptr, false);
       if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
       if (source.is_object() && source.contains("asset")) in.source_asset = source["asset"];
@@ -264,7 +264,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
 tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out,
                                    bake::ndf::FlakesHandover& handover, uint64_t* flake_bytes) {
   tensor::TensorPackReport report;
-  bake::Status s = bake::okStatus();
+  bake::BakeStatus s = bake::okStatus();
   if (in.from_container) {
     s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
   } else {
@@ -283,15 +283,17 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     errors.push_back(l.relative_error);
   }
   const int lobes = in.from_container ? bake::ndf::kDefaultLobesPerTile : o.pyramid.lobes;
-  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), kFaithfulLevelError, lobes);
+  handover =
+      bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), kFaithfulLevelError, lobes);
   if (!in.from_container) {
     *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
     std::vector<uint8_t> flakes;
-    format::Status st = in.reader.readSection(size_t(idx), &flakes);
-    if (st == format::Status::kOk) {
+    format::ContainerStatus st = in.reader.readSection(size_t(idx), &flakes);
+    if (st == format::ContainerStatus::kOk) {
       format::FlakesRecord rec;
-      if (flakes.size() < sizeof(rec)) throw Error(cli::kExitInvalidInput, o.input + ": the flakes section is truncated");
+      if (flakes.size() < sizeof(rec))
+        throw Error(cli::kExitInvalidInput, o.input + ": the flakes section is truncated");
       std::memcpy(&rec, flakes.data(), sizeof(rec));
       rec.version = format::FlakesRecord().version;
       rec.flakes_up_to = handover.flakes_up_to;
@@ -304,7 +306,7 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
       st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
       *flake_bytes = flakes.size();
     }
-    if (st != format::Status::kOk)
+    if (st != format::ContainerStatus::kOk)
       throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
   }
   return report;

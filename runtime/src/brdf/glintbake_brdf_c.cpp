@@ -14,7 +14,7 @@ namespace {
 
 using namespace glintbake::runtime;
 
-int32_t code(Status s) { return static_cast<int32_t>(s); }
+int32_t code(RuntimeStatus s) { return static_cast<int32_t>(s); }
 
 Vec3 toVec(const double v[3]) { return Vec3{v[0], v[1], v[2]}; }
 Rgb toRgb(const double v[3]) { return Rgb{v[0], v[1], v[2]}; }
@@ -60,27 +60,28 @@ bool makeSg(const gb_sg* in, SphericalGaussian* out) {
 extern "C" {
 
 int32_t gb_brdf_ndf_open(const char* path, gb_brdf_ndf** out) {
-  if (out == nullptr) return code(Status::kInvalidArgument);
+  if (out == nullptr) return code(RuntimeStatus::kInvalidArgument);
   *out = nullptr;
-  if (path == nullptr) return code(Status::kInvalidArgument);
+  if (path == nullptr) return code(RuntimeStatus::kInvalidArgument);
   std::unique_ptr<NdfSource> source;
-  const Status st = openNdfAsset(path, &source);
-  if (st != Status::kOk) return code(st);
+  const RuntimeStatus st = openNdfAsset(path, &source);
+  if (st != RuntimeStatus::kOk) return code(st);
   gb_brdf_ndf* ndf = new (std::nothrow) gb_brdf_ndf;
-  if (ndf == nullptr) return code(Status::kOutOfMemory);
+  if (ndf == nullptr) return code(RuntimeStatus::kOutOfMemory);
   ndf->source = std::move(source);
   *out = ndf;
-  return code(Status::kOk);
+  return code(RuntimeStatus::kOk);
 }
 
 void gb_brdf_ndf_close(gb_brdf_ndf* ndf) { delete ndf; }
 
 int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]) {
   MicrofacetBrdf brdf;
-  if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || f == nullptr) return code(Status::kInvalidArgument);
+  if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || f == nullptr)
+    return code(RuntimeStatus::kInvalidArgument);
   Rgb value;
-  const Status st = brdf.eval(toVec(wi), toVec(wo), &value);
-  if (st == Status::kOk) fromRgb(value, f);
+  const RuntimeStatus st = brdf.eval(toVec(wi), toVec(wo), &value);
+  if (st == RuntimeStatus::kOk) fromRgb(value, f);
   return code(st);
 }
 
@@ -88,40 +89,40 @@ int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double 
                        double* pdf, double weight[3]) {
   MicrofacetBrdf brdf;
   if (!makeBrdf(params, &brdf) || wo == nullptr || wi == nullptr || pdf == nullptr || weight == nullptr)
-    return code(Status::kInvalidArgument);
+    return code(RuntimeStatus::kInvalidArgument);
   BrdfSample s;
-  const Status st = brdf.sample(toVec(wo), u1, u2, &s);
-  if (st != Status::kOk) return code(st);
+  const RuntimeStatus st = brdf.sample(toVec(wo), u1, u2, &s);
+  if (st != RuntimeStatus::kOk) return code(st);
   wi[0] = s.wi.x;
   wi[1] = s.wi.y;
   wi[2] = s.wi.z;
   *pdf = s.pdf;
   fromRgb(s.weight, weight);
-  return code(Status::kOk);
+  return code(RuntimeStatus::kOk);
 }
 
 int32_t gb_brdf_pdf(const gb_brdf_params* params, const double wi[3], const double wo[3], double* pdf) {
   MicrofacetBrdf brdf;
   if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || pdf == nullptr)
-    return code(Status::kInvalidArgument);
+    return code(RuntimeStatus::kInvalidArgument);
   return code(brdf.pdf(toVec(wi), toVec(wo), pdf));
 }
 
 int32_t gb_sg_support(const gb_sg* sg, double eps, double* cos_theta_max, int32_t* empty) {
   SphericalGaussian g;
   if (!makeSg(sg, &g) || !(eps > 0.0) || cos_theta_max == nullptr || empty == nullptr)
-    return code(Status::kInvalidArgument);
+    return code(RuntimeStatus::kInvalidArgument);
   const SgSupport support = sgSupport(g, eps);
   *cos_theta_max = support.cos_theta_max;
   *empty = support.empty ? 1 : 0;
-  return code(Status::kOk);
+  return code(RuntimeStatus::kOk);
 }
 
 int32_t gb_sg_integral(const gb_sg* sg, double integral[3]) {
   SphericalGaussian g;
-  if (!makeSg(sg, &g) || integral == nullptr) return code(Status::kInvalidArgument);
+  if (!makeSg(sg, &g) || integral == nullptr) return code(RuntimeStatus::kInvalidArgument);
   fromRgb(sgIntegral(g), integral);
-  return code(Status::kOk);
+  return code(RuntimeStatus::kOk);
 }
 
 int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps, const double wo[3],
@@ -129,10 +130,10 @@ int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg,
   MicrofacetBrdf brdf;
   SphericalGaussian g;
   if (!makeBrdf(params, &brdf) || !makeSg(sg, &g) || wo == nullptr || radiance == nullptr)
-    return code(Status::kInvalidArgument);
+    return code(RuntimeStatus::kInvalidArgument);
   Rgb value;
-  const Status st = prefilteredSgShading(brdf, g, eps, toVec(wo), &value);
-  if (st == Status::kOk) fromRgb(value, radiance);
+  const RuntimeStatus st = prefilteredSgShading(brdf, g, eps, toVec(wo), &value);
+  if (st == RuntimeStatus::kOk) fromRgb(value, radiance);
   return code(st);
 }
 

@@ -118,43 +118,43 @@ MicrofacetBrdf MicrofacetBrdf::glinty(const NdfSource* source, const Footprint& 
   return brdf;
 }
 
-Status MicrofacetBrdf::ndf(const Vec3& h, double* value) const {
-  if (!finite(h)) return Status::kInvalidArgument;
+RuntimeStatus MicrofacetBrdf::ndf(const Vec3& h, double* value) const {
+  if (!finite(h)) return RuntimeStatus::kInvalidArgument;
   if (!(h.z > 0.0)) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   if (kind_ == NdfKind::kSmooth) {
     *value = microfacetD(model_, alpha_, h);
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
-  if (source_ == nullptr) return Status::kInvalidArgument;
+  if (source_ == nullptr) return RuntimeStatus::kInvalidArgument;
   return source_->eval(footprint_, SPoint{h.x, h.y}, value);
 }
 
-Status MicrofacetBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const {
-  if (!finite(wi) || !finite(wo)) return Status::kInvalidArgument;
+RuntimeStatus MicrofacetBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const {
+  if (!finite(wi) || !finite(wo)) return RuntimeStatus::kInvalidArgument;
   if (!(wi.z > 0.0) || !(wo.z > 0.0)) {
     *f = Rgb{};
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   const Vec3 h = normalize(wi + wo);
   double d = 0.0;
-  const Status st = ndf(h, &d);
-  if (st != Status::kOk) return st;
+  const RuntimeStatus st = ndf(h, &d);
+  if (st != RuntimeStatus::kOk) return st;
   const double g = smithG2(model_, alpha_, wi, wo);
   const double scale = d * g / (4.0 * wi.z * wo.z);
   const Rgb fr = evalFresnel(fresnel_, dot(wi, h));
   *f = Rgb{fr.r * scale, fr.g * scale, fr.b * scale};
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const {
-  if (!finite(wo) || !std::isfinite(u1) || !std::isfinite(u2)) return Status::kInvalidArgument;
+RuntimeStatus MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const {
+  if (!finite(wo) || !std::isfinite(u1) || !std::isfinite(u2)) return RuntimeStatus::kInvalidArgument;
   BrdfSample result;
   if (!(wo.z > 0.0)) {
     *out = result;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   Vec3 h;
   double density_h = 0.0;  // solid-angle density of h
@@ -162,18 +162,18 @@ Status MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* 
     h = sampleMicrofacetNormal(model_, alpha_, u1, u2);
     density_h = microfacetD(model_, alpha_, h) * h.z;
   } else {
-    if (source_ == nullptr) return Status::kInvalidArgument;
+    if (source_ == nullptr) return RuntimeStatus::kInvalidArgument;
     NdfSample s;
-    const Status st = source_->sample(footprint_, u1, u2, &s);
-    if (st != Status::kOk) {
+    const RuntimeStatus st = source_->sample(footprint_, u1, u2, &s);
+    if (st != RuntimeStatus::kOk) {
       // A footprint with no mass (e.g. outside a clamped map) reflects nothing.
       *out = result;
-      return Status::kOk;
+      return RuntimeStatus::kOk;
     }
     const double r2 = s.s.x * s.s.x + s.s.y * s.s.y;
     if (!(r2 < 1.0)) {
       *out = result;
-      return Status::kOk;
+      return RuntimeStatus::kOk;
     }
     h = Vec3{s.s.x, s.s.y, std::sqrt(1.0 - r2)};
     density_h = s.pdf * h.z;
@@ -181,46 +181,46 @@ Status MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* 
   const double wo_h = dot(wo, h);
   if (!(wo_h > 0.0) || !(density_h > 0.0)) {
     *out = result;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   result.wi = normalize(2.0 * wo_h * h - wo);
   // Report the density exactly as pdf() computes it from (wi, wo), so both agree up to rounding.
-  const Status st = pdf(result.wi, wo, &result.pdf);
-  if (st != Status::kOk) return st;
+  const RuntimeStatus st = pdf(result.wi, wo, &result.pdf);
+  if (st != RuntimeStatus::kOk) return st;
   if (result.wi.z > 0.0 && result.pdf > 0.0) {
     Rgb f;
-    const Status se = eval(result.wi, wo, &f);
-    if (se != Status::kOk) return se;
+    const RuntimeStatus se = eval(result.wi, wo, &f);
+    if (se != RuntimeStatus::kOk) return se;
     const double w = result.wi.z / result.pdf;
     result.weight = Rgb{f.r * w, f.g * w, f.b * w};
   }
   *out = result;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status MicrofacetBrdf::pdf(const Vec3& wi, const Vec3& wo, double* value) const {
-  if (!finite(wi) || !finite(wo)) return Status::kInvalidArgument;
+RuntimeStatus MicrofacetBrdf::pdf(const Vec3& wi, const Vec3& wo, double* value) const {
+  if (!finite(wi) || !finite(wo)) return RuntimeStatus::kInvalidArgument;
   const Vec3 sum = wi + wo;
   if (!(wo.z > 0.0) || !(dot(sum, sum) > 0.0)) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   const Vec3 h = normalize(sum);
   const double wo_h = dot(wo, h);
   if (!(h.z > 0.0) || !(wo_h > 0.0)) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   double d = 0.0;
   if (kind_ == NdfKind::kSmooth) {
     d = microfacetD(model_, alpha_, h);
   } else {
-    if (source_ == nullptr) return Status::kInvalidArgument;
-    const Status st = source_->pdf(footprint_, SPoint{h.x, h.y}, &d);
-    if (st != Status::kOk) return st;
+    if (source_ == nullptr) return RuntimeStatus::kInvalidArgument;
+    const RuntimeStatus st = source_->pdf(footprint_, SPoint{h.x, h.y}, &d);
+    if (st != RuntimeStatus::kOk) return st;
   }
   *value = d * h.z / (4.0 * wo_h);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

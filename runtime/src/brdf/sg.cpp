@@ -55,12 +55,13 @@ SgSupport sgSupport(const SphericalGaussian& sg, double eps) {
   return support;
 }
 
-Status sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo, SRect* rect, bool* has_support) {
-  if (!validSg(sg) || !finite(wo) || !std::isfinite(eps) || !(eps > 0.0)) return Status::kInvalidArgument;
+RuntimeStatus sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo, SRect* rect,
+                               bool* has_support) {
+  if (!validSg(sg) || !finite(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
   const SgSupport support = sgSupport(sg, eps);
   if (support.empty) {
     *has_support = false;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   *has_support = true;
   const SRect whole{-1.0, -1.0, 1.0, 1.0};
@@ -68,7 +69,7 @@ Status sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo,
   // The cone holds -wo: wi = -wo has no half vector and nearby wi reach every direction.
   if (cos_max <= -1.0 || -dot(wo, sg.axis) >= cos_max) {
     *rect = whole;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   const double sin_max = std::sqrt(std::fmax(0.0, 1.0 - cos_max * cos_max));
   Vec3 t, b;
@@ -110,21 +111,21 @@ Status sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo,
   constexpr double kMinSide = 1e-9;
   if (rect->x1 - rect->x0 < kMinSide) rect->x1 = rect->x0 + kMinSide;
   if (rect->y1 - rect->y0 < kMinSide) rect->y1 = rect->y0 + kMinSide;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
-                     double* value) {
+RuntimeStatus sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
+                            double* value) {
   SRect rect;
   bool has_support = false;
-  const Status st = sgHalfVectorRect(sg, eps, wo, &rect, &has_support);
-  if (st != Status::kOk) return st;
+  const RuntimeStatus st = sgHalfVectorRect(sg, eps, wo, &rect, &has_support);
+  if (st != RuntimeStatus::kOk) return st;
   if (!has_support) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   if (brdf.ndfKind() == NdfKind::kSource) {
-    if (brdf.source() == nullptr) return Status::kInvalidArgument;
+    if (brdf.source() == nullptr) return RuntimeStatus::kInvalidArgument;
     return brdf.source()->average(brdf.footprint(), rect, value);
   }
   constexpr int kGrid = 8;
@@ -139,26 +140,26 @@ Status sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, do
     }
   }
   *value = sum / (kGrid * kGrid);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status prefilteredSgShading(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
-                            Rgb* radiance) {
-  if (!validSg(sg) || !finite(wo) || !std::isfinite(eps) || !(eps > 0.0)) return Status::kInvalidArgument;
+RuntimeStatus prefilteredSgShading(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
+                                   Rgb* radiance) {
+  if (!validSg(sg) || !finite(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
   if (!(wo.z > 0.0) || !(sg.axis.z > 0.0)) {
     *radiance = Rgb{};
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   double d_avg = 0.0;
-  const Status st = sgAveragedNdf(brdf, sg, eps, wo, &d_avg);
-  if (st != Status::kOk) return st;
+  const RuntimeStatus st = sgAveragedNdf(brdf, sg, eps, wo, &d_avg);
+  if (st != RuntimeStatus::kOk) return st;
   const Vec3 h = normalize(sg.axis + wo);
   const Rgb f = evalFresnel(brdf.fresnel(), dot(sg.axis, h));
   const double g = smithG2(brdf.shadowingModel(), brdf.alpha(), sg.axis, wo);
   const Rgb integral = sgIntegral(sg);
   const double k = d_avg * g / (4.0 * wo.z);
   *radiance = Rgb{f.r * k * integral.r, f.g * k * integral.g, f.b * k * integral.b};
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 Vec3 sampleSg(const SphericalGaussian& sg, double u1, double u2, double* pdf) {

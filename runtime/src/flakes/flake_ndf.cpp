@@ -99,7 +99,7 @@ struct FlakeNdf::Impl {
   Array<Node> nodes;
   Array<uint32_t> tile_root;  // node index of every tile's root
 
-  Status build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in);
+  RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in);
   void buildFlakes(const float* normals, int tx, int ty, FlakeRec* out, uint32_t* count) const;
   void buildTree(uint32_t id, FlakeRec* f, uint32_t count, double origin_x, double origin_y, uint32_t* next_node,
                  uint32_t* next_block);
@@ -147,14 +147,14 @@ void FlakeNdf::Impl::buildFlakes(const float* normals, int tx, int ty, FlakeRec*
   *count = c;
 }
 
-Status FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in) {
+RuntimeStatus FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in) {
   width = src.width();
   height = src.height();
-  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return Status::kInvalidArgument;
+  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return RuntimeStatus::kInvalidArgument;
   if (rate_in < 1 || rate_in > 16 || !(sigma_r_in > 0.0 && sigma_r_in <= 1.0) || res_in < 2 || res_in > 4096)
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   if (uint64_t(width) * uint64_t(height) * uint64_t(rate_in) * uint64_t(rate_in) > kMaxFlakes)
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   rate = rate_in;
   repeat = src.repeats();
   res = res_in;
@@ -182,12 +182,12 @@ Status FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r
   if (!normals.allocate(texels * 2) || !blocks.allocate(block_count) ||
       !slot.allocate(size_t(fine_w) * size_t(fine_h)) || !tile_root.allocate(size_t(tiles_x) * size_t(tiles_y)) ||
       !nodes.allocate(node_count))
-    return Status::kOutOfMemory;
+    return RuntimeStatus::kOutOfMemory;
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       float* n = normals.data + (size_t(y) * size_t(width) + size_t(x)) * 2;
       src.normal(x, y, n);
-      if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return Status::kInvalidArgument;
+      if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return RuntimeStatus::kInvalidArgument;
     }
   }
   FlakeRec tile[kTile * kTile];
@@ -201,7 +201,7 @@ Status FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r
       buildTree(root, tile, count, tileOrigin(tx), tileOrigin(ty), &next_node, &next_block);
     }
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 // Builds node `id`, the k-d tree over f[0, count): splits at the median of the widest of n_x, n_y
@@ -421,13 +421,13 @@ double FlakeNdf::Impl::weightSum(const FootprintTerms& t, bool along_x) const {
 FlakeNdf::FlakeNdf() = default;
 FlakeNdf::~FlakeNdf() = default;
 
-Status FlakeNdf::build(const TexelSource& source, int rate, double sigma_r, int resolution) {
+RuntimeStatus FlakeNdf::build(const TexelSource& source, int rate, double sigma_r, int resolution) {
   impl_.reset();
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->build(source, rate, sigma_r, resolution); s != Status::kOk) return s;
+  if (!impl) return RuntimeStatus::kOutOfMemory;
+  if (RuntimeStatus s = impl->build(source, rate, sigma_r, resolution); s != RuntimeStatus::kOk) return s;
   impl_ = std::move(impl);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 bool FlakeNdf::isBuilt() const { return impl_ != nullptr; }
@@ -448,38 +448,38 @@ bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0
 bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 }  // namespace
 
-Status FlakeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+RuntimeStatus FlakeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status FlakeNdf::mass(const Footprint& footprint, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint)) return Status::kInvalidArgument;
+RuntimeStatus FlakeNdf::mass(const Footprint& footprint, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = impl_->mass(t);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+RuntimeStatus FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double m = impl_->mass(t);
   *value = (inSquare(s) && m > 0.0) ? impl_->evalAt(t, s.x, s.y) / m : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
   if (!impl_ || !value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
       !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   FootprintTerms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
@@ -502,26 +502,27 @@ Status FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* 
     integral *= t.wnorm;
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+RuntimeStatus FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!impl_) return RuntimeStatus::kInvalidArgument;
   const int res = impl_->res;
   const size_t n = size_t(res) * size_t(res);
-  if (!out || out_count < n) return Status::kInvalidArgument;
+  if (!out || out_count < n) return RuntimeStatus::kInvalidArgument;
   std::fill(out, out + n, 0.0f);
   return addImage(footprint, 1.0, out, out_count);
 }
 
-Status FlakeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
+  if (!impl_) return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   const int res = m.res;
   const size_t n = size_t(res) * size_t(res);
-  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight)) return Status::kInvalidArgument;
+  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight))
+    return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double bin = 2.0 / res;
   // Each lobe adds its probability over the bins, scaled to a density (divided by the bin area),
   // in the fixed order of the traversal.
@@ -534,18 +535,18 @@ Status FlakeNdf::addImage(const Footprint& footprint, double weight, float* out,
       flakes::splatLobe(g, to_density * std::exp(-spatial), res, out);
     });
   });
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status FlakeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+RuntimeStatus FlakeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   if (!impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   FootprintTerms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double sum_x = m.weightSum(t, true), sum_y = m.weightSum(t, false);
   const double total = t.wnorm * sum_x * sum_y;
-  if (!(total > 0.0)) return Status::kInvalidArgument;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The footprint weights are separable: a row by its weight, then a column; each uniform is
   // rescaled within the chosen interval and reused for the lobe.
   auto pick = [&](int64_t f0, int64_t f1, double centre, double u, double sum, double* rest) {
@@ -576,7 +577,7 @@ Status FlakeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSam
   out->s.x = g.mx + l11 * z0;
   out->s.y = g.my + l21 * z0 + l22 * z1;
   out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

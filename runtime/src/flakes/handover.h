@@ -31,7 +31,7 @@ struct FlakePaths {
 // Reads and checks the flakes section (index `section` of the reader) and builds its evaluators
 // at image resolution `resolution`. kInvalidAsset for a record the check refuses or non-finite
 // normals, kOutOfMemory. Safe on untrusted input.
-Status loadFlakes(const format::Reader& reader, int section, int resolution, FlakePaths* paths);
+RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resolution, FlakePaths* paths);
 
 // An NDF source that answers small footprints from the flakes, mid-size ones from the clustered
 // lobes (when present) and the others from a pyramid.
@@ -45,12 +45,12 @@ class HandoverNdf final : public NdfSource {
   FootprintRange footprintRange() const override;
   MapSize mapSize() const override { return pyramid_->mapSize(); }
   MapWrap wrap() const override { return pyramid_->wrap(); }
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status mass(const Footprint& footprint, double* value) const override;
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const override;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
 
  private:
   // The two paths of a footprint and the weight t of the upper one (t = 0: the lower alone, no
@@ -62,7 +62,7 @@ class HandoverNdf final : public NdfSource {
   };
   Mix mixFor(double sigma) const;
   template <typename Query>
-  Status blend(const Footprint& footprint, double* value, Query&& query) const;
+  RuntimeStatus blend(const Footprint& footprint, double* value, Query&& query) const;
 
   FlakePaths paths_;
   std::unique_ptr<NdfSource> pyramid_;

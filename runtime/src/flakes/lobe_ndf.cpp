@@ -16,8 +16,8 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
-constexpr int kFinestTile = 4;         // flakes per side of a level-0 tile
-constexpr double kTileRatio = 0.5;     // a footprint is answered on tiles of at most this x its std
+constexpr int kFinestTile = 4;      // flakes per side of a level-0 tile
+constexpr double kTileRatio = 0.5;  // a footprint is answered on tiles of at most this x its std
 // Spatial truncation, in standard deviations of a lobe's footprint weight: the lobes beyond hold
 // about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
 constexpr double kWindowSigmas = 3.0;
@@ -28,6 +28,8 @@ constexpr int kLloydPasses = 4;
 constexpr int kMaxSide = 1 << 16;
 constexpr uint64_t kMaxFlakes = uint64_t(1) << 30;
 constexpr float kPaddingPosition = 1e15f;  // position of unused lanes: weight 0
+// Items grouped into one tile at most: the flakes of a level-0 tile, or the lobes of four children.
+constexpr int kMaxItems = std::max(kFinestTile * kFinestTile, 4 * kLanes);
 
 // A 4D Gaussian in (position u, normal s) while the hierarchy is built: weight, means, and the
 // covariance blocks uu {xx, xy, yy}, su {s_x u_x, s_x u_y, s_y u_x, s_y u_y}, ss {xx, xy, yy}.
@@ -109,12 +111,11 @@ double distance2(const Feature& a, const double* c) {
 // the heaviest item and then the items farthest from every seed (ties to the lower index), then the
 // moments of every group. Writes the lobes to out and returns their count.
 int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
-  constexpr int kMaxItems = 4 * kLanes * kLanes;
   if (n <= k) {
     for (int i = 0; i < n; ++i) out[i] = items[i];
     return n;
   }
-  Feature f[kMaxItems];
+  Feature f[kMaxItems] = {};
   for (int i = 0; i < n; ++i) f[i] = featureOf(items[i]);
   double centre[kLanes][3];
   int seeds = 0, heaviest = 0;
@@ -188,7 +189,7 @@ struct LobeNdf::Impl {
   Array<Block> blocks;
   Array<Bound> bounds;
 
-  Status build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in);
+  RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in);
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
   void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
@@ -205,15 +206,15 @@ struct LobeNdf::Impl {
   double massOf(const Terms& t) const;
 };
 
-Status LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in) {
+RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in) {
   width = src.width();
   height = src.height();
-  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return Status::kInvalidArgument;
+  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return RuntimeStatus::kInvalidArgument;
   if (rate_in < 1 || rate_in > 16 || !(sigma_r > 0.0 && sigma_r <= 1.0) || lobes_in < 1 || lobes_in > kLanes ||
       res_in < 2 || res_in > 4096)
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   if (uint64_t(width) * uint64_t(height) * uint64_t(rate_in) * uint64_t(rate_in) > kMaxFlakes)
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   rate = rate_in;
   repeat = src.repeats();
   res = res_in;
@@ -237,17 +238,17 @@ Status LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r,
   }
   Array<float> normals;
   if (!normals.allocate(size_t(width) * size_t(height) * 2) || !blocks.allocate(total) || !bounds.allocate(total))
-    return Status::kOutOfMemory;
+    return RuntimeStatus::kOutOfMemory;
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       float* n = normals.data + (size_t(y) * size_t(width) + size_t(x)) * 2;
       src.normal(x, y, n);
-      if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return Status::kInvalidArgument;
+      if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return RuntimeStatus::kInvalidArgument;
     }
   }
   // Level 0: the flakes of every tile as 4D Gaussians, grouped.
   const double area = step * step;
-  Gauss4 items[4 * kLanes * kLanes], grouped[kLanes];
+  Gauss4 items[kMaxItems], grouped[kLanes];
   const Level& l0 = levels[0];
   for (int ty = 0; ty < l0.tiles_y; ++ty) {
     for (int tx = 0; tx < l0.tiles_x; ++tx) {
@@ -271,7 +272,8 @@ Status LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r,
           g.ss[2] = sigma_r2 + sigma_h2 * (double(jk[2]) * jk[2] + double(jk[3]) * jk[3]);
         }
       }
-      storeTile(l0.first + size_t(ty) * size_t(l0.tiles_x) + size_t(tx), grouped, clusterLobes(items, n, lobes, grouped));
+      storeTile(l0.first + size_t(ty) * size_t(l0.tiles_x) + size_t(tx), grouped,
+                clusterLobes(items, n, lobes, grouped));
     }
   }
   // Every level above: the lobes of the four children, grouped again.
@@ -286,7 +288,7 @@ Status LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r,
       }
     }
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 // The lobes of the (up to four) children of tile (tx, ty) of the level above `child`, positions
@@ -401,11 +403,13 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   for (int64_t py = py0; py <= py1; ++py) {
     const double oy = double(py) * height;
     const double ly0 = t.uy - t.reach - oy, ly1 = t.uy + t.reach - oy;
-    const int ty0 = int(std::max(0.0, std::floor(ly0 / side))), ty1 = int(std::min(double(l.tiles_y - 1), std::floor(ly1 / side)));
+    const int ty0 = int(std::max(0.0, std::floor(ly0 / side))),
+              ty1 = int(std::min(double(l.tiles_y - 1), std::floor(ly1 / side)));
     for (int64_t px = px0; px <= px1; ++px) {
       const double ox = double(px) * width;
       const double lx0 = t.ux - t.reach - ox, lx1 = t.ux + t.reach - ox;
-      const int tx0 = int(std::max(0.0, std::floor(lx0 / side))), tx1 = int(std::min(double(l.tiles_x - 1), std::floor(lx1 / side)));
+      const int tx0 = int(std::max(0.0, std::floor(lx0 / side))),
+                tx1 = int(std::min(double(l.tiles_x - 1), std::floor(lx1 / side)));
       for (int ty = ty0; ty <= ty1; ++ty) {
         const double by = t.uy - oy - ty * side;
         const double dy = by < 0.0 ? -by : (by > side ? by - side : 0.0);
@@ -510,13 +514,14 @@ double LobeNdf::Impl::massOf(const Terms& t) const {
 LobeNdf::LobeNdf() = default;
 LobeNdf::~LobeNdf() = default;
 
-Status LobeNdf::build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution) {
+RuntimeStatus LobeNdf::build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution) {
   impl_.reset();
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->build(source, rate, sigma_r, lobes_per_tile, resolution); s != Status::kOk) return s;
+  if (!impl) return RuntimeStatus::kOutOfMemory;
+  if (RuntimeStatus s = impl->build(source, rate, sigma_r, lobes_per_tile, resolution); s != RuntimeStatus::kOk)
+    return s;
   impl_ = std::move(impl);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 bool LobeNdf::isBuilt() const { return impl_ != nullptr; }
@@ -534,7 +539,8 @@ FootprintRange LobeNdf::footprintRange() const {
   const double side = m.levels[m.level_count - 1].tile * m.step;
   const double reach = (double(kMaxWindowTiles) - 2.0) * side / 2.0 - side;
   r.clustered_min_sigma = 0.0;
-  r.clustered_max_sigma = std::floor(std::sqrt(std::max(0.0, reach * reach / (kWindowSigmas * kWindowSigmas) - m.sigma_h2)));
+  r.clustered_max_sigma =
+      std::floor(std::sqrt(std::max(0.0, reach * reach / (kWindowSigmas * kWindowSigmas) - m.sigma_h2)));
   return r;
 }
 
@@ -543,38 +549,38 @@ bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0
 bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 }  // namespace
 
-Status LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
   Terms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LobeNdf::mass(const Footprint& footprint, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint)) return Status::kInvalidArgument;
+RuntimeStatus LobeNdf::mass(const Footprint& footprint, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
   Terms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = impl_->massOf(t);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return Status::kInvalidArgument;
+RuntimeStatus LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
+  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
   Terms t;
-  if (!impl_->terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double m = impl_->massOf(t);
   *value = (inSquare(s) && m > 0.0) ? impl_->evalAt(t, s.x, s.y) / m : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LobeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
+RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
   if (!impl_ || !value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
       !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   Terms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
@@ -586,41 +592,42 @@ Status LobeNdf::average(const Footprint& footprint, const SRect& rect, double* v
     });
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LobeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+RuntimeStatus LobeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
+  if (!impl_) return RuntimeStatus::kInvalidArgument;
   const size_t n = size_t(impl_->res) * size_t(impl_->res);
-  if (!out || out_count < n) return Status::kInvalidArgument;
+  if (!out || out_count < n) return RuntimeStatus::kInvalidArgument;
   std::fill(out, out + n, 0.0f);
   return addImage(footprint, 1.0, out, out_count);
 }
 
-Status LobeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
-  if (!impl_) return Status::kInvalidArgument;
+RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
+  if (!impl_) return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   const size_t n = size_t(m.res) * size_t(m.res);
-  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight)) return Status::kInvalidArgument;
+  if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight))
+    return RuntimeStatus::kInvalidArgument;
   Terms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double bin = 2.0 / m.res;
   const double to_density = weight / (bin * bin);
   m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
     m.forEachLobe(b, bound, bx, by, t.sp2,
                   [&](const flakes::Lobe& g, double w) { flakes::splatLobe(g, to_density * w, m.res, out); });
   });
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LobeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   if (!impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return Status::kInvalidArgument;
+    return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   Terms t;
-  if (!m.terms(footprint, &t)) return Status::kInvalidArgument;
+  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double total = m.massOf(t);
-  if (!(total > 0.0)) return Status::kInvalidArgument;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // A lobe in proportion to its weight (the same traversal as massOf), u1 rescaled within it.
   double target = u1 * total, v1 = 0.5;
   bool found = false;
@@ -647,7 +654,7 @@ Status LobeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSamp
   out->s.x = picked.mx + l11 * z0;
   out->s.y = picked.my + l21 * z0 + l22 * z1;
   out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

@@ -16,42 +16,42 @@ constexpr uint32_t kLtcTableSection = format::kSectionLtcTable;
 
 // Reads section (48, key) and checks it is an N x N x 4 image; *size is set by the first call and
 // must match in the second.
-Status readImage(const format::Reader& reader, uint64_t key, int* size, std::vector<float>* out) {
+RuntimeStatus readImage(const format::Reader& reader, uint64_t key, int* size, std::vector<float>* out) {
   const int index = reader.find(kLtcTableSection, key);
-  if (index < 0) return Status::kInvalidAsset;
+  if (index < 0) return RuntimeStatus::kInvalidAsset;
   const format::SectionInfo& info = reader.sections()[size_t(index)];
-  if (info.raw_size < sizeof(format::ImageSectionHeader)) return Status::kInvalidAsset;
+  if (info.raw_size < sizeof(format::ImageSectionHeader)) return RuntimeStatus::kInvalidAsset;
   format::ImageSectionHeader header;
   std::vector<uint8_t> bytes;
   if (info.raw_size > uint64_t(sizeof(header)) + uint64_t(kMaxTableSize) * kMaxTableSize * 16)
-    return Status::kInvalidAsset;
-  const format::Status read = reader.readSection(size_t(index), &bytes);
-  if (read != format::Status::kOk) return fromFormatStatus(read);
+    return RuntimeStatus::kInvalidAsset;
+  const format::ContainerStatus read = reader.readSection(size_t(index), &bytes);
+  if (read != format::ContainerStatus::kOk) return fromFormatStatus(read);
   // The layout is little-endian; this reader assumes a little-endian host.
   std::memcpy(&header, bytes.data(), sizeof(header));
   if (header.magic != format::ImageSectionHeader{}.magic || header.channels != 4 || header.layers != 1 ||
       header.width != header.height || header.width < 2 || header.width > uint32_t(kMaxTableSize))
-    return Status::kInvalidAsset;
+    return RuntimeStatus::kInvalidAsset;
   const int n = int(header.width);
-  if (*size != 0 && *size != n) return Status::kInvalidAsset;
+  if (*size != 0 && *size != n) return RuntimeStatus::kInvalidAsset;
   const size_t count = size_t(n) * size_t(n) * 4;
-  if (bytes.size() != sizeof(header) + count * sizeof(float)) return Status::kInvalidAsset;
+  if (bytes.size() != sizeof(header) + count * sizeof(float)) return RuntimeStatus::kInvalidAsset;
   out->resize(count);
   std::memcpy(out->data(), bytes.data() + sizeof(header), count * sizeof(float));
   for (float value : *out)
-    if (!std::isfinite(value)) return Status::kInvalidAsset;
+    if (!std::isfinite(value)) return RuntimeStatus::kInvalidAsset;
   *size = n;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status load(format::Reader& reader, LtcTable* table) {
-  if (reader.kind() != format::AssetKind::kLtcTable) return Status::kWrongKind;
+RuntimeStatus load(format::Reader& reader, LtcTable* table) {
+  if (reader.kind() != format::AssetKind::kLtcTable) return RuntimeStatus::kWrongKind;
   int size = 0;
   std::vector<float> ltc1, ltc2;
-  Status status = readImage(reader, 0, &size, &ltc1);
-  if (status != Status::kOk) return status;
+  RuntimeStatus status = readImage(reader, 0, &size, &ltc1);
+  if (status != RuntimeStatus::kOk) return status;
   status = readImage(reader, 1, &size, &ltc2);
-  if (status != Status::kOk) return status;
+  if (status != RuntimeStatus::kOk) return status;
   return table->fromArrays(size, ltc1.data(), ltc2.data());
 }
 
@@ -68,35 +68,36 @@ Lerp lerpAt(float x, int n) {
 
 }  // namespace
 
-Status LtcTable::open(const char* path) {
-  if (!path) return Status::kInvalidArgument;
+RuntimeStatus LtcTable::open(const char* path) {
+  if (!path) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  const format::Status status = reader.open(path);
-  if (status != format::Status::kOk) return fromFormatStatus(status);
+  const format::ContainerStatus status = reader.open(path);
+  if (status != format::ContainerStatus::kOk) return fromFormatStatus(status);
   return load(reader, this);
 }
 
-Status LtcTable::openMemory(const void* data, size_t size) {
-  if (!data) return Status::kInvalidArgument;
+RuntimeStatus LtcTable::openMemory(const void* data, size_t size) {
+  if (!data) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  const format::Status status = reader.openMemory(data, size);
-  if (status != format::Status::kOk) return fromFormatStatus(status);
+  const format::ContainerStatus status = reader.openMemory(data, size);
+  if (status != format::ContainerStatus::kOk) return fromFormatStatus(status);
   return load(reader, this);
 }
 
-Status LtcTable::fromArrays(int size, const float* ltc1, const float* ltc2) {
-  if (size < 2 || size > kMaxTableSize || !ltc1 || !ltc2) return Status::kInvalidArgument;
+RuntimeStatus LtcTable::fromArrays(int size, const float* ltc1, const float* ltc2) {
+  if (size < 2 || size > kMaxTableSize || !ltc1 || !ltc2) return RuntimeStatus::kInvalidArgument;
   const size_t count = size_t(size) * size_t(size) * 4;
   for (size_t i = 0; i < count; ++i)
-    if (!std::isfinite(ltc1[i]) || !std::isfinite(ltc2[i])) return Status::kInvalidArgument;
+    if (!std::isfinite(ltc1[i]) || !std::isfinite(ltc2[i])) return RuntimeStatus::kInvalidArgument;
   ltc1_.assign(ltc1, ltc1 + count);
   ltc2_.assign(ltc2, ltc2 + count);
   size_ = size;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status LtcTable::lookup(float roughness, float cos_theta_v, LtcCoefficients* out) const {
-  if (size_ == 0 || !out || !std::isfinite(roughness) || !std::isfinite(cos_theta_v)) return Status::kInvalidArgument;
+RuntimeStatus LtcTable::lookup(float roughness, float cos_theta_v, LtcCoefficients* out) const {
+  if (size_ == 0 || !out || !std::isfinite(roughness) || !std::isfinite(cos_theta_v))
+    return RuntimeStatus::kInvalidArgument;
   const float n1 = float(size_ - 1);
   const Lerp la = lerpAt(std::clamp(roughness, 0.0f, 1.0f) * n1, size_);
   const Lerp lt = lerpAt(std::sqrt(1.0f - std::clamp(cos_theta_v, 0.0f, 1.0f)) * n1, size_);
@@ -124,7 +125,7 @@ Status LtcTable::lookup(float roughness, float cos_theta_v, LtcCoefficients* out
   out->norm = t2[0];
   out->fresnel = t2[1];
   out->sphere = t2[3];
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 float LtcTable::sphereFactor(float z, float len) const {

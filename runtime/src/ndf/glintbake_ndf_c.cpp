@@ -10,9 +10,9 @@
 
 using glintbake::runtime::Footprint;
 using glintbake::runtime::NdfSample;
+using glintbake::runtime::RuntimeStatus;
 using glintbake::runtime::SPoint;
 using glintbake::runtime::SRect;
-using glintbake::runtime::Status;
 
 struct gb_ndf_asset {
   std::unique_ptr<glintbake::runtime::NdfSource> source;
@@ -20,7 +20,7 @@ struct gb_ndf_asset {
 };
 
 namespace {
-int32_t code(Status s) { return int32_t(s); }
+int32_t code(RuntimeStatus s) { return int32_t(s); }
 Footprint footprint(double x, double y, double sigma) {
   Footprint f;
   f.x = x;
@@ -29,8 +29,8 @@ Footprint footprint(double x, double y, double sigma) {
   return f;
 }
 // Wraps an opened NDF source in a handle; the kind code is the source's container kind.
-int32_t wrapAsset(gb_ndf_asset** out, Status opened, std::unique_ptr<glintbake::runtime::NdfSource> source) {
-  if (opened != Status::kOk) return code(opened);
+int32_t wrapAsset(gb_ndf_asset** out, RuntimeStatus opened, std::unique_ptr<glintbake::runtime::NdfSource> source) {
+  if (opened != RuntimeStatus::kOk) return code(opened);
   gb_ndf_asset* a = new (std::nothrow) gb_ndf_asset();
   if (!a) return GB_OUT_OF_MEMORY;
   a->kind = int32_t(source->kind());
@@ -54,7 +54,7 @@ extern "C" {
 
 const char* gb_status_string(int32_t status) {
   if (status < 0 || status > GB_OUT_OF_MEMORY) return "unknown status";
-  return glintbake::runtime::statusString(Status(status));
+  return glintbake::runtime::statusString(RuntimeStatus(status));
 }
 
 int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {
@@ -62,7 +62,7 @@ int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {
   *out = nullptr;
   if (!path) return GB_INVALID_ARGUMENT;
   std::unique_ptr<glintbake::runtime::NdfSource> source;
-  const Status opened = glintbake::runtime::openNdfAsset(path, &source);
+  const RuntimeStatus opened = glintbake::runtime::openNdfAsset(path, &source);
   return wrapAsset(out, opened, std::move(source));
 }
 
@@ -71,7 +71,7 @@ int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** o
   *out = nullptr;
   if (!data) return GB_INVALID_ARGUMENT;
   std::unique_ptr<glintbake::runtime::NdfSource> source;
-  const Status opened = glintbake::runtime::openNdfAssetMemory(data, size, &source);
+  const RuntimeStatus opened = glintbake::runtime::openNdfAssetMemory(data, size, &source);
   return wrapAsset(out, opened, std::move(source));
 }
 
@@ -133,8 +133,8 @@ int32_t gb_ndf_asset_sample(const gb_ndf_asset* a, double x, double y, double si
                             double* sy, double* pdf) {
   if (!a || !sx || !sy || !pdf) return GB_INVALID_ARGUMENT;
   NdfSample s;
-  const Status st = a->source->sample(footprint(x, y, sigma), u1, u2, &s);
-  if (st != Status::kOk) return code(st);
+  const RuntimeStatus st = a->source->sample(footprint(x, y, sigma), u1, u2, &s);
+  if (st != RuntimeStatus::kOk) return code(st);
   *sx = s.s.x;
   *sy = s.s.y;
   *pdf = s.pdf;

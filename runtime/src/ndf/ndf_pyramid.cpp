@@ -41,7 +41,7 @@ struct NdfPyramid::Impl {
   NdfLevelRecord records[kMaxNdfLevels];  // levels[l].rec, contiguous (PyramidNdf::levelRecords)
   PyramidBlender blender;
 
-  Status load(const format::Reader& reader);
+  RuntimeStatus load(const format::Reader& reader);
   void blend(const Footprint& fp, Blend* b) const;
   // Bin of s, or -1 outside [-1,1]^2.
   int binOf(double sx, double sy) const { return ndfBinOf(sx, sy, res, inv_bin); }
@@ -57,18 +57,21 @@ struct NdfPyramid::Impl {
   }
 };
 
-Status NdfPyramid::Impl::load(const format::Reader& reader) {
+RuntimeStatus NdfPyramid::Impl::load(const format::Reader& reader) {
   std::vector<uint8_t> bytes;
   level_count = 0;
   for (int l = 0; l < kMaxNdfLevels; ++l) {
     const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));
     if (idx < 0) break;
-    if (reader.sections()[size_t(idx)].raw_size != sizeof(NdfLevelRecord)) return Status::kInvalidAsset;
+    if (reader.sections()[size_t(idx)].raw_size != sizeof(NdfLevelRecord)) return RuntimeStatus::kInvalidAsset;
     NdfLevelRecord rec;
-    if (Status s = fromFormatStatus(reader.readSectionInto(size_t(idx), &rec, sizeof(rec))); s != Status::kOk) return s;
+    if (RuntimeStatus s = fromFormatStatus(reader.readSectionInto(size_t(idx), &rec, sizeof(rec)));
+        s != RuntimeStatus::kOk)
+      return s;
     // Descriptor sanity: everything the queries index with is checked here.
-    if (Status s = fromRecordCheck(format::checkNdfLevelRecord(rec, uint32_t(l), l > 0 ? &levels[l - 1].rec : nullptr));
-        s != Status::kOk)
+    if (RuntimeStatus s =
+            fromRecordCheck(format::checkNdfLevelRecord(rec, uint32_t(l), l > 0 ? &levels[l - 1].rec : nullptr));
+        s != RuntimeStatus::kOk)
       return s;
     res = int(rec.ndf_res);
     Level& lv = levels[l];
@@ -76,9 +79,9 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     records[l] = rec;
     const uint64_t image_floats = uint64_t(res) * uint64_t(res);
     const uint64_t centres = uint64_t(rec.grid_width) * uint64_t(rec.grid_height);
-    if (centres * image_floats > kMaxTotalFloats) return Status::kInvalidAsset;
+    if (centres * image_floats > kMaxTotalFloats) return RuntimeStatus::kInvalidAsset;
     if (!lv.images.allocate(size_t(centres * image_floats)) || !lv.prefix.allocate(size_t(centres * (res + 1))))
-      return Status::kOutOfMemory;
+      return RuntimeStatus::kOutOfMemory;
     const double area = 4.0 / (double(res) * double(res));
 
     // Chunks: one per region, scattered into centre order.
@@ -86,21 +89,22 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
       for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
         const uint64_t region = uint64_t(ry) * rec.regions_x + rx;
         const int cidx = reader.find(format::kSectionNdfChunk, format::ndfChunkKey(uint32_t(l), region));
-        if (cidx < 0) return Status::kInvalidAsset;
+        if (cidx < 0) return RuntimeStatus::kInvalidAsset;
         const uint32_t cx0 = rx * rec.region_size, cy0 = ry * rec.region_size;
         const uint32_t cw = std::min(rec.region_size, rec.grid_width - cx0);
         const uint32_t ch = std::min(rec.region_size, rec.grid_height - cy0);
         const uint64_t expected = sizeof(format::ImageSectionHeader) + uint64_t(cw) * ch * image_floats * 4;
-        if (reader.sections()[size_t(cidx)].raw_size != expected) return Status::kInvalidAsset;
+        if (reader.sections()[size_t(cidx)].raw_size != expected) return RuntimeStatus::kInvalidAsset;
         Array<uint8_t> chunk;
-        if (!chunk.allocate(size_t(expected))) return Status::kOutOfMemory;
-        if (Status s = fromFormatStatus(reader.readSectionInto(size_t(cidx), chunk.data, chunk.size)); s != Status::kOk)
+        if (!chunk.allocate(size_t(expected))) return RuntimeStatus::kOutOfMemory;
+        if (RuntimeStatus s = fromFormatStatus(reader.readSectionInto(size_t(cidx), chunk.data, chunk.size));
+            s != RuntimeStatus::kOk)
           return s;
         format::ImageSectionHeader header;
         std::memcpy(&header, chunk.data, sizeof(header));
         if (header.magic != format::ImageSectionHeader().magic || header.width != uint32_t(res) ||
             header.height != uint32_t(res) || header.channels != 1 || header.layers != cw * ch)
-          return Status::kInvalidAsset;
+          return RuntimeStatus::kInvalidAsset;
         const uint8_t* src = chunk.data + sizeof(header);
         for (uint32_t k = 0; k < cw * ch; ++k) {
           const uint64_t centre = uint64_t(cy0 + k / cw) * rec.grid_width + (cx0 + k % cw);
@@ -112,7 +116,7 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
             double row = 0.0;
             for (int i = 0; i < res; ++i) {
               const float v = dst[size_t(j) * res + i];
-              if (!(v >= 0.0f) || !std::isfinite(v)) return Status::kInvalidAsset;  // NaN, Inf, negative
+              if (!(v >= 0.0f) || !std::isfinite(v)) return RuntimeStatus::kInvalidAsset;  // NaN, Inf, negative
               row += v;
             }
             pre[j + 1] = pre[j] + row * area;
@@ -122,12 +126,12 @@ Status NdfPyramid::Impl::load(const format::Reader& reader) {
     }
     level_count = l + 1;
   }
-  if (level_count == 0) return Status::kInvalidAsset;
+  if (level_count == 0) return RuntimeStatus::kInvalidAsset;
   bin = 2.0 / res;
   inv_bin = res / 2.0;
   bin_area = bin * bin;
   blender.init(records, level_count);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
@@ -145,12 +149,12 @@ void NdfPyramid::Impl::blend(const Footprint& fp, Blend* b) const {
 NdfPyramid::NdfPyramid() = default;
 NdfPyramid::~NdfPyramid() = default;
 
-Status NdfPyramid::loadKind(const format::Reader& reader) {
+RuntimeStatus NdfPyramid::loadKind(const format::Reader& reader) {
   auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->load(reader); s != Status::kOk) return s;
+  if (!impl) return RuntimeStatus::kOutOfMemory;
+  if (RuntimeStatus s = impl->load(reader); s != RuntimeStatus::kOk) return s;
   impl_ = std::move(impl);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 void NdfPyramid::reset() { impl_.reset(); }
@@ -168,15 +172,15 @@ const float* NdfPyramid::centreImage(int l, int i, int j) const {
   return impl_->levels[l].images.data + (size_t(j) * r->grid_width + size_t(i)) * image_floats;
 }
 
-Status NdfPyramid::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
+RuntimeStatus NdfPyramid::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   const int bin = impl_->binOf(s.x, s.y);
   *value = bin < 0 ? 0.0 : impl_->blendValue(b, bin);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status NdfPyramid::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
+RuntimeStatus NdfPyramid::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
   const Impl& m = *impl_;
   Blend b;
   m.blend(footprint, &b);
@@ -199,31 +203,31 @@ Status NdfPyramid::averageChecked(const Footprint& footprint, const SRect& rect,
     }
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status NdfPyramid::massChecked(const Footprint& footprint, double* value) const {
+RuntimeStatus NdfPyramid::massChecked(const Footprint& footprint, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   *value = impl_->blendMass(b);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status NdfPyramid::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
+RuntimeStatus NdfPyramid::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   Blend b;
   impl_->blend(footprint, &b);
   const double total = impl_->blendMass(b);
   const int bin = impl_->binOf(s.x, s.y);
   *value = (bin < 0 || !(total > 0.0)) ? 0.0 : impl_->blendValue(b, bin) / total;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status NdfPyramid::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+RuntimeStatus NdfPyramid::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
   Blend b;
   m.blend(footprint, &b);
   const double total = m.blendMass(b);
-  if (!(total > 0.0)) return Status::kInvalidArgument;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
 
   // 1. Component by weighted mass (u1 reused, rescaled to [0, 1) within the chosen component).
   double target = u1 * total;
@@ -261,10 +265,10 @@ Status NdfPyramid::sampleChecked(const Footprint& footprint, double u1, double u
   out->s.x = -1.0 + (col + fx) * m.bin;
   out->s.y = 1.0 - (row + fy) * m.bin;
   out->pdf = m.blendValue(b, row * m.res + col) / total;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status NdfPyramid::imageChecked(const Footprint& footprint, float* out) const {
+RuntimeStatus NdfPyramid::imageChecked(const Footprint& footprint, float* out) const {
   const size_t n = size_t(impl_->res) * size_t(impl_->res);
   Blend b;
   impl_->blend(footprint, &b);
@@ -273,7 +277,7 @@ Status NdfPyramid::imageChecked(const Footprint& footprint, float* out) const {
     for (int k = 0; k < b.count; ++k) v += b.weight[k] * double(b.image[k][i]);
     out[i] = float(v);
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

@@ -13,71 +13,72 @@ namespace glintbake::runtime {
 namespace {
 
 template <typename Asset>
-Status loadAs(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
+RuntimeStatus loadAs(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   std::unique_ptr<Asset> asset(new (std::nothrow) Asset());
-  if (!asset) return Status::kOutOfMemory;
-  if (Status st = asset->load(reader); st != Status::kOk) return st;
+  if (!asset) return RuntimeStatus::kOutOfMemory;
+  if (RuntimeStatus st = asset->load(reader); st != RuntimeStatus::kOk) return st;
   *out = std::move(asset);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 // The NDF asset classes, by the kind of an opened reader.
-Status loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
+RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   switch (reader.kind()) {
     case format::AssetKind::kNdfPyramid:
       return loadAs<NdfPyramid>(reader, out);
     case format::AssetKind::kTensorNdf:
       return loadAs<TensorNdf>(reader, out);
     default:
-      return Status::kWrongKind;
+      return RuntimeStatus::kWrongKind;
   }
 }
 
 // An asset with a flakes section answers small footprints from its flakes (formats/SPEC.md 10.5):
 // wraps the opened pyramid-shaped asset into the hand-over.
-Status attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
+RuntimeStatus attachFlakes(const format::Reader& reader, std::unique_ptr<NdfSource>* out) {
   const int idx = reader.find(format::kSectionFlakes, 0);
-  if (idx < 0) return Status::kOk;
+  if (idx < 0) return RuntimeStatus::kOk;
   FlakePaths paths;
-  Status s = loadFlakes(reader, idx, (*out)->resolution(), &paths);
+  RuntimeStatus s = loadFlakes(reader, idx, (*out)->resolution(), &paths);
   // The flakes must be those of the pyramid's map.
   const MapSize size = (*out)->mapSize();
   const format::FlakesRecord& rec = paths.record;
-  if (s == Status::kOk && (int64_t(rec.map_width) != size.width || int64_t(rec.map_height) != size.height ||
-                           rec.wrap != uint32_t((*out)->wrap())))
-    s = Status::kInvalidAsset;
-  if (s != Status::kOk) {
+  if (s == RuntimeStatus::kOk && (int64_t(rec.map_width) != size.width || int64_t(rec.map_height) != size.height ||
+                                  rec.wrap != uint32_t((*out)->wrap())))
+    s = RuntimeStatus::kInvalidAsset;
+  if (s != RuntimeStatus::kOk) {
     out->reset();
     return s;
   }
   std::unique_ptr<NdfSource> handover(new (std::nothrow) HandoverNdf(std::move(paths), std::move(*out)));
   if (!handover) {
     out->reset();
-    return Status::kOutOfMemory;
+    return RuntimeStatus::kOutOfMemory;
   }
   *out = std::move(handover);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace
 
-Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
-  if (out == nullptr) return Status::kInvalidArgument;
+RuntimeStatus openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out) {
+  if (out == nullptr) return RuntimeStatus::kInvalidArgument;
   out->reset();
-  if (path == nullptr) return Status::kInvalidArgument;
+  if (path == nullptr) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  if (format::Status st = reader.open(path); st != format::Status::kOk) return fromFormatStatus(st);
-  if (Status s = loadKind(reader, out); s != Status::kOk) return s;
+  if (format::ContainerStatus st = reader.open(path); st != format::ContainerStatus::kOk) return fromFormatStatus(st);
+  if (RuntimeStatus s = loadKind(reader, out); s != RuntimeStatus::kOk) return s;
   return attachFlakes(reader, out);
 }
 
-Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out) {
-  if (out == nullptr) return Status::kInvalidArgument;
+RuntimeStatus openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out) {
+  if (out == nullptr) return RuntimeStatus::kInvalidArgument;
   out->reset();
-  if (data == nullptr) return Status::kInvalidArgument;
+  if (data == nullptr) return RuntimeStatus::kInvalidArgument;
   format::Reader reader;
-  if (format::Status st = reader.openMemory(data, size); st != format::Status::kOk) return fromFormatStatus(st);
-  if (Status s = loadKind(reader, out); s != Status::kOk) return s;
+  if (format::ContainerStatus st = reader.openMemory(data, size); st != format::ContainerStatus::kOk)
+    return fromFormatStatus(st);
+  if (RuntimeStatus s = loadKind(reader, out); s != RuntimeStatus::kOk) return s;
   return attachFlakes(reader, out);
 }
 

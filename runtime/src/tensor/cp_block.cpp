@@ -8,24 +8,24 @@
 
 namespace glintbake::runtime {
 
-Status validateCpGroupView(const CpGroupView& v) {
+RuntimeStatus validateCpGroupView(const CpGroupView& v) {
   if (v.bins < 1 || v.bins > kCpMaxBins || v.rank < 1 || v.rank > kCpMaxRank || v.blocks < 1)
-    return Status::kInvalidArgument;
-  if (!v.a || !v.b || !v.c || !v.a_prefix || !v.b_prefix) return Status::kInvalidArgument;
-  return Status::kOk;
+    return RuntimeStatus::kInvalidArgument;
+  if (!v.a || !v.b || !v.c || !v.a_prefix || !v.b_prefix) return RuntimeStatus::kInvalidArgument;
+  return RuntimeStatus::kOk;
 }
 
-Status CpMix::init(const CpBlendTerm* terms, int32_t count) {
+RuntimeStatus CpMix::init(const CpBlendTerm* terms, int32_t count) {
   group_count_ = 0;
   bins_ = 0;
-  if (count < 0 || count > kCpMaxBlend || (count > 0 && !terms)) return Status::kInvalidArgument;
+  if (count < 0 || count > kCpMaxBlend || (count > 0 && !terms)) return RuntimeStatus::kInvalidArgument;
   for (int32_t t = 0; t < count; ++t) {
     const CpBlendTerm& term = terms[t];
-    if (!term.group || validateCpGroupView(*term.group) != Status::kOk || term.block < 0 ||
+    if (!term.group || validateCpGroupView(*term.group) != RuntimeStatus::kOk || term.block < 0 ||
         term.block >= term.group->blocks || !std::isfinite(term.weight) || (bins_ != 0 && term.group->bins != bins_)) {
       group_count_ = 0;
       bins_ = 0;
-      return Status::kInvalidArgument;
+      return RuntimeStatus::kInvalidArgument;
     }
     if (term.weight == 0.0f) continue;
     bins_ = term.group->bins;
@@ -41,7 +41,7 @@ Status CpMix::init(const CpBlendTerm* terms, int32_t count) {
     const float* c = term.group->c + static_cast<size_t>(term.block) * rank;
     for (int32_t r = 0; r < rank; ++r) coef_[g][r] += term.weight * c[r];
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 float CpMix::rawValue(int32_t i, int32_t j) const {

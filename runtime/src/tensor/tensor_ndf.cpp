@@ -131,12 +131,12 @@ double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
 
 // ---------------------------------------------------------------------------------------------
 
-Status TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
+RuntimeStatus TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   const Impl& m = *impl_;
   int i, j;
   if (!ndfBinCoords(s.x, s.y, m.res, m.inv_bin, &i, &j)) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   Impl::Blend b;
   m.blend(footprint, &b);
@@ -158,10 +158,10 @@ Status TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s, doubl
   }
   const float sum = laneTotal(lanes);
   *value = sum > 0.0f ? double(sum) : 0.0;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
+RuntimeStatus TensorNdf::averageChecked(const Footprint& footprint, const SRect& rect, double* value) const {
   const Impl& m = *impl_;
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
@@ -197,35 +197,35 @@ Status TensorNdf::averageChecked(const Footprint& footprint, const SRect& rect, 
     }
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::massChecked(const Footprint& footprint, double* value) const {
+RuntimeStatus TensorNdf::massChecked(const Footprint& footprint, double* value) const {
   Impl::Blend b;
   impl_->blend(footprint, &b);
   *value = impl_->totalMass(b);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
+RuntimeStatus TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const {
   const Impl& m = *impl_;
   const int bin = m.binOf(s.x, s.y);
   if (bin < 0) {
     *value = 0.0;
-    return Status::kOk;
+    return RuntimeStatus::kOk;
   }
   Impl::Blend b;
   m.blend(footprint, &b);
   *value = m.binPdf(b, bin % m.res, bin / m.res);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
+RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
   Impl::Blend b;
   m.blend(footprint, &b);
   const double total = m.totalMass(b);
-  if (!(total > 0.0)) return Status::kInvalidArgument;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
 
   // 1. Block by clamped blended mass; u1 is rescaled to [0, 1) within the chosen block.
   const double target = u1 * total;
@@ -269,10 +269,10 @@ Status TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2
   if (m.binOf(s.x, s.y) != row * m.res + col) s = SPoint{-1.0 + (col + 0.5) * m.bin, 1.0 - (row + 0.5) * m.bin};
   out->s = s;
   out->pdf = combinePdf(chosen_mass, total, p, m.bin_area);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::imageChecked(const Footprint& footprint, float* out) const {
+RuntimeStatus TensorNdf::imageChecked(const Footprint& footprint, float* out) const {
   const Impl& m = *impl_;
   Impl::Blend b;
   m.blend(footprint, &b);
@@ -286,7 +286,7 @@ Status TensorNdf::imageChecked(const Footprint& footprint, float* out) const {
       }
     }
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

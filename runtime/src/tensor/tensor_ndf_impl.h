@@ -49,9 +49,9 @@ struct TensorNdf::Impl {
   uint64_t blocks_kept = 0;
   uint64_t memory_bytes = 0;
 
-  Status load(const format::Reader& reader);
-  Status loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch);
-  Status loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch);
+  RuntimeStatus load(const format::Reader& reader);
+  RuntimeStatus loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch);
+  RuntimeStatus loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch);
 
   void blend(const Footprint& fp, Blend* b) const;
   // The CpMix of block `block` of the blend (blank entries skipped).

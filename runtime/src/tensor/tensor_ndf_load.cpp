@@ -16,33 +16,33 @@ namespace {
 constexpr uint64_t kMaxIndexEntries = uint64_t(1) << 32;
 
 // Reads a whole section of exactly `size` bytes (kInvalidAsset on a size mismatch).
-Status readExact(const format::Reader& reader, int idx, uint64_t size, Array<uint8_t>* out) {
-  if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return Status::kInvalidAsset;
-  if (size > SIZE_MAX || !out->allocate(size_t(size))) return Status::kOutOfMemory;
+RuntimeStatus readExact(const format::Reader& reader, int idx, uint64_t size, Array<uint8_t>* out) {
+  if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
+  if (size > SIZE_MAX || !out->allocate(size_t(size))) return RuntimeStatus::kOutOfMemory;
   return fromFormatStatus(reader.readSectionInto(size_t(idx), out->data, out->size));
 }
 
 }  // namespace
 
-Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch) {
+RuntimeStatus TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch) {
   const int idx = reader.find(format::kSectionTensorGroup, uint64_t(g));
-  if (idx < 0) return Status::kInvalidAsset;
+  if (idx < 0) return RuntimeStatus::kInvalidAsset;
   const uint64_t raw_size = reader.sections()[size_t(idx)].raw_size;
-  if (raw_size < sizeof(TensorGroupHeader)) return Status::kInvalidAsset;
+  if (raw_size < sizeof(TensorGroupHeader)) return RuntimeStatus::kInvalidAsset;
   TensorGroupHeader h;
   // The reader bounds raw_size (ReaderOptions::max_raw_section_size); the header's fields then
   // decide the exact size the section must have.
-  if (Status s = readExact(reader, idx, raw_size, scratch); s != Status::kOk) return s;
+  if (RuntimeStatus s = readExact(reader, idx, raw_size, scratch); s != RuntimeStatus::kOk) return s;
   std::memcpy(&h, scratch->data, sizeof(h));
-  if (!format::checkTensorGroupHeader(h, info, level_records)) return Status::kInvalidAsset;
+  if (!format::checkTensorGroupHeader(h, info, level_records)) return RuntimeStatus::kInvalidAsset;
   const uint64_t rank = h.rank, b = h.bins, k = h.blocks;
   const uint64_t factor_values = (2 * b + k) * rank;
   const uint64_t prefix_values = 2 * (b + 1) * rank;
   const uint64_t elem = info.precision == 1 ? 2 : 4;
-  if (raw_size != format::tensorGroupSectionBytes(b, rank, k, info.precision)) return Status::kInvalidAsset;
+  if (raw_size != format::tensorGroupSectionBytes(b, rank, k, info.precision)) return RuntimeStatus::kInvalidAsset;
 
   Group& group = groups.data[g];
-  if (!group.data.allocate(size_t(factor_values + prefix_values))) return Status::kOutOfMemory;
+  if (!group.data.allocate(size_t(factor_values + prefix_values))) return RuntimeStatus::kOutOfMemory;
   const uint8_t* src = scratch->data + sizeof(TensorGroupHeader);
   float* dst = group.data.data;
   for (uint64_t v = 0; v < factor_values; ++v) {
@@ -54,13 +54,13 @@ Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Arra
     } else {
       std::memcpy(&f, src + v * 4, 4);
     }
-    if (!(std::fabs(f) <= kTensorMaxFactor)) return Status::kInvalidAsset;  // NaN, Inf, huge
-    if (nonneg && f < 0.0f) return Status::kInvalidAsset;
+    if (!(std::fabs(f) <= kTensorMaxFactor)) return RuntimeStatus::kInvalidAsset;  // NaN, Inf, huge
+    if (nonneg && f < 0.0f) return RuntimeStatus::kInvalidAsset;
     dst[v] = f;
   }
   std::memcpy(dst + factor_values, src + factor_values * elem, size_t(prefix_values) * 4);
   for (uint64_t v = 0; v < prefix_values; ++v) {
-    if (!(std::fabs(dst[factor_values + v]) <= kTensorMaxPrefix)) return Status::kInvalidAsset;
+    if (!(std::fabs(dst[factor_values + v]) <= kTensorMaxPrefix)) return RuntimeStatus::kInvalidAsset;
   }
   group_headers.data[g] = h;
   CpGroupView& view = group.view;
@@ -74,22 +74,23 @@ Status TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t g, Arra
   view.b_prefix = dst + factor_values + (b + 1) * rank;
   // Prefix sums start at 0 (the sum of no rows).
   for (uint64_t r = 0; r < rank; ++r) {
-    if (view.a_prefix[r] != 0.0f || view.b_prefix[r] != 0.0f) return Status::kInvalidAsset;
+    if (view.a_prefix[r] != 0.0f || view.b_prefix[r] != 0.0f) return RuntimeStatus::kInvalidAsset;
   }
-  if (validateCpGroupView(view) != Status::kOk) return Status::kInvalidAsset;
+  if (validateCpGroupView(view) != RuntimeStatus::kOk) return RuntimeStatus::kInvalidAsset;
   memory_bytes += (factor_values + prefix_values) * 4;
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch) {
+RuntimeStatus TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch) {
   TLevel& lv = levels[l];
   const NdfLevelRecord& rec = lv.rec;
   const uint64_t centres = uint64_t(rec.grid_width) * rec.grid_height;
   const uint64_t entries = centres * nb2;
-  if (entries > kMaxIndexEntries) return Status::kInvalidAsset;
+  if (entries > kMaxIndexEntries) return RuntimeStatus::kInvalidAsset;
   const int idx = reader.find(format::kSectionTensorIndex, uint64_t(l));
-  if (Status s = readExact(reader, idx, entries * sizeof(TensorIndexEntry), scratch); s != Status::kOk) return s;
-  if (!lv.index.allocate(size_t(entries)) || !lv.mass.allocate(size_t(entries))) return Status::kOutOfMemory;
+  if (RuntimeStatus s = readExact(reader, idx, entries * sizeof(TensorIndexEntry), scratch); s != RuntimeStatus::kOk)
+    return s;
+  if (!lv.index.allocate(size_t(entries)) || !lv.mass.allocate(size_t(entries))) return RuntimeStatus::kOutOfMemory;
   std::memcpy(lv.index.data, scratch->data, size_t(entries) * sizeof(TensorIndexEntry));
   memory_bytes += entries * (sizeof(TensorIndexEntry) + sizeof(double));
   const uint32_t b = info.block;
@@ -104,7 +105,7 @@ Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uin
         continue;
       }
       if (!format::checkTensorIndexEntry(e, group_headers.data, group_count, uint32_t(l), region))
-        return Status::kInvalidAsset;
+        return RuntimeStatus::kInvalidAsset;
       const Group& g = groups.data[e.group];
       // Raw (unclamped) integral of the block over its s-plane area, from the prefix sums exactly
       // as CpMix::rawRangeSum forms it, in double.
@@ -120,15 +121,16 @@ Status TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Array<uin
       ++blocks_kept;
     }
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
-Status TensorNdf::Impl::load(const format::Reader& reader) {
+RuntimeStatus TensorNdf::Impl::load(const format::Reader& reader) {
   Array<uint8_t> scratch;
   const int info_idx = reader.find(format::kSectionTensorInfo, 0);
-  if (Status s = readExact(reader, info_idx, sizeof(TensorInfoRecord), &scratch); s != Status::kOk) return s;
+  if (RuntimeStatus s = readExact(reader, info_idx, sizeof(TensorInfoRecord), &scratch); s != RuntimeStatus::kOk)
+    return s;
   std::memcpy(&info, scratch.data, sizeof(info));
-  if (Status s = fromRecordCheck(format::checkTensorInfoRecord(info)); s != Status::kOk) return s;
+  if (RuntimeStatus s = fromRecordCheck(format::checkTensorInfoRecord(info)); s != RuntimeStatus::kOk) return s;
   res = int(info.ndf_res);
   bins = int(info.block);
   bins_shift = -1;
@@ -144,40 +146,40 @@ Status TensorNdf::Impl::load(const format::Reader& reader) {
 
   for (int l = 0; l < int(info.level_count); ++l) {
     const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));
-    if (Status s = readExact(reader, idx, sizeof(NdfLevelRecord), &scratch); s != Status::kOk) return s;
+    if (RuntimeStatus s = readExact(reader, idx, sizeof(NdfLevelRecord), &scratch); s != RuntimeStatus::kOk) return s;
     std::memcpy(&levels[l].rec, scratch.data, sizeof(NdfLevelRecord));
     level_records[l] = levels[l].rec;
     const NdfLevelRecord* below = l > 0 ? &levels[l - 1].rec : nullptr;
-    if (Status s = fromRecordCheck(format::checkTensorLevelRecord(levels[l].rec, uint32_t(l), info, below));
-        s != Status::kOk)
+    if (RuntimeStatus s = fromRecordCheck(format::checkTensorLevelRecord(levels[l].rec, uint32_t(l), info, below));
+        s != RuntimeStatus::kOk)
       return s;
   }
   level_count = int(info.level_count);
   blender.init(level_records, level_count);
 
   // Every group needs its own section, so the section count bounds the allocation.
-  if (uint64_t(info.group_count) > reader.sections().size()) return Status::kInvalidAsset;
+  if (uint64_t(info.group_count) > reader.sections().size()) return RuntimeStatus::kInvalidAsset;
   group_count = info.group_count;
   if (group_count > 0 && (!groups.allocate(group_count) || !group_headers.allocate(group_count)))
-    return Status::kOutOfMemory;
+    return RuntimeStatus::kOutOfMemory;
   for (uint32_t g = 0; g < group_count; ++g) {
-    if (Status s = loadGroup(reader, g, &scratch); s != Status::kOk) return s;
+    if (RuntimeStatus s = loadGroup(reader, g, &scratch); s != RuntimeStatus::kOk) return s;
   }
   for (int l = 0; l < level_count; ++l) {
-    if (Status s = loadIndex(reader, l, &scratch); s != Status::kOk) return s;
+    if (RuntimeStatus s = loadIndex(reader, l, &scratch); s != RuntimeStatus::kOk) return s;
   }
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 TensorNdf::TensorNdf() = default;
 TensorNdf::~TensorNdf() = default;
 
-Status TensorNdf::loadKind(const format::Reader& reader) {
+RuntimeStatus TensorNdf::loadKind(const format::Reader& reader) {
   std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
-  if (!impl) return Status::kOutOfMemory;
-  if (Status s = impl->load(reader); s != Status::kOk) return s;
+  if (!impl) return RuntimeStatus::kOutOfMemory;
+  if (RuntimeStatus s = impl->load(reader); s != RuntimeStatus::kOk) return s;
   impl_ = std::move(impl);
-  return Status::kOk;
+  return RuntimeStatus::kOk;
 }
 
 void TensorNdf::reset() { impl_.reset(); }

@@ -14,20 +14,20 @@ int main(int argc, char** argv) {
                            R"("generator":{"tool":"consumer","version":"0"},"parameters":{},"inputs":[]})";
   const std::vector<float> payload(1000, 0.5f);
   fmt::Writer writer;
-  if (writer.open(argv[1], fmt::AssetKind::kTest) != fmt::Status::kOk) return 2;
-  if (writer.addMetadata(meta) != fmt::Status::kOk) return 2;
+  if (writer.open(argv[1], fmt::AssetKind::kTest) != fmt::ContainerStatus::kOk) return 2;
+  if (writer.addMetadata(meta) != fmt::ContainerStatus::kOk) return 2;
   if (writer.addSection(fmt::kSectionFirstPrivate, 7, payload.data(), payload.size() * sizeof(float)) !=
-      fmt::Status::kOk)
+      fmt::ContainerStatus::kOk)
     return 2;
-  if (writer.finish() != fmt::Status::kOk) return 2;
+  if (writer.finish() != fmt::ContainerStatus::kOk) return 2;
 
   fmt::Reader reader;
-  if (reader.open(argv[1]) != fmt::Status::kOk) return 3;
+  if (reader.open(argv[1]) != fmt::ContainerStatus::kOk) return 3;
   const int index = reader.find(fmt::kSectionFirstPrivate, 7);
   std::vector<uint8_t> bytes;
-  if (index < 0 || reader.readSection(size_t(index), &bytes) != fmt::Status::kOk) return 3;
+  if (index < 0 || reader.readSection(size_t(index), &bytes) != fmt::ContainerStatus::kOk) return 3;
   if (bytes.size() != payload.size() * sizeof(float)) return 3;
   std::printf("consumer ok: %s, runtime says '%s'\n", fmt::assetKindString(reader.kind()),
-              glintbake::runtime::statusString(glintbake::runtime::Status::kOk));
+              glintbake::runtime::statusString(glintbake::runtime::RuntimeStatus::kOk));
   return 0;
 }

@@ -18,8 +18,8 @@ namespace {
 
 using runtime::FlakeNdf;
 using runtime::Footprint;
+using runtime::RuntimeStatus;
 using runtime::SPoint;
-using runtime::Status;
 
 // A normal map seen through the runtime's texel-source interface.
 runtime::InterleavedTexels mapTexels(const bake::NormalMap& map) {
@@ -40,7 +40,7 @@ struct Fixture {
   Fixture(bake::NormalMap m, int rate = 1, int res = 64) : map(std::move(m)) {
     set = reference::buildFlakes(map, rate);
     const auto texels = mapTexels(map);
-    EXPECT_EQ(ndf.build(texels, rate, reference::kDefaultSigmaR, res), Status::kOk);
+    EXPECT_EQ(ndf.build(texels, rate, reference::kDefaultSigmaR, res), RuntimeStatus::kOk);
   }
 };
 
@@ -72,7 +72,7 @@ void expectEvalMatchesReference(const Fixture& f, double sigma, uint64_t seed) {
     std::vector<std::pair<double, double>> values;
     for (const SPoint& s : probePoints(f, rfp, rng)) {
       double v = -1.0;
-      ASSERT_EQ(f.ndf.eval(fp, s, &v), Status::kOk);
+      ASSERT_EQ(f.ndf.eval(fp, s, &v), RuntimeStatus::kOk);
       const double r = reference::evalPndf(f.set, rfp, s.x, s.y, reference::kDefaultSigmaR);
       values.push_back({v, r});
       peak = std::max(peak, r);
@@ -81,7 +81,7 @@ void expectEvalMatchesReference(const Fixture& f, double sigma, uint64_t seed) {
       EXPECT_NEAR(v, r, 2e-5 * r + 1e-6 * peak) << "sigma " << sigma << " at (" << rfp.x << ", " << rfp.y << ")";
     }
     double mass = 0.0;
-    ASSERT_EQ(f.ndf.mass(fp, &mass), Status::kOk);
+    ASSERT_EQ(f.ndf.mass(fp, &mass), RuntimeStatus::kOk);
     EXPECT_NEAR(mass, reference::footprintWeight(f.set, rfp), 1e-6 * mass);
   }
 }
@@ -111,7 +111,7 @@ TEST(FlakeNdf, ImageMatchesReferenceBinAverages) {
   for (double sigma : {0.7, 3.0}) {
     const Footprint fp{20.3, 41.7, sigma};
     std::vector<float> img(64 * 64);
-    ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), Status::kOk);
+    ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
     const std::vector<double> ref =
         reference::binAveragedImage(f.set, {fp.x, fp.y, sigma}, reference::kDefaultSigmaR, 64);
     double diff = 0.0, total = 0.0;
@@ -127,7 +127,7 @@ TEST(FlakeNdf, AverageIsTheMeanOfTheImageBins) {
   Fixture f(mapOf(bake::MapKind::kScratches, 64, 4), 1, 32);
   const Footprint fp{33.0, 12.5, 1.7};
   std::vector<float> img(32 * 32);
-  ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), Status::kOk);
+  ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
   const double bin = 2.0 / 32;
   // Rectangles of whole bins inside the unit disk, where image() and average() agree exactly.
   for (int i0 : {10, 13}) {
@@ -139,7 +139,7 @@ TEST(FlakeNdf, AverageIsTheMeanOfTheImageBins) {
       mean /= w * h;
       runtime::SRect r{-1.0 + i0 * bin, 1.0 - (j0 + h) * bin, -1.0 + (i0 + w) * bin, 1.0 - j0 * bin};
       double avg = 0.0;
-      ASSERT_EQ(f.ndf.average(fp, r, &avg), Status::kOk);
+      ASSERT_EQ(f.ndf.average(fp, r, &avg), RuntimeStatus::kOk);
       EXPECT_NEAR(avg, mean, 1e-5 * mean + 1e-9);
     }
   }
@@ -152,14 +152,14 @@ TEST(FlakeNdf, FlatMapIsTheIntrinsicGaussianAndIntegratesToOne) {
     const Footprint fp{7.0, 9.0, sigma};
     // Small footprints see the flake lattice: their mass is not 1, but their shape is the Gaussian.
     double mass = 0.0;
-    ASSERT_EQ(f.ndf.mass(fp, &mass), Status::kOk);
+    ASSERT_EQ(f.ndf.mass(fp, &mass), RuntimeStatus::kOk);
     if (sigma >= 1.0) {
       EXPECT_NEAR(mass, 1.0, 1e-6);
     }
     const float nx = float(0.1), ny = float(-0.2);  // the normal as the map stores it
     for (SPoint s : {SPoint{0.1, -0.2}, SPoint{0.104, -0.197}, SPoint{0.09, -0.21}}) {
       double v = 0.0;
-      ASSERT_EQ(f.ndf.eval(fp, s, &v), Status::kOk);
+      ASSERT_EQ(f.ndf.eval(fp, s, &v), RuntimeStatus::kOk);
       v /= mass;
       const double d2 = (s.x - nx) * (s.x - nx) + (s.y - ny) * (s.y - ny);
       const double expected = std::exp(-d2 / (2 * sr * sr)) / (2 * M_PI * sr * sr);
@@ -174,8 +174,8 @@ TEST(FlakeNdf, PointFootprintIsTheLimitOfSmallOnes) {
   std::mt19937_64 rng(3);
   for (SPoint s : probePoints(f, {10.2, 5.9, 1e-5}, rng)) {
     double a = 0.0, b = 0.0;
-    ASSERT_EQ(f.ndf.eval(point, s, &a), Status::kOk);
-    ASSERT_EQ(f.ndf.eval(tiny, s, &b), Status::kOk);
+    ASSERT_EQ(f.ndf.eval(point, s, &a), RuntimeStatus::kOk);
+    ASSERT_EQ(f.ndf.eval(tiny, s, &b), RuntimeStatus::kOk);
     EXPECT_NEAR(a, b, 1e-6 * std::max(a, b) + 1e-9);
   }
 }
@@ -185,7 +185,7 @@ TEST(FlakeNdf, SamplesFollowTheirPdf) {
   for (double sigma : {0.8, 3.0}) {
     const Footprint fp{40.5, 22.25, sigma};
     double mass = 0.0;
-    ASSERT_EQ(f.ndf.mass(fp, &mass), Status::kOk);
+    ASSERT_EQ(f.ndf.mass(fp, &mass), RuntimeStatus::kOk);
     std::mt19937_64 rng(17);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     struct S {
@@ -194,16 +194,16 @@ TEST(FlakeNdf, SamplesFollowTheirPdf) {
     std::vector<S> samples;
     for (int i = 0; i < 30000; ++i) {
       runtime::NdfSample smp;
-      ASSERT_EQ(f.ndf.sample(fp, u(rng), u(rng), &smp), Status::kOk);
+      ASSERT_EQ(f.ndf.sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
       double p = -1.0, e = -1.0;
-      ASSERT_EQ(f.ndf.pdf(fp, smp.s, &p), Status::kOk);
-      ASSERT_EQ(f.ndf.eval(fp, smp.s, &e), Status::kOk);
+      ASSERT_EQ(f.ndf.pdf(fp, smp.s, &p), RuntimeStatus::kOk);
+      ASSERT_EQ(f.ndf.eval(fp, smp.s, &e), RuntimeStatus::kOk);
       EXPECT_EQ(p, smp.pdf);
       EXPECT_NEAR(p * mass, e, 1e-12 * e);
       samples.push_back({smp.s.x, smp.s.y});
     }
     std::vector<float> img(32 * 32);
-    ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), Status::kOk);
+    ASSERT_EQ(f.ndf.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
     const std::vector<double> image(img.begin(), img.end());
     const stats::ChiSquareResult r = stats::chiSquareNdfTest(samples, image, 32, mass);
     EXPECT_GT(r.p_value, 0.01) << "sigma " << sigma << ": " << r.message;
@@ -213,19 +213,19 @@ TEST(FlakeNdf, SamplesFollowTheirPdf) {
 TEST(FlakeNdf, RejectsBadArgumentsAndSources) {
   Fixture f(mapOf(bake::MapKind::kBeckmann, 16, 2));
   double v = 0.0;
-  EXPECT_EQ(f.ndf.eval({1, 1, -1.0}, {0, 0}, &v), Status::kInvalidArgument);
-  EXPECT_EQ(f.ndf.eval({NAN, 1, 1.0}, {0, 0}, &v), Status::kInvalidArgument);
-  EXPECT_EQ(f.ndf.eval({1, 1, 1.0}, {0, INFINITY}, &v), Status::kInvalidArgument);
-  EXPECT_EQ(f.ndf.eval({1, 1, 1e5}, {0, 0}, &v), Status::kInvalidArgument);  // beyond the window limit
+  EXPECT_EQ(f.ndf.eval({1, 1, -1.0}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(f.ndf.eval({NAN, 1, 1.0}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(f.ndf.eval({1, 1, 1.0}, {0, INFINITY}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(f.ndf.eval({1, 1, 1e5}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);  // beyond the window limit
   runtime::NdfSample smp;
-  EXPECT_EQ(f.ndf.sample({1, 1, 1.0}, 1.0, 0.5, &smp), Status::kInvalidArgument);
+  EXPECT_EQ(f.ndf.sample({1, 1, 1.0}, 1.0, 0.5, &smp), RuntimeStatus::kInvalidArgument);
   FlakeNdf other;
   const auto texels = mapTexels(f.map);
-  EXPECT_EQ(other.build(texels, 0, 0.005, 64), Status::kInvalidArgument);
-  EXPECT_EQ(other.build(texels, 1, 0.0, 64), Status::kInvalidArgument);
-  EXPECT_EQ(other.build(texels, 1, 0.005, 1), Status::kInvalidArgument);
+  EXPECT_EQ(other.build(texels, 0, 0.005, 64), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(other.build(texels, 1, 0.0, 64), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(other.build(texels, 1, 0.005, 1), RuntimeStatus::kInvalidArgument);
   EXPECT_FALSE(other.isBuilt());
-  EXPECT_EQ(other.eval({1, 1, 1.0}, {0, 0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(other.eval({1, 1, 1.0}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);
 }
 
 }  // namespace

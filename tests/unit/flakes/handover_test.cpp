@@ -22,8 +22,8 @@ namespace glintbake {
 namespace {
 
 using runtime::Footprint;
+using runtime::RuntimeStatus;
 using runtime::SPoint;
-using runtime::Status;
 
 // Writes an ndf-pyramid of `map` (sigma0 4, stride 8, 2 levels, R 32) with the flakes of `flakes_map`.
 std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes_map, const std::string& name,
@@ -35,15 +35,15 @@ std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes
   o.levels = 2;
   const std::string path = glintbake::testing::processTempDir() + name;
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
   if (with_flakes) {
     EXPECT_TRUE(
         bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0, 0), nullptr)
             .ok());
   }
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return path;
 }
 
@@ -57,8 +57,8 @@ bake::NormalMap beckmann(int size, uint64_t seed) {
 TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
   const bake::NormalMap map = beckmann(32, 4);
   std::unique_ptr<runtime::NdfSource> asset, pyramid;
-  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "h.gbk").c_str(), &asset), Status::kOk);
-  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "p.gbk", false).c_str(), &pyramid), Status::kOk);
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "h.gbk").c_str(), &asset), RuntimeStatus::kOk);
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "p.gbk", false).c_str(), &pyramid), RuntimeStatus::kOk);
   EXPECT_EQ(asset->kind(), format::AssetKind::kNdfPyramid);
   const runtime::FootprintRange r = asset->footprintRange();
   EXPECT_EQ(r.exact_max_sigma, 4.0);
@@ -71,38 +71,38 @@ TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
   // Exact below the band (sigma 0 included, as the limit of small footprints).
   for (double sigma : {1e-6, 1.0, 4.0}) {
     double v = 0.0;
-    ASSERT_EQ(asset->eval({13.2, 7.7, sigma}, s, &v), Status::kOk);
+    ASSERT_EQ(asset->eval({13.2, 7.7, sigma}, s, &v), RuntimeStatus::kOk);
     const double ref = reference::evalPndf(set, {13.2, 7.7, sigma}, s.x, s.y, reference::kDefaultSigmaR);
     EXPECT_NEAR(v, ref, 2e-5 * ref + 1e-9) << "sigma " << sigma;
   }
   double zero = 0.0, tiny = 0.0;
-  ASSERT_EQ(asset->eval({13.2, 7.7, 0.0}, s, &zero), Status::kOk);
-  ASSERT_EQ(asset->eval({13.2, 7.7, 1e-6}, s, &tiny), Status::kOk);
+  ASSERT_EQ(asset->eval({13.2, 7.7, 0.0}, s, &zero), RuntimeStatus::kOk);
+  ASSERT_EQ(asset->eval({13.2, 7.7, 1e-6}, s, &tiny), RuntimeStatus::kOk);
   EXPECT_NEAR(zero, tiny, 1e-6 * tiny + 1e-12);
   // The pyramid alone above the band.
   for (double sigma : {6.0, 12.0}) {
     double a = 0.0, b = 0.0;
-    ASSERT_EQ(asset->eval({13.2, 7.7, sigma}, s, &a), Status::kOk);
-    ASSERT_EQ(pyramid->eval({13.2, 7.7, sigma}, s, &b), Status::kOk);
+    ASSERT_EQ(asset->eval({13.2, 7.7, sigma}, s, &a), RuntimeStatus::kOk);
+    ASSERT_EQ(pyramid->eval({13.2, 7.7, sigma}, s, &b), RuntimeStatus::kOk);
     EXPECT_EQ(a, b);
   }
   // In the band: the blend of both paths, linear in log sigma, and consistent.
   const double sigma = 4.0 * std::pow(2.0, 0.25);  // halfway through the band in log sigma
   const Footprint fp{13.2, 7.7, sigma};
   double v = 0.0, p = 0.0, m = 0.0;
-  ASSERT_EQ(asset->eval(fp, s, &v), Status::kOk);
-  ASSERT_EQ(pyramid->eval(fp, s, &p), Status::kOk);
+  ASSERT_EQ(asset->eval(fp, s, &v), RuntimeStatus::kOk);
+  ASSERT_EQ(pyramid->eval(fp, s, &p), RuntimeStatus::kOk);
   const double f = reference::evalPndf(set, {fp.x, fp.y, sigma}, s.x, s.y, reference::kDefaultSigmaR);
   EXPECT_NEAR(v, 0.5 * f + 0.5 * p, 1e-4 * v);
-  ASSERT_EQ(asset->mass(fp, &m), Status::kOk);
+  ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < 200; ++i) {
     runtime::NdfSample smp;
-    ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), Status::kOk);
+    ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
     double pdf = -1.0, e = -1.0;
-    ASSERT_EQ(asset->pdf(fp, smp.s, &pdf), Status::kOk);
-    ASSERT_EQ(asset->eval(fp, smp.s, &e), Status::kOk);
+    ASSERT_EQ(asset->pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
+    ASSERT_EQ(asset->eval(fp, smp.s, &e), RuntimeStatus::kOk);
     EXPECT_EQ(pdf, smp.pdf);
     EXPECT_NEAR(pdf * m, e, 1e-12 * e);
   }
@@ -111,7 +111,7 @@ TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
 TEST(Handover, FlakesOfAnotherMapAreRefused) {
   const bake::NormalMap map = beckmann(32, 4), other = beckmann(16, 5);
   std::unique_ptr<runtime::NdfSource> asset;
-  EXPECT_EQ(runtime::openNdfAsset(writeAsset(map, other, "x.gbk").c_str(), &asset), Status::kInvalidAsset);
+  EXPECT_EQ(runtime::openNdfAsset(writeAsset(map, other, "x.gbk").c_str(), &asset), RuntimeStatus::kInvalidAsset);
   EXPECT_EQ(asset, nullptr);
 }
 

@@ -20,14 +20,14 @@ TEST(Container, RoundTripBothCodecs) {
   const auto noise = test::noiseBytes(777, 1);
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest, 5), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 1, ramp.data(), ramp.size(), Codec::kZstd), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 2, noise.data(), noise.size(), Codec::kRaw), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest, 5), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 1, ramp.data(), ramp.size(), Codec::kZstd), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 2, noise.data(), noise.size(), Codec::kRaw), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   Reader reader;
-  ASSERT_EQ(reader.open(path, {0xFFFFFFFF, true}), Status::kOk);
+  ASSERT_EQ(reader.open(path, {0xFFFFFFFF, true}), ContainerStatus::kOk);
   EXPECT_EQ(reader.kind(), AssetKind::kTest);
   EXPECT_EQ(reader.header().version_major, kFormatVersionMajor);
   EXPECT_EQ(reader.header().version_minor, kFormatVersionMinor);
@@ -40,23 +40,23 @@ TEST(Container, RoundTripBothCodecs) {
   for (const SectionInfo& s : reader.sections()) EXPECT_EQ(s.offset % kSectionAlignment, 0u);
 
   std::vector<uint8_t> out;
-  ASSERT_EQ(reader.readSection(size_t(reader.find(kSectionImage, 1)), &out), Status::kOk);
+  ASSERT_EQ(reader.readSection(size_t(reader.find(kSectionImage, 1)), &out), ContainerStatus::kOk);
   EXPECT_EQ(out, ramp);
-  ASSERT_EQ(reader.readSection(size_t(reader.find(kSectionImage, 2)), &out), Status::kOk);
+  ASSERT_EQ(reader.readSection(size_t(reader.find(kSectionImage, 2)), &out), ContainerStatus::kOk);
   EXPECT_EQ(out, noise);
   std::string json;
-  ASSERT_EQ(reader.readMetadata(&json), Status::kOk);
+  ASSERT_EQ(reader.readMetadata(&json), ContainerStatus::kOk);
   EXPECT_EQ(json, test::testMetadata());
   EXPECT_EQ(reader.find(kSectionImage), 0);
   EXPECT_EQ(reader.find(kSectionImage, 3), -1);
   EXPECT_EQ(reader.find(kSectionNdfChunk), -1);
-  EXPECT_EQ(reader.verifyFileChecksum(), Status::kOk);
+  EXPECT_EQ(reader.verifyFileChecksum(), ContainerStatus::kOk);
 
   // The same bytes through the in-memory path.
   const auto bytes = test::readFile(path);
   Reader memory;
-  ASSERT_EQ(memory.openMemory(bytes.data(), bytes.size()), Status::kOk);
-  ASSERT_EQ(memory.readSection(0, &out), Status::kOk);
+  ASSERT_EQ(memory.openMemory(bytes.data(), bytes.size()), ContainerStatus::kOk);
+  ASSERT_EQ(memory.readSection(0, &out), ContainerStatus::kOk);
   EXPECT_EQ(out, ramp);
 }
 
@@ -71,15 +71,15 @@ TEST(Container, EmptySection) {
   ScratchDir dir;
   test::makeSmallContainer(dir.path("a.gbk"));
   Reader reader;
-  ASSERT_EQ(reader.open(dir.path("a.gbk")), Status::kOk);
+  ASSERT_EQ(reader.open(dir.path("a.gbk")), ContainerStatus::kOk);
   const int i = reader.find(kSectionFirstPrivate + 2, 0);
   ASSERT_GE(i, 0);
   EXPECT_EQ(reader.sections()[size_t(i)].raw_size, 0u);
   EXPECT_EQ(reader.sections()[size_t(i)].codec, uint32_t(Codec::kRaw));
   std::vector<uint8_t> out(5, 1);
-  ASSERT_EQ(reader.readSection(size_t(i), &out), Status::kOk);
+  ASSERT_EQ(reader.readSection(size_t(i), &out), ContainerStatus::kOk);
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(reader.readSectionInto(size_t(i), nullptr, 0), Status::kOk);
+  EXPECT_EQ(reader.readSectionInto(size_t(i), nullptr, 0), ContainerStatus::kOk);
 }
 
 TEST(Container, ManySectionsRandomAccess) {
@@ -88,17 +88,17 @@ TEST(Container, ManySectionsRandomAccess) {
   constexpr int kCount = 500;
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kNdfPyramid, 1), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kNdfPyramid, 1), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
     for (int i = 0; i < kCount; ++i) {
       const auto bytes = (i % 2) ? test::noiseBytes(size_t(i * 3), uint64_t(i)) : test::rampBytes(size_t(i * 5));
       const uint64_t key = (uint64_t(i % 7) << 32) | uint64_t(i);
-      ASSERT_EQ(writer.addSection(kSectionNdfChunk, key, bytes.data(), bytes.size()), Status::kOk);
+      ASSERT_EQ(writer.addSection(kSectionNdfChunk, key, bytes.data(), bytes.size()), ContainerStatus::kOk);
     }
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   Reader reader;
-  ASSERT_EQ(reader.open(path), Status::kOk);
+  ASSERT_EQ(reader.open(path), ContainerStatus::kOk);
   EXPECT_EQ(reader.sections().size(), size_t(kCount + 1));
   // Read in a scrambled order, from several threads at once (const methods are thread-safe).
   auto check = [&](int start, bool* ok) {
@@ -108,7 +108,7 @@ TEST(Container, ManySectionsRandomAccess) {
       const uint64_t key = (uint64_t(i % 7) << 32) | uint64_t(i);
       const int index = reader.find(kSectionNdfChunk, key);
       const auto expect = (i % 2) ? test::noiseBytes(size_t(i * 3), uint64_t(i)) : test::rampBytes(size_t(i * 5));
-      if (index < 0 || reader.readSection(size_t(index), &out) != Status::kOk || out != expect) *ok = false;
+      if (index < 0 || reader.readSection(size_t(index), &out) != ContainerStatus::kOk || out != expect) *ok = false;
     }
   };
   bool ok1 = true, ok2 = true;
@@ -130,20 +130,21 @@ TEST(Container, LargeSectionStreams) {
   }
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest, 1), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 0, big.data(), big.size()), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest, 1), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 0, big.data(), big.size()), ContainerStatus::kOk);
     // Written as added: the bytes are in the file before finish().
     EXPECT_GT(writer.bytesWritten(), 128u);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   Reader reader;
-  ASSERT_EQ(reader.open(path), Status::kOk);
+  ASSERT_EQ(reader.open(path), ContainerStatus::kOk);
   std::vector<uint8_t> out(kSize);
-  ASSERT_EQ(reader.readSectionInto(0 + size_t(reader.find(kSectionImage)), out.data(), out.size()), Status::kOk);
+  ASSERT_EQ(reader.readSectionInto(0 + size_t(reader.find(kSectionImage)), out.data(), out.size()),
+            ContainerStatus::kOk);
   EXPECT_TRUE(out == big);
   EXPECT_EQ(reader.readSectionInto(size_t(reader.find(kSectionImage)), out.data(), out.size() - 1),
-            Status::kInvalidArgument);
+            ContainerStatus::kInvalidArgument);
 }
 
 TEST(Container, IncompressibleFallsBackToRaw) {
@@ -151,12 +152,12 @@ TEST(Container, IncompressibleFallsBackToRaw) {
   const std::string path = dir.path("noise.gbk");
   const auto noise = test::noiseBytes(4096, 9);
   Writer writer;
-  ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-  ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
-  ASSERT_EQ(writer.addSection(kSectionImage, 0, noise.data(), noise.size(), Codec::kZstd), Status::kOk);
-  ASSERT_EQ(writer.finish(), Status::kOk);
+  ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+  ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
+  ASSERT_EQ(writer.addSection(kSectionImage, 0, noise.data(), noise.size(), Codec::kZstd), ContainerStatus::kOk);
+  ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   Reader reader;
-  ASSERT_EQ(reader.open(path), Status::kOk);
+  ASSERT_EQ(reader.open(path), ContainerStatus::kOk);
   const SectionInfo& s = reader.sections()[size_t(reader.find(kSectionImage))];
   EXPECT_EQ(s.codec, uint32_t(Codec::kRaw));
   EXPECT_EQ(s.stored_size, s.raw_size);
@@ -166,40 +167,40 @@ TEST(Container, MetadataRequiredExactlyOnce) {
   ScratchDir dir;
   const std::string path = dir.path("nometa.gbk");
   Writer writer;
-  ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
+  ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
   const auto ramp = test::rampBytes(64);
-  ASSERT_EQ(writer.addSection(kSectionImage, 0, ramp.data(), ramp.size()), Status::kOk);
-  EXPECT_EQ(writer.finish(), Status::kInvalidArgument);
+  ASSERT_EQ(writer.addSection(kSectionImage, 0, ramp.data(), ramp.size()), ContainerStatus::kOk);
+  EXPECT_EQ(writer.finish(), ContainerStatus::kInvalidArgument);
   // Nothing left behind: neither the final file nor the temporary.
   EXPECT_TRUE(dir.list().empty());
 
   Writer twice;
-  ASSERT_EQ(twice.open(path, AssetKind::kTest), Status::kOk);
-  ASSERT_EQ(twice.addMetadata("{}"), Status::kOk);
-  EXPECT_EQ(twice.addMetadata("{}"), Status::kInvalidArgument);
+  ASSERT_EQ(twice.open(path, AssetKind::kTest), ContainerStatus::kOk);
+  ASSERT_EQ(twice.addMetadata("{}"), ContainerStatus::kOk);
+  EXPECT_EQ(twice.addMetadata("{}"), ContainerStatus::kInvalidArgument);
 }
 
 TEST(Container, DuplicateTypeAndKeyRefused) {
   ScratchDir dir;
   Writer writer;
-  ASSERT_EQ(writer.open(dir.path("dup.gbk"), AssetKind::kTest), Status::kOk);
+  ASSERT_EQ(writer.open(dir.path("dup.gbk"), AssetKind::kTest), ContainerStatus::kOk);
   const auto ramp = test::rampBytes(64);
-  ASSERT_EQ(writer.addSection(kSectionImage, 4, ramp.data(), ramp.size()), Status::kOk);
-  EXPECT_EQ(writer.addSection(kSectionImage, 4, ramp.data(), ramp.size()), Status::kInvalidArgument);
-  EXPECT_EQ(writer.addSection(kSectionImage, 5, ramp.data(), ramp.size()), Status::kOk);
+  ASSERT_EQ(writer.addSection(kSectionImage, 4, ramp.data(), ramp.size()), ContainerStatus::kOk);
+  EXPECT_EQ(writer.addSection(kSectionImage, 4, ramp.data(), ramp.size()), ContainerStatus::kInvalidArgument);
+  EXPECT_EQ(writer.addSection(kSectionImage, 5, ramp.data(), ramp.size()), ContainerStatus::kOk);
 }
 
 TEST(Container, BadArgumentsRefused) {
   ScratchDir dir;
   Writer writer;
-  EXPECT_EQ(writer.addMetadata("{}"), Status::kInvalidArgument);  // not open
-  EXPECT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest, 0), Status::kInvalidArgument);
-  EXPECT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest, 20), Status::kInvalidArgument);
-  ASSERT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest), Status::kOk);
-  EXPECT_EQ(writer.addSection(kSectionImage, 0, nullptr, 3), Status::kInvalidArgument);
-  EXPECT_EQ(writer.addSection(kSectionImage, 0, "abc", 3, Codec(9)), Status::kInvalidArgument);
+  EXPECT_EQ(writer.addMetadata("{}"), ContainerStatus::kInvalidArgument);  // not open
+  EXPECT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest, 0), ContainerStatus::kInvalidArgument);
+  EXPECT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest, 20), ContainerStatus::kInvalidArgument);
+  ASSERT_EQ(writer.open(dir.path("x.gbk"), AssetKind::kTest), ContainerStatus::kOk);
+  EXPECT_EQ(writer.addSection(kSectionImage, 0, nullptr, 3), ContainerStatus::kInvalidArgument);
+  EXPECT_EQ(writer.addSection(kSectionImage, 0, "abc", 3, Codec(9)), ContainerStatus::kInvalidArgument);
   Writer nowhere;
-  EXPECT_EQ(nowhere.open(dir.path("missing-dir/x.gbk"), AssetKind::kTest), Status::kIoError);
+  EXPECT_EQ(nowhere.open(dir.path("missing-dir/x.gbk"), AssetKind::kTest), ContainerStatus::kIoError);
 }
 
 TEST(Container, TemporaryFileLifecycle) {
@@ -207,27 +208,27 @@ TEST(Container, TemporaryFileLifecycle) {
   const std::string path = dir.path("t.gbk");
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
     const std::string tmp = writer.temporaryPath();
     EXPECT_EQ(tmp.rfind(path + ".tmp-", 0), 0u) << tmp;
     ASSERT_EQ(dir.list().size(), 1u);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
     writer.abort();
     EXPECT_TRUE(dir.list().empty());
-    EXPECT_EQ(writer.finish(), Status::kInvalidArgument);
+    EXPECT_EQ(writer.finish(), ContainerStatus::kInvalidArgument);
   }
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
     // Destroyed without finish().
   }
   EXPECT_TRUE(dir.list().empty());
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
     EXPECT_TRUE(writer.temporaryPath().empty());
   }
   EXPECT_EQ(dir.list(), std::vector<std::string>{"t.gbk"});
@@ -240,14 +241,14 @@ TEST(Container, HashesAreStable) {
   ScratchDir dir;
   test::writeFile(dir.path("in.bin"), {'a', 'b', 'c'});
   std::string hex;
-  ASSERT_EQ(hashFile128Hex(dir.path("in.bin"), &hex), Status::kOk);
+  ASSERT_EQ(hashFile128Hex(dir.path("in.bin"), &hex), ContainerStatus::kOk);
   EXPECT_EQ(hex, hash128Hex("abc", 3));
-  EXPECT_EQ(hashFile128Hex(dir.path("absent.bin"), &hex), Status::kIoError);
+  EXPECT_EQ(hashFile128Hex(dir.path("absent.bin"), &hex), ContainerStatus::kIoError);
 }
 
 TEST(Container, Names) {
-  EXPECT_STREQ(statusString(Status::kOk), "ok");
-  EXPECT_STREQ(statusString(Status(999)), "unknown status");
+  EXPECT_STREQ(statusString(ContainerStatus::kOk), "ok");
+  EXPECT_STREQ(statusString(ContainerStatus(999)), "unknown status");
   EXPECT_STREQ(codecString(Codec::kZstd), "zstd");
   EXPECT_STREQ(codecString(Codec(5)), "unknown");
   for (uint32_t k = 0; k < 0x8000; ++k) {

@@ -36,7 +36,7 @@ bool readAll(const Reader& reader, std::vector<std::vector<uint8_t>>* contents) 
   contents->clear();
   for (size_t i = 0; i < reader.sections().size(); ++i) {
     std::vector<uint8_t> out;
-    if (reader.readSection(i, &out) != Status::kOk) return false;
+    if (reader.readSection(i, &out) != ContainerStatus::kOk) return false;
     contents->push_back(std::move(out));
   }
   return true;
@@ -47,7 +47,7 @@ class Corruption : public ::testing::Test {
   void SetUp() override {
     good_ = test::makeSmallContainer(dir_.path("good.gbk"));
     Reader reader;
-    ASSERT_EQ(reader.openMemory(good_.data(), good_.size()), Status::kOk);
+    ASSERT_EQ(reader.openMemory(good_.data(), good_.size()), ContainerStatus::kOk);
     ASSERT_TRUE(readAll(reader, &good_contents_));
     ASSERT_TRUE(validate(good_.data(), good_.size()).valid());
   }
@@ -67,16 +67,16 @@ TEST_F(Corruption, EveryByteFlipIsDetected) {
       EXPECT_FALSE(report.valid()) << "flip of byte " << at << " mask " << int(mask) << " went unnoticed";
       // A reader that skips the whole-file hash either fails or returns the original data.
       Reader reader;
-      if (reader.openMemory(bad.data(), bad.size()) == Status::kOk) {
+      if (reader.openMemory(bad.data(), bad.size()) == ContainerStatus::kOk) {
         std::vector<std::vector<uint8_t>> contents;
         if (readAll(reader, &contents)) {
           EXPECT_EQ(contents, good_contents_) << "flip of byte " << at << " changed data silently";
         }
-        EXPECT_NE(reader.verifyFileChecksum(), Status::kOk) << "byte " << at;
+        EXPECT_NE(reader.verifyFileChecksum(), ContainerStatus::kOk) << "byte " << at;
       }
       ReaderOptions verify;
       verify.verify_file_checksum = true;
-      EXPECT_NE(reader.openMemory(bad.data(), bad.size(), verify), Status::kOk) << "byte " << at;
+      EXPECT_NE(reader.openMemory(bad.data(), bad.size(), verify), ContainerStatus::kOk) << "byte " << at;
     }
   }
 }
@@ -86,17 +86,17 @@ TEST_F(Corruption, EveryTruncationIsDetected) {
     // A fresh copy of exactly `length` bytes, so reading past it is an ASan error, not luck.
     const std::vector<uint8_t> cut(good_.begin(), good_.begin() + std::ptrdiff_t(length));
     Reader reader;
-    const Status status = reader.openMemory(cut.data(), cut.size());
+    const ContainerStatus status = reader.openMemory(cut.data(), cut.size());
     // Every prefix starts with the right magic, so each is reported as truncated.
-    EXPECT_EQ(status, Status::kTruncated) << "length " << length;
+    EXPECT_EQ(status, ContainerStatus::kTruncated) << "length " << length;
     EXPECT_FALSE(validate(cut.data(), cut.size()).valid()) << "length " << length;
   }
   // Through the file path too, for one length in the section area.
   std::vector<uint8_t> cut(good_.begin(), good_.begin() + 200);
   test::writeFile(dir_.path("cut.gbk"), cut);
   Reader reader;
-  EXPECT_EQ(reader.open(dir_.path("cut.gbk")), Status::kTruncated);
-  EXPECT_EQ(validateFile(dir_.path("cut.gbk")).status, Status::kTruncated);
+  EXPECT_EQ(reader.open(dir_.path("cut.gbk")), ContainerStatus::kTruncated);
+  EXPECT_EQ(validateFile(dir_.path("cut.gbk")).status, ContainerStatus::kTruncated);
 }
 
 TEST_F(Corruption, NotAContainer) {
@@ -104,17 +104,17 @@ TEST_F(Corruption, NotAContainer) {
       "hello, this is not a container at all, but it is long enough to hold a header....."
       "..................................................";
   Reader reader;
-  EXPECT_EQ(reader.openMemory(text.data(), text.size()), Status::kBadMagic);
+  EXPECT_EQ(reader.openMemory(text.data(), text.size()), ContainerStatus::kBadMagic);
   // The validator says exactly that, and nothing about sections or metadata it cannot see.
   const ValidationReport not_container = validate(text.data(), text.size());
   ASSERT_EQ(not_container.messages.size(), 1u);
   EXPECT_EQ(not_container.messages[0].id, 2002);
-  EXPECT_EQ(not_container.status, Status::kBadMagic);
-  EXPECT_EQ(reader.openMemory(nullptr, 0), Status::kTruncated);
-  EXPECT_EQ(reader.open(dir_.path("absent.gbk")), Status::kIoError);
-  EXPECT_EQ(reader.open(dir_.path("")), Status::kIoError);  // a directory
+  EXPECT_EQ(not_container.status, ContainerStatus::kBadMagic);
+  EXPECT_EQ(reader.openMemory(nullptr, 0), ContainerStatus::kTruncated);
+  EXPECT_EQ(reader.open(dir_.path("absent.gbk")), ContainerStatus::kIoError);
+  EXPECT_EQ(reader.open(dir_.path("")), ContainerStatus::kIoError);  // a directory
   const ValidationReport report = validateFile(dir_.path("absent.gbk"));
-  EXPECT_EQ(report.status, Status::kIoError);
+  EXPECT_EQ(report.status, ContainerStatus::kIoError);
   ASSERT_EQ(report.messages.size(), 1u);
   EXPECT_EQ(report.messages[0].id, 1001);
 }
@@ -123,18 +123,18 @@ TEST_F(Corruption, TrailingBytesRefused) {
   std::vector<uint8_t> bad = good_;
   bad.push_back(0);
   Reader reader;
-  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kCorruptHeader);
+  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kCorruptHeader);
 }
 
 TEST_F(Corruption, RawSizeCap) {
   ReaderOptions options;
   options.max_raw_section_size = 200;  // the small container has a 300-byte section
   Reader reader;
-  EXPECT_EQ(reader.openMemory(good_.data(), good_.size(), options), Status::kTooLarge);
+  EXPECT_EQ(reader.openMemory(good_.data(), good_.size(), options), ContainerStatus::kTooLarge);
   ValidateOptions validate_options;
   validate_options.max_raw_section_size = 200;
   const ValidationReport report = validate(good_.data(), good_.size(), validate_options);
-  EXPECT_EQ(report.status, Status::kTooLarge);
+  EXPECT_EQ(report.status, ContainerStatus::kTooLarge);
   EXPECT_EQ(report.messages.at(0).id, 3005);
 }
 
@@ -143,7 +143,7 @@ TEST_F(Corruption, SectionCountCap) {
   store32(&bad, kSectionCountOffset, kMaxSectionCount + 1);
   test::resealHeader(&bad);
   Reader reader;
-  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kTooLarge);
+  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kTooLarge);
 }
 
 TEST_F(Corruption, NewerMinorReadsAndSkipsUnknownSections) {
@@ -151,27 +151,27 @@ TEST_F(Corruption, NewerMinorReadsAndSkipsUnknownSections) {
   const std::string path = dir_.path("future.gbk");
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
     const auto ramp = test::rampBytes(256);
-    ASSERT_EQ(writer.addSection(0x2345, 0, ramp.data(), ramp.size(), Codec::kRaw), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage + 1, 0, ramp.data(), ramp.size(), Codec::kRaw), Status::kOk);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.addSection(0x2345, 0, ramp.data(), ramp.size(), Codec::kRaw), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage + 1, 0, ramp.data(), ramp.size(), Codec::kRaw), ContainerStatus::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   std::vector<uint8_t> bytes = test::readFile(path);
   bytes[kVersionMinorOffset] = 7;
   store32(&bytes, entryAt(bytes, 2) + kEntryCodec, 9);  // a codec of "1.7"
   test::resealIndex(&bytes);
   Reader reader;
-  ASSERT_EQ(reader.openMemory(bytes.data(), bytes.size()), Status::kOk);
+  ASSERT_EQ(reader.openMemory(bytes.data(), bytes.size()), ContainerStatus::kOk);
   EXPECT_EQ(reader.header().version_minor, 7);
   ASSERT_EQ(reader.sections().size(), 3u);
   EXPECT_EQ(reader.sections()[1].type, 0x2345u);
   std::vector<uint8_t> out;
-  EXPECT_EQ(reader.readSection(1, &out), Status::kOk);  // unknown type, known codec: readable
-  EXPECT_NE(reader.readSection(2, &out), Status::kOk);  // unknown codec: refused, not misread
+  EXPECT_EQ(reader.readSection(1, &out), ContainerStatus::kOk);  // unknown type, known codec: readable
+  EXPECT_NE(reader.readSection(2, &out), ContainerStatus::kOk);  // unknown codec: refused, not misread
   std::string json;
-  EXPECT_EQ(reader.readMetadata(&json), Status::kOk);
+  EXPECT_EQ(reader.readMetadata(&json), ContainerStatus::kOk);
 
   const ValidationReport report = validate(bytes.data(), bytes.size());
   EXPECT_TRUE(report.valid());
@@ -187,11 +187,11 @@ TEST_F(Corruption, NewerMajorRefused) {
   bad[kVersionMajorOffset] = 2;
   Reader reader;
   // Refused whether or not the header checksum matches: a 2.x header need not follow 1.x rules.
-  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kUnsupportedVersion);
+  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kUnsupportedVersion);
   test::resealHeader(&bad);
-  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kUnsupportedVersion);
+  EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kUnsupportedVersion);
   const ValidationReport report = validate(bad.data(), bad.size());
-  EXPECT_EQ(report.status, Status::kUnsupportedVersion);
+  EXPECT_EQ(report.status, ContainerStatus::kUnsupportedVersion);
   ASSERT_EQ(report.messages.size(), 1u);
   EXPECT_EQ(report.messages.at(0).id, 2003);
 }
@@ -204,9 +204,9 @@ TEST_F(Corruption, InconsistentIndexRefused) {
     ASSERT_EQ(bad[e + kEntryCodec], 1);
     store64(&bad, e + kEntryRawSize, load64(bad, e + kEntryRawSize) + 1);
     test::resealIndex(&bad);
-    ASSERT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kOk);
+    ASSERT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kOk);
     std::vector<uint8_t> out;
-    EXPECT_EQ(reader.readSection(1, &out), Status::kDecompressFailed);
+    EXPECT_EQ(reader.readSection(1, &out), ContainerStatus::kDecompressFailed);
     EXPECT_TRUE(out.empty());
     EXPECT_FALSE(validate(bad.data(), bad.size()).valid());
   }
@@ -214,31 +214,31 @@ TEST_F(Corruption, InconsistentIndexRefused) {
     std::vector<uint8_t> bad = good_;
     store64(&bad, entryAt(bad, 2) + kEntryOffset, load64(bad, entryAt(bad, 1) + kEntryOffset));
     test::resealIndex(&bad);
-    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kCorruptIndex);
+    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kCorruptIndex);
   }
   {  // misaligned section
     std::vector<uint8_t> bad = good_;
     store64(&bad, entryAt(bad, 1) + kEntryOffset, load64(bad, entryAt(bad, 1) + kEntryOffset) + 8);
     test::resealIndex(&bad);
-    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kCorruptIndex);
+    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kCorruptIndex);
   }
   {  // section reaching into the index
     std::vector<uint8_t> bad = good_;
     store64(&bad, entryAt(bad, 2) + kEntryOffset, load64(bad, kIndexOffsetOffset) - 64);
     test::resealIndex(&bad);
-    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kCorruptIndex);
+    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kCorruptIndex);
   }
   {  // raw codec whose stored and raw sizes differ
     std::vector<uint8_t> bad = good_;
     store64(&bad, entryAt(bad, 2) + kEntryRawSize, 1u << 20);
     test::resealIndex(&bad);
-    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kCorruptIndex);
+    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kCorruptIndex);
   }
   {  // a zstd "bomb": tiny stored size claiming a huge raw size
     std::vector<uint8_t> bad = good_;
     store64(&bad, entryAt(bad, 1) + kEntryRawSize, uint64_t(1) << 40);
     test::resealIndex(&bad);
-    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), Status::kTooLarge);
+    EXPECT_EQ(reader.openMemory(bad.data(), bad.size()), ContainerStatus::kTooLarge);
   }
 }
 

@@ -71,14 +71,15 @@ std::string testMetadata() {
 
 std::vector<uint8_t> makeSmallContainer(const std::string& path) {
   Writer writer;
-  EXPECT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-  EXPECT_EQ(writer.addMetadata(testMetadata()), Status::kOk);
+  EXPECT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+  EXPECT_EQ(writer.addMetadata(testMetadata()), ContainerStatus::kOk);
   const auto ramp = rampBytes(300);
-  EXPECT_EQ(writer.addSection(kSectionFirstPrivate, 7, ramp.data(), ramp.size(), Codec::kZstd), Status::kOk);
+  EXPECT_EQ(writer.addSection(kSectionFirstPrivate, 7, ramp.data(), ramp.size(), Codec::kZstd), ContainerStatus::kOk);
   const auto noise = noiseBytes(100, 3);
-  EXPECT_EQ(writer.addSection(kSectionFirstPrivate + 1, 0, noise.data(), noise.size(), Codec::kRaw), Status::kOk);
-  EXPECT_EQ(writer.addSection(kSectionFirstPrivate + 2, 0, nullptr, 0), Status::kOk);
-  EXPECT_EQ(writer.finish(), Status::kOk);
+  EXPECT_EQ(writer.addSection(kSectionFirstPrivate + 1, 0, noise.data(), noise.size(), Codec::kRaw),
+            ContainerStatus::kOk);
+  EXPECT_EQ(writer.addSection(kSectionFirstPrivate + 2, 0, nullptr, 0), ContainerStatus::kOk);
+  EXPECT_EQ(writer.finish(), ContainerStatus::kOk);
   return readFile(path);
 }
 

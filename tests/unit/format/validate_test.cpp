@@ -50,7 +50,7 @@ TEST(Validate, GoodContainerHasNoMessages) {
   const auto bytes = test::makeSmallContainer(dir.path("a.gbk"));
   const ValidationReport report = validate(bytes.data(), bytes.size());
   EXPECT_TRUE(report.valid());
-  EXPECT_EQ(report.status, Status::kOk);
+  EXPECT_EQ(report.status, ContainerStatus::kOk);
   EXPECT_TRUE(report.messages.empty()) << report.messages.at(0).message;
   const ValidationReport from_file = validateFile(dir.path("a.gbk"));
   EXPECT_TRUE(from_file.messages.empty());
@@ -106,17 +106,17 @@ TEST(Validate, ImageSections) {
   wrong_size.resize(wrong_size.size() + 4);
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kTest), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(test::testMetadata()), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 0, good.data(), good.size()), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 1, nan.data(), nan.size()), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionImage, 2, not_image.data(), not_image.size()), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionNdfChunk, 3, wrong_size.data(), wrong_size.size()), Status::kOk);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 0, good.data(), good.size()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 1, nan.data(), nan.size()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionImage, 2, not_image.data(), not_image.size()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionNdfChunk, 3, wrong_size.data(), wrong_size.size()), ContainerStatus::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   const ValidationReport report = validateFile(path);
   EXPECT_FALSE(report.valid());
-  EXPECT_EQ(report.status, Status::kOk);  // the container itself is sound
+  EXPECT_EQ(report.status, ContainerStatus::kOk);  // the container itself is sound
   EXPECT_EQ(ids(report.messages), (std::vector<int>{4006, 4004, 4005}));
 }
 
@@ -125,10 +125,10 @@ TEST(Validate, MetadataMissingOrBroken) {
   const std::string path = dir.path("meta.gbk");
   {
     Writer writer;
-    ASSERT_EQ(writer.open(path, AssetKind::kNdfPyramid), Status::kOk);
-    ASSERT_EQ(writer.addMetadata(R"({"schema":"glintbake.container-metadata/0"})"), Status::kOk);
-    ASSERT_EQ(writer.addSection(kSectionFirstPrivate, 1, "{}", 2), Status::kOk);
-    ASSERT_EQ(writer.finish(), Status::kOk);
+    ASSERT_EQ(writer.open(path, AssetKind::kNdfPyramid), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addMetadata(R"({"schema":"glintbake.container-metadata/0"})"), ContainerStatus::kOk);
+    ASSERT_EQ(writer.addSection(kSectionFirstPrivate, 1, "{}", 2), ContainerStatus::kOk);
+    ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
   }
   // Writers refuse a second metadata section, so make one by retyping index entry 1 (SPEC.md:
   // index_offset at header byte 32, entry type at entry byte 0).
@@ -153,7 +153,7 @@ TEST(Validate, CorruptSectionReported) {
   bytes[256 + 3] ^= 0x40;
   test::resealFile(&bytes);
   const ValidationReport report = validate(bytes.data(), bytes.size());
-  EXPECT_EQ(report.status, Status::kChecksumMismatch);
+  EXPECT_EQ(report.status, ContainerStatus::kChecksumMismatch);
   EXPECT_TRUE(has(report.messages, 4002));
   EXPECT_FALSE(has(report.messages, 4001));
   for (const auto& m : report.messages) {

@@ -87,10 +87,11 @@ TEST(LtcTable, NormMatchesBrdfAlbedoAndLtcIntegral) {
 
 runtime::LtcCoefficients runtimeCell(int a, int t) {
   runtime::LtcTable table;
-  EXPECT_EQ(table.fromArrays(kSize, ggxPublished().ltc1.data(), ggxPublished().ltc2.data()), runtime::Status::kOk);
+  EXPECT_EQ(table.fromArrays(kSize, ggxPublished().ltc1.data(), ggxPublished().ltc2.data()),
+            runtime::RuntimeStatus::kOk);
   const double x = double(t) / (kSize - 1);
   runtime::LtcCoefficients c;
-  EXPECT_EQ(table.lookup(float(double(a) / (kSize - 1)), float(1.0 - x * x), &c), runtime::Status::kOk);
+  EXPECT_EQ(table.lookup(float(double(a) / (kSize - 1)), float(1.0 - x * x), &c), runtime::RuntimeStatus::kOk);
   return c;
 }
 

@@ -70,7 +70,7 @@ TEST(Roughness, DeterministicAndWritesMipmappedExr) {
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].alpha, two[i].alpha);
 
   const std::string path = glintbake::testing::processTempDir() + "ltc_rough.exr";
-  const Status written = writeRoughnessExr(one, path);
+  const BakeStatus written = writeRoughnessExr(one, path);
   ASSERT_TRUE(written.ok()) << written.error().message;
   auto input = OIIO::ImageInput::open(path);
   ASSERT_TRUE(input);

@@ -94,20 +94,20 @@ TEST(LtcTableRuntime, BilinearLookupInPublishedParametrisation) {
   std::vector<float> l1, l2;
   makeTable(5, &l1, &l2);
   LtcTable table;
-  ASSERT_EQ(table.fromArrays(5, l1.data(), l2.data()), Status::kOk);
+  ASSERT_EQ(table.fromArrays(5, l1.data(), l2.data()), RuntimeStatus::kOk);
   LtcCoefficients c;
   // roughness 0.375 -> a = 1.5; cos = 1 - (2.5/4)^2 -> t = 2.5.
   const float x = 2.5f / 4.0f;
-  ASSERT_EQ(table.lookup(0.375f, 1.0f - x * x, &c), Status::kOk);
+  ASSERT_EQ(table.lookup(0.375f, 1.0f - x * x, &c), RuntimeStatus::kOk);
   EXPECT_NEAR(c.norm, 1.5f, 1e-5f);
   EXPECT_NEAR(c.fresnel, 2.5f, 1e-4f);
   EXPECT_NEAR(c.inv_m[0][0], 2.5f, 1e-5f);
   EXPECT_NEAR(c.inv_m[2][0], 0.25f, 1e-5f);
   EXPECT_EQ(c.inv_m[1][1], 1.0f);
   EXPECT_NEAR(ltcFresnelMagnitude(c, 0.5f), 2.0f, 1e-4f);
-  EXPECT_EQ(table.lookup(NAN, 0.5f, &c), Status::kInvalidArgument);
+  EXPECT_EQ(table.lookup(NAN, 0.5f, &c), RuntimeStatus::kInvalidArgument);
   // Clamping outside the range.
-  ASSERT_EQ(table.lookup(7.0f, -3.0f, &c), Status::kOk);
+  ASSERT_EQ(table.lookup(7.0f, -3.0f, &c), RuntimeStatus::kOk);
   EXPECT_NEAR(c.norm, 4.0f, 1e-6f);
   EXPECT_NEAR(c.fresnel, 4.0f, 1e-6f);
 }
@@ -126,11 +126,11 @@ std::string writeContainer(const std::string& name, format::AssetKind kind, cons
                            const std::vector<uint8_t>& s1) {
   const std::string path = glintbake::testing::processTempDir() + name;
   format::Writer writer;
-  EXPECT_EQ(writer.open(path, kind), format::Status::kOk);
-  EXPECT_EQ(writer.addSection(format::kSectionLtcTable, 0, s0.data(), s0.size()), format::Status::kOk);
-  EXPECT_EQ(writer.addSection(format::kSectionLtcTable, 1, s1.data(), s1.size()), format::Status::kOk);
-  EXPECT_EQ(writer.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(writer.finish(), format::Status::kOk);
+  EXPECT_EQ(writer.open(path, kind), format::ContainerStatus::kOk);
+  EXPECT_EQ(writer.addSection(format::kSectionLtcTable, 0, s0.data(), s0.size()), format::ContainerStatus::kOk);
+  EXPECT_EQ(writer.addSection(format::kSectionLtcTable, 1, s1.data(), s1.size()), format::ContainerStatus::kOk);
+  EXPECT_EQ(writer.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(writer.finish(), format::ContainerStatus::kOk);
   return path;
 }
 
@@ -140,29 +140,29 @@ TEST(LtcTableRuntime, LoadsContainersAndRefusesMalformedOnes) {
   const std::string good =
       writeContainer("ltc_good.gbk", format::AssetKind::kLtcTable, imageSection(6, l1), imageSection(6, l2));
   LtcTable table;
-  ASSERT_EQ(table.open(good.c_str()), Status::kOk);
+  ASSERT_EQ(table.open(good.c_str()), RuntimeStatus::kOk);
   EXPECT_EQ(table.size(), 6);
   EXPECT_EQ(std::memcmp(table.ltc1(), l1.data(), l1.size() * sizeof(float)), 0);
 
   const std::string wrong_kind =
       writeContainer("ltc_kind.gbk", format::AssetKind::kTest, imageSection(6, l1), imageSection(6, l2));
-  EXPECT_EQ(LtcTable().open(wrong_kind.c_str()), Status::kWrongKind);
+  EXPECT_EQ(LtcTable().open(wrong_kind.c_str()), RuntimeStatus::kWrongKind);
 
   std::vector<float> l2_small;
   makeTable(5, &l1, &l2_small);
   const std::string mismatched =
       writeContainer("ltc_mismatch.gbk", format::AssetKind::kLtcTable, imageSection(6, l2), imageSection(5, l2_small));
-  EXPECT_EQ(LtcTable().open(mismatched.c_str()), Status::kInvalidAsset);
+  EXPECT_EQ(LtcTable().open(mismatched.c_str()), RuntimeStatus::kInvalidAsset);
 
   std::vector<float> bad = l2;
   bad[3] = NAN;
   const std::string nonfinite =
       writeContainer("ltc_nan.gbk", format::AssetKind::kLtcTable, imageSection(6, l2), imageSection(6, bad));
-  EXPECT_EQ(LtcTable().open(nonfinite.c_str()), Status::kInvalidAsset);
+  EXPECT_EQ(LtcTable().open(nonfinite.c_str()), RuntimeStatus::kInvalidAsset);
 
-  EXPECT_EQ(LtcTable().open((glintbake::testing::processTempDir() + "missing.gbk").c_str()), Status::kIoError);
+  EXPECT_EQ(LtcTable().open((glintbake::testing::processTempDir() + "missing.gbk").c_str()), RuntimeStatus::kIoError);
   const uint8_t garbage[64] = {1, 2, 3};
-  EXPECT_NE(LtcTable().openMemory(garbage, sizeof(garbage)), Status::kOk);
+  EXPECT_NE(LtcTable().openMemory(garbage, sizeof(garbage)), RuntimeStatus::kOk);
   for (const auto& path : {good, wrong_kind, mismatched, nonfinite}) std::remove(path.c_str());
 }
 

@@ -175,7 +175,7 @@ TEST(Mapgen, ScratchesTiltOnlyInsideGrooves) {
 TEST(Mapgen, ValidationNamesTheParameter) {
   MapParams p = params(64, 1);
   p.alpha = -0.1;
-  Status s = validateMapParams(MapKind::kBeckmann, p);
+  BakeStatus s = validateMapParams(MapKind::kBeckmann, p);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ErrorCode::kBadArgument);
   EXPECT_NE(s.error().message.find("alpha"), std::string::npos);

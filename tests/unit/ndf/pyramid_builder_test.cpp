@@ -28,13 +28,13 @@ std::vector<char> readAll(const std::string& path) {
   return std::vector<char>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
-Status buildTo(const NormalMap& map, const PyramidOptions& o, const std::string& path, PyramidReport* rep) {
+BakeStatus buildTo(const NormalMap& map, const PyramidOptions& o, const std::string& path, PyramidReport* rep) {
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
-  Status s = buildNdfPyramid(map, o, w, rep);
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
+  BakeStatus s = buildNdfPyramid(map, o, w, rep);
   if (!s) return s;
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return s;
 }
 
@@ -88,13 +88,13 @@ TEST(PyramidBuilder, WritesLevelsAndChunksThatMatchTheSplat) {
   EXPECT_EQ(rep.stop_reason, "levels");
 
   format::Reader r;
-  ASSERT_EQ(r.open(path), format::Status::kOk);
+  ASSERT_EQ(r.open(path), format::ContainerStatus::kOk);
   EXPECT_EQ(r.kind(), format::AssetKind::kNdfPyramid);
   for (int l = 0; l < 3; ++l) {
     const int idx = r.find(format::kSectionNdfLevel, uint64_t(l));
     ASSERT_GE(idx, 0);
     std::vector<uint8_t> bytes;
-    ASSERT_EQ(r.readSection(size_t(idx), &bytes), format::Status::kOk);
+    ASSERT_EQ(r.readSection(size_t(idx), &bytes), format::ContainerStatus::kOk);
     ASSERT_EQ(bytes.size(), sizeof(runtime::NdfLevelRecord));
     runtime::NdfLevelRecord rec;
     std::memcpy(&rec, bytes.data(), sizeof(rec));
@@ -108,7 +108,7 @@ TEST(PyramidBuilder, WritesLevelsAndChunksThatMatchTheSplat) {
   const int idx = r.find(format::kSectionNdfChunk, uint64_t(3));
   ASSERT_GE(idx, 0);
   std::vector<uint8_t> chunk;
-  ASSERT_EQ(r.readSection(size_t(idx), &chunk), format::Status::kOk);
+  ASSERT_EQ(r.readSection(size_t(idx), &chunk), format::ContainerStatus::kOk);
   format::ImageSectionHeader h;
   std::memcpy(&h, chunk.data(), sizeof(h));
   EXPECT_EQ(h.magic, format::ImageSectionHeader().magic);
@@ -160,9 +160,9 @@ TEST(PyramidBuilder, SplitFootprintsAreDeterministicAndMatchTheSplat) {
   two.execute([&] { ASSERT_TRUE(buildTo(map, o, p2, nullptr).ok()); });
   EXPECT_EQ(readAll(p1), readAll(p2));
   format::Reader r;
-  ASSERT_EQ(r.open(p1), format::Status::kOk);
+  ASSERT_EQ(r.open(p1), format::ContainerStatus::kOk);
   std::vector<uint8_t> chunk;
-  ASSERT_EQ(r.readSection(size_t(r.find(format::kSectionNdfChunk, 0)), &chunk), format::Status::kOk);
+  ASSERT_EQ(r.readSection(size_t(r.find(format::kSectionNdfChunk, 0)), &chunk), format::ContainerStatus::kOk);
   Result<FlakeSet> flakes = buildFlakes(map, 1);
   ASSERT_TRUE(flakes.ok());
   Splatter sp(flakes.value(), o.splat);

@@ -30,13 +30,13 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
   const std::string path = glintbake::testing::processTempDir() + "rt_ref_pyramid.gbk";
   {
     format::Writer w;
-    ASSERT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
+    ASSERT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
     ASSERT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
-    ASSERT_EQ(w.addMetadata("{}"), format::Status::kOk);
-    ASSERT_EQ(w.finish(), format::Status::kOk);
+    ASSERT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.finish(), format::ContainerStatus::kOk);
   }
   NdfPyramid pyr;
-  ASSERT_EQ(pyr.open(path.c_str()), Status::kOk);
+  ASSERT_EQ(pyr.open(path.c_str()), RuntimeStatus::kOk);
   ASSERT_EQ(pyr.levelCount(), 3);
   const int res = pyr.resolution();
   const reference::FlakeSet flakes = reference::buildFlakes(map, 1);
@@ -57,7 +57,7 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
   centre.x = l0->origin_x + 2 * l0->stride_x;
   centre.y = l0->origin_y + 1 * l0->stride_y;
   centre.sigma = l0->sigma_texels;
-  ASSERT_EQ(pyr.image(centre, img.data(), img.size()), Status::kOk);
+  ASSERT_EQ(pyr.image(centre, img.data(), img.size()), RuntimeStatus::kOk);
   const float* stored = pyr.centreImage(0, 2, 1);
   ASSERT_NE(stored, nullptr);
   EXPECT_EQ(0, std::memcmp(stored, img.data(), img.size() * 4));
@@ -103,7 +103,7 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
     f.x = c[0];
     f.y = c[1];
     f.sigma = c[2];
-    ASSERT_EQ(pyr.image(f, img.data(), img.size()), Status::kOk);
+    ASSERT_EQ(pyr.image(f, img.data(), img.size()), RuntimeStatus::kOk);
     rf.x = c[0];
     rf.y = c[1];
     rf.sigma = c[2];
@@ -118,7 +118,9 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
     std::printf("[ measured ] blend error at (%.2f, %.2f) sigma %.2f: relative L1 %.3f (trilinear %.3f)\n", c[0], c[1],
                 c[2], err, num / den);
     EXPECT_LT(err, 0.06);
-    if (&c != &cases[3]) EXPECT_LT(err, num / den);
+    if (&c != &cases[3]) {
+      EXPECT_LT(err, num / den);
+    }
   }
   std::remove(path.c_str());
 }

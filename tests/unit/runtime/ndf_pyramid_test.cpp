@@ -53,7 +53,7 @@ std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int regio
                                  const std::string& path = "") {
   const std::string file = path.empty() ? glintbake::testing::processTempDir() + "rt_pyramid.gbk" : path;
   format::Writer w;
-  EXPECT_EQ(w.open(file, format::AssetKind::kNdfPyramid, 1), format::Status::kOk);
+  EXPECT_EQ(w.open(file, format::AssetKind::kNdfPyramid, 1), format::ContainerStatus::kOk);
   for (size_t l = 0; l < levels.size(); ++l) {
     NdfLevelRecord rec;
     rec.level = uint32_t(l);
@@ -67,7 +67,7 @@ std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int regio
     rec.origin_x = rec.origin_y = 0.5 * rec.stride_x;
     rec.sigma_texels = levels[l].sigma;
     rec.sigma_r = 0.005;
-    EXPECT_EQ(w.addSection(format::kSectionNdfLevel, l, &rec, sizeof(rec)), format::Status::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionNdfLevel, l, &rec, sizeof(rec)), format::ContainerStatus::kOk);
     for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
       for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
         const int cw = std::min(region, levels[l].grid - int(rx) * region);
@@ -85,12 +85,12 @@ std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int regio
         }
         EXPECT_EQ(w.addSection(format::kSectionNdfChunk, (uint64_t(l) << 32) | (ry * rec.regions_x + rx), bytes.data(),
                                bytes.size()),
-                  format::Status::kOk);
+                  format::ContainerStatus::kOk);
       }
     }
   }
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   std::ifstream f(file, std::ios::binary);
   return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
@@ -101,7 +101,7 @@ class NdfPyramidTest : public ::testing::Test {
  protected:
   void SetUp() override {
     bytes_ = makePyramid(kLevels, 3);
-    ASSERT_EQ(pyr_.openMemory(bytes_.data(), bytes_.size()), Status::kOk);
+    ASSERT_EQ(pyr_.openMemory(bytes_.data(), bytes_.size()), RuntimeStatus::kOk);
   }
   std::vector<uint8_t> bytes_;
   NdfPyramid pyr_;
@@ -124,12 +124,12 @@ TEST_F(NdfPyramidTest, CentreQueriesReturnTheStoredImagesExactly) {
   for (int j = 0; j < kLevels[0].grid; ++j) {
     for (int i = 0; i < kLevels[0].grid; ++i) {
       const double x = rec->origin_x + i * rec->stride_x, y = rec->origin_y + j * rec->stride_y;
-      ASSERT_EQ(pyr_.image(fp(x, y, kLevels[0].sigma), out.data(), out.size()), Status::kOk);
+      ASSERT_EQ(pyr_.image(fp(x, y, kLevels[0].sigma), out.data(), out.size()), RuntimeStatus::kOk);
       EXPECT_EQ(out, testImage(0, i, j)) << "centre " << i << "," << j;
       // Point queries at bin centres too.
       double v = 0.0;
       ASSERT_EQ(pyr_.eval(fp(x, y, kLevels[0].sigma), SPoint{-1 + 9.5 * 2.0 / kRes, 1 - 6.5 * 2.0 / kRes}, &v),
-                Status::kOk);
+                RuntimeStatus::kOk);
       EXPECT_EQ(float(v), testImage(0, i, j)[6 * kRes + 9]);
     }
   }
@@ -169,14 +169,14 @@ TEST_F(NdfPyramidTest, GaussianBlendOfTheFinestSufficientLevel) {
   for (int j = 0; j < 8; ++j)
     for (int i = 0; i < 8; ++i) expected += wx[size_t(i)] * wy[size_t(j)] * double(testImage(0, i, j)[bin]);
   double v = 0.0;
-  ASSERT_EQ(pyr_.eval(fp(x, y, sigma), s, &v), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, sigma), s, &v), RuntimeStatus::kOk);
   EXPECT_NEAR(v, expected, 2e-3 * expected);
   // Below level 0 it is level 0; far above the top level of this repeating map it is the mean of
   // the top level's centres.
   double below = 0.0, at0 = 0.0, above = 0.0;
-  ASSERT_EQ(pyr_.eval(fp(x, y, 0.1), s, &below), Status::kOk);
-  ASSERT_EQ(pyr_.eval(fp(x, y, 2.0), s, &at0), Status::kOk);
-  ASSERT_EQ(pyr_.eval(fp(x, y, 1000.0), s, &above), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 0.1), s, &below), RuntimeStatus::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 2.0), s, &at0), RuntimeStatus::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x, y, 1000.0), s, &above), RuntimeStatus::kOk);
   EXPECT_EQ(below, at0);
   double mean = 0.0;
   for (int j = 0; j < 2; ++j)
@@ -185,10 +185,10 @@ TEST_F(NdfPyramidTest, GaussianBlendOfTheFinestSufficientLevel) {
   // Repeat wrap: a query one map period away is identical; the grid wraps between the last and
   // first centres.
   double shifted = 0.0;
-  ASSERT_EQ(pyr_.eval(fp(x + kMap, y - 2 * kMap, sigma), s, &shifted), Status::kOk);
+  ASSERT_EQ(pyr_.eval(fp(x + kMap, y - 2 * kMap, sigma), s, &shifted), RuntimeStatus::kOk);
   EXPECT_NEAR(shifted, v, 1e-12 * v);
   double seam = 0.0;
-  ASSERT_EQ(pyr_.eval(fp(kMap, 4.0, 2.0), s, &seam), Status::kOk);  // midway between centres 7 and 0
+  ASSERT_EQ(pyr_.eval(fp(kMap, 4.0, 2.0), s, &seam), RuntimeStatus::kOk);  // midway between centres 7 and 0
   EXPECT_NEAR(seam, 0.5 * (at(0, 7, 0) + at(0, 0, 0)), 1e-6 * seam);
 }
 
@@ -200,7 +200,7 @@ TEST_F(NdfPyramidTest, BlendIsContinuousInSigma) {
     double prev = -1.0, worst = 0.0;
     for (double sigma = 2.0; sigma < 40.0; sigma *= ratio) {
       double v = 0.0;
-      EXPECT_EQ(pyr_.eval(fp(21.0, 43.0, sigma), s, &v), Status::kOk);
+      EXPECT_EQ(pyr_.eval(fp(21.0, 43.0, sigma), s, &v), RuntimeStatus::kOk);
       if (prev > 0.0) worst = std::max(worst, std::fabs(v - prev) / prev);
       prev = v;
     }
@@ -225,11 +225,11 @@ TEST_F(NdfPyramidTest, RepeatBlendOfFarAndSeamPositionsMatchesTheReducedPosition
       if (reduced < 0.0) reduced += kMap;
       if (reduced >= kMap) reduced -= kMap;
       double v = 0.0, expect = 0.0;
-      ASSERT_EQ(pyr_.eval(fp(x, 20.0, sigma), s, &v), Status::kOk);
-      ASSERT_EQ(pyr_.eval(fp(reduced, 20.0, sigma), s, &expect), Status::kOk);
+      ASSERT_EQ(pyr_.eval(fp(x, 20.0, sigma), s, &v), RuntimeStatus::kOk);
+      ASSERT_EQ(pyr_.eval(fp(reduced, 20.0, sigma), s, &expect), RuntimeStatus::kOk);
       EXPECT_NEAR(v, expect, 1e-6 * expect) << "x " << x << " sigma " << sigma;
-      ASSERT_EQ(pyr_.eval(fp(20.0, x, sigma), s, &v), Status::kOk);
-      ASSERT_EQ(pyr_.eval(fp(20.0, reduced, sigma), s, &expect), Status::kOk);
+      ASSERT_EQ(pyr_.eval(fp(20.0, x, sigma), s, &v), RuntimeStatus::kOk);
+      ASSERT_EQ(pyr_.eval(fp(20.0, reduced, sigma), s, &expect), RuntimeStatus::kOk);
       EXPECT_NEAR(v, expect, 1e-6 * expect) << "y " << x << " sigma " << sigma;
     }
   }
@@ -238,7 +238,7 @@ TEST_F(NdfPyramidTest, RepeatBlendOfFarAndSeamPositionsMatchesTheReducedPosition
 TEST_F(NdfPyramidTest, RangeAveragesAreExactForPiecewiseConstantImages) {
   const Footprint f = fp(20.0, 33.0, 3.0);
   std::vector<float> img(kRes * kRes);
-  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), Status::kOk);
+  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), RuntimeStatus::kOk);
   const double h = 2.0 / kRes;
   // Bin-aligned rectangle: mean of its bins.
   SRect r;
@@ -251,24 +251,24 @@ TEST_F(NdfPyramidTest, RangeAveragesAreExactForPiecewiseConstantImages) {
     for (int i = 3; i < 7; ++i) expect += img[size_t(j) * kRes + i];
   expect /= 12.0;
   double v = 0.0;
-  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  ASSERT_EQ(pyr_.average(f, r, &v), RuntimeStatus::kOk);
   EXPECT_NEAR(v, expect, 1e-6 * expect);
   // Inside one bin: the bin value. Whole plane: mass / 4.
   r.x0 = -1 + 3.2 * h;
   r.x1 = -1 + 3.7 * h;
   r.y0 = 1 - 2.9 * h;
   r.y1 = 1 - 2.1 * h;
-  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  ASSERT_EQ(pyr_.average(f, r, &v), RuntimeStatus::kOk);
   EXPECT_NEAR(v, img[2 * kRes + 3], 1e-6 * v);
   double m = 0.0;
-  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  ASSERT_EQ(pyr_.mass(f, &m), RuntimeStatus::kOk);
   EXPECT_NEAR(m, 1.0, 1e-5);
   r = SRect();
   r.x0 = -2;
   r.x1 = 2;
   r.y0 = -2;
   r.y1 = 2;
-  ASSERT_EQ(pyr_.average(f, r, &v), Status::kOk);
+  ASSERT_EQ(pyr_.average(f, r, &v), RuntimeStatus::kOk);
   EXPECT_NEAR(v, m / 16.0, 1e-6);
 }
 
@@ -277,29 +277,29 @@ TEST_F(NdfPyramidTest, SamplePdfEqualsPdfAndEval) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const Footprint f = fp(37.0, 11.0, 5.0);
   double m = 0.0;
-  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  ASSERT_EQ(pyr_.mass(f, &m), RuntimeStatus::kOk);
   for (int k = 0; k < 2000; ++k) {
     NdfSample smp;
-    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), Status::kOk);
+    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), RuntimeStatus::kOk);
     double p = 0.0, e = 0.0;
-    ASSERT_EQ(pyr_.pdf(f, smp.s, &p), Status::kOk);
-    ASSERT_EQ(pyr_.eval(f, smp.s, &e), Status::kOk);
+    ASSERT_EQ(pyr_.pdf(f, smp.s, &p), RuntimeStatus::kOk);
+    ASSERT_EQ(pyr_.eval(f, smp.s, &e), RuntimeStatus::kOk);
     ASSERT_GT(smp.pdf, 0.0);
     EXPECT_DOUBLE_EQ(smp.pdf, p);
     EXPECT_NEAR(p, e / m, 1e-12 * p);
   }
   NdfSample smp;
-  EXPECT_EQ(pyr_.sample(f, 1.0, 0.5, &smp), Status::kInvalidArgument);
-  EXPECT_EQ(pyr_.sample(f, std::nan(""), 0.5, &smp), Status::kInvalidArgument);
+  EXPECT_EQ(pyr_.sample(f, 1.0, 0.5, &smp), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(pyr_.sample(f, std::nan(""), 0.5, &smp), RuntimeStatus::kInvalidArgument);
 }
 
 TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {
   // Histogram of samples over the bins against the blended image's bin masses.
   const Footprint f = fp(29.0, 45.0, 3.3);
   std::vector<float> img(kRes * kRes);
-  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), Status::kOk);
+  ASSERT_EQ(pyr_.image(f, img.data(), img.size()), RuntimeStatus::kOk);
   double m = 0.0;
-  ASSERT_EQ(pyr_.mass(f, &m), Status::kOk);
+  ASSERT_EQ(pyr_.mass(f, &m), RuntimeStatus::kOk);
   const int n = 200000;
   std::vector<double> counts(kRes * kRes, 0.0);
   std::mt19937_64 rng(11);
@@ -307,7 +307,7 @@ TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {
   const double h = 2.0 / kRes;
   for (int k = 0; k < n; ++k) {
     NdfSample smp;
-    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), Status::kOk);
+    ASSERT_EQ(pyr_.sample(f, u(rng), u(rng), &smp), RuntimeStatus::kOk);
     const int i = std::min(kRes - 1, int((smp.s.x + 1) / h)), j = std::min(kRes - 1, int((1 - smp.s.y) / h));
     counts[size_t(j) * kRes + i] += 1.0;
   }
@@ -331,9 +331,9 @@ TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {
 TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {
   const std::vector<uint8_t> bytes = makePyramid({{4, 4.0}}, 2, 1);
   NdfPyramid p;
-  ASSERT_EQ(p.openMemory(bytes.data(), bytes.size()), Status::kOk);
+  ASSERT_EQ(p.openMemory(bytes.data(), bytes.size()), RuntimeStatus::kOk);
   std::vector<float> a(kRes * kRes);
-  ASSERT_EQ(p.image(fp(-30.0, 200.0, 4.0), a.data(), a.size()), Status::kOk);
+  ASSERT_EQ(p.image(fp(-30.0, 200.0, 4.0), a.data(), a.size()), RuntimeStatus::kOk);
   EXPECT_EQ(a, testImage(0, 0, 3));
 }
 
@@ -347,11 +347,11 @@ TEST(NdfPyramidC, CApiMatchesTheClass) {
   EXPECT_EQ(res, kRes);
   EXPECT_EQ(kind, GB_KIND_NDF_PYRAMID);
   NdfPyramid cls;
-  ASSERT_EQ(cls.open(path.c_str()), Status::kOk);
+  ASSERT_EQ(cls.open(path.c_str()), RuntimeStatus::kOk);
   EXPECT_EQ(cls.levelCount(), 3);
   double a = 0.0, b = 0.0, sx = 0.0, sy = 0.0, pdf = 0.0, pdf2 = 0.0;
   ASSERT_EQ(gb_ndf_asset_eval(p, 13.0, 50.0, 3.0, 0.1, -0.2, &a), GB_OK);
-  ASSERT_EQ(cls.eval(fp(13.0, 50.0, 3.0), SPoint{0.1, -0.2}, &b), Status::kOk);
+  ASSERT_EQ(cls.eval(fp(13.0, 50.0, 3.0), SPoint{0.1, -0.2}, &b), RuntimeStatus::kOk);
   EXPECT_EQ(a, b);
   ASSERT_EQ(gb_ndf_asset_sample(p, 13.0, 50.0, 3.0, 0.3, 0.6, &sx, &sy, &pdf), GB_OK);
   ASSERT_EQ(gb_ndf_asset_pdf(p, 13.0, 50.0, 3.0, sx, sy, &pdf2), GB_OK);
@@ -365,7 +365,7 @@ TEST(NdfPyramidC, CApiMatchesTheClass) {
   gb_ndf_asset* bad = nullptr;
   EXPECT_EQ(gb_ndf_asset_open("/nonexistent/none.gbk", &bad), GB_IO_ERROR);
   EXPECT_EQ(bad, nullptr);
-  EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(Status::kWrongKind));
+  EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(RuntimeStatus::kWrongKind));
   std::remove(path.c_str());
 }
 
@@ -374,7 +374,7 @@ TEST(NdfPyramidInvalid, MalformedAssetsAreRejected) {
   NdfPyramid p;
   // Every truncation fails cleanly.
   for (size_t cut : {size_t(0), size_t(10), good.size() / 2, good.size() - 1}) {
-    EXPECT_NE(p.openMemory(good.data(), cut), Status::kOk) << cut;
+    EXPECT_NE(p.openMemory(good.data(), cut), RuntimeStatus::kOk) << cut;
     EXPECT_FALSE(p.isOpen());
   }
   // Single flipped bytes anywhere: either rejected or (if the byte is unused) a valid pyramid.
@@ -382,30 +382,30 @@ TEST(NdfPyramidInvalid, MalformedAssetsAreRejected) {
   for (int k = 0; k < 200; ++k) {
     std::vector<uint8_t> bad = good;
     bad[rng() % bad.size()] ^= uint8_t(1 + rng() % 255);
-    const Status s = p.openMemory(bad.data(), bad.size());
-    if (s == Status::kOk) {
+    const RuntimeStatus s = p.openMemory(bad.data(), bad.size());
+    if (s == RuntimeStatus::kOk) {
       double v = 0.0;
-      EXPECT_EQ(p.eval(fp(1, 2, 3), SPoint{0, 0}, &v), Status::kOk);
+      EXPECT_EQ(p.eval(fp(1, 2, 3), SPoint{0, 0}, &v), RuntimeStatus::kOk);
     }
   }
   // Wrong asset kind.
   const std::string path = glintbake::testing::processTempDir() + "rt_wrong_kind.gbk";
   {
     format::Writer w;
-    ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::Status::kOk);
-    ASSERT_EQ(w.addMetadata("{}"), format::Status::kOk);
-    ASSERT_EQ(w.finish(), format::Status::kOk);
+    ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.finish(), format::ContainerStatus::kOk);
   }
-  EXPECT_EQ(p.open(path.c_str()), Status::kWrongKind);
+  EXPECT_EQ(p.open(path.c_str()), RuntimeStatus::kWrongKind);
   std::remove(path.c_str());
   // Queries on a closed pyramid and bad arguments.
   double v = 0.0;
-  EXPECT_EQ(p.eval(fp(0, 0, 1), SPoint{0, 0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(p.eval(fp(0, 0, 1), SPoint{0, 0}, &v), RuntimeStatus::kInvalidArgument);
   NdfPyramid ok;
-  ASSERT_EQ(ok.openMemory(good.data(), good.size()), Status::kOk);
-  EXPECT_EQ(ok.eval(fp(std::nan(""), 0, 1), SPoint{0, 0}, &v), Status::kInvalidArgument);
-  EXPECT_EQ(ok.eval(fp(0, 0, -1), SPoint{0, 0}, &v), Status::kInvalidArgument);
-  ASSERT_EQ(ok.eval(fp(0, 0, 1), SPoint{3, 0}, &v), Status::kOk);
+  ASSERT_EQ(ok.openMemory(good.data(), good.size()), RuntimeStatus::kOk);
+  EXPECT_EQ(ok.eval(fp(std::nan(""), 0, 1), SPoint{0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(ok.eval(fp(0, 0, -1), SPoint{0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  ASSERT_EQ(ok.eval(fp(0, 0, 1), SPoint{3, 0}, &v), RuntimeStatus::kOk);
   EXPECT_EQ(v, 0.0);
 }
 

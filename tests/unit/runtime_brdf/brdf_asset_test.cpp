@@ -40,12 +40,12 @@ std::unique_ptr<NdfSource> bakePyramid(bake::MapKind kind, double alpha, int ndf
   o.levels = 2;
   const std::string path = glintbake::testing::processTempDir() + "" + name + ".gbk";
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   std::unique_ptr<NdfSource> source;
-  EXPECT_EQ(openNdfAsset(path.c_str(), &source), Status::kOk);
+  EXPECT_EQ(openNdfAsset(path.c_str(), &source), RuntimeStatus::kOk);
   return source;
 }
 
@@ -90,7 +90,7 @@ TEST(BrdfAsset, WhiteFurnaceOfFlatMapAsset) {
   fp.y = 7.5;
   fp.sigma = 5.0;
   double mass = 0.0;
-  ASSERT_EQ(source->mass(fp, &mass), Status::kOk);
+  ASSERT_EQ(source->mass(fp, &mass), RuntimeStatus::kOk);
   EXPECT_NEAR(mass, 1.0, 1e-3);
   const MicrofacetBrdf brdf = MicrofacetBrdf::glinty(source.get(), fp, MicrofacetModel::kGgx, 1e-3, Fresnel{});
   for (double theta_o : {0.0, 0.5, 1.0}) {
@@ -100,7 +100,7 @@ TEST(BrdfAsset, WhiteFurnaceOfFlatMapAsset) {
     for (int a = 0; a < n; ++a) {
       for (int b = 0; b < n; ++b) {
         BrdfSample s;
-        ASSERT_EQ(brdf.sample(wo, (a + 0.5) / n, (b + 0.5) / n, &s), Status::kOk);
+        ASSERT_EQ(brdf.sample(wo, (a + 0.5) / n, (b + 0.5) / n, &s), RuntimeStatus::kOk);
         albedo += s.weight.r;
       }
     }
@@ -123,18 +123,18 @@ TEST(BrdfAsset, ReciprocityAndSamplingOfARoughMapAsset) {
     const Vec3 wi = sphericalDirection(rng.next(), 2.0 * kPi * rng.next());
     const Vec3 wo = sphericalDirection(rng.next(), 2.0 * kPi * rng.next());
     Rgb a, b;
-    ASSERT_EQ(brdf.eval(wi, wo, &a), Status::kOk);
-    ASSERT_EQ(brdf.eval(wo, wi, &b), Status::kOk);
+    ASSERT_EQ(brdf.eval(wi, wo, &a), RuntimeStatus::kOk);
+    ASSERT_EQ(brdf.eval(wo, wi, &b), RuntimeStatus::kOk);
     EXPECT_NEAR(a.g, b.g, 1e-12 * std::fmax(1.0, a.g));
   }
   const Vec3 wo = normalize(Vec3{0.3, -0.2, 0.9});
   int checked = 0;
   auto sample = [&](double u1, double u2, Vec3* w) {
     BrdfSample s;
-    EXPECT_EQ(brdf.sample(wo, u1, u2, &s), Status::kOk);
+    EXPECT_EQ(brdf.sample(wo, u1, u2, &s), RuntimeStatus::kOk);
     if (!(s.pdf > 0.0)) return false;
     double p = 0.0;
-    EXPECT_EQ(brdf.pdf(s.wi, wo, &p), Status::kOk);
+    EXPECT_EQ(brdf.pdf(s.wi, wo, &p), RuntimeStatus::kOk);
     if (checked++ < 2000) {
       EXPECT_NEAR(p, s.pdf, 1e-9 * s.pdf);
     }
@@ -156,14 +156,14 @@ TEST(BrdfAsset, ReciprocityAndSamplingOfARoughMapAsset) {
   sg.axis = normalize(Vec3{-0.2, 0.25, 0.95});
   sg.sharpness = 400.0;
   Rgb pre;
-  ASSERT_EQ(prefilteredSgShading(brdf, sg, 1e-4, wo, &pre), Status::kOk);
+  ASSERT_EQ(prefilteredSgShading(brdf, sg, 1e-4, wo, &pre), RuntimeStatus::kOk);
   double mc = 0.0;
   const int n = 50000;
   for (int i = 0; i < n; ++i) {
     double p = 0.0;
     const Vec3 wi = sampleSg(sg, rng.next(), rng.next(), &p);
     Rgb f;
-    ASSERT_EQ(brdf.eval(wi, wo, &f), Status::kOk);
+    ASSERT_EQ(brdf.eval(wi, wo, &f), RuntimeStatus::kOk);
     mc += f.r * evalSg(sg, wi).r * std::fmax(0.0, wi.z) / p;
   }
   mc /= n;

@@ -78,7 +78,7 @@ TEST_P(ModelTest, AlbedoBoundedAndNearOneWhenSmooth) {
     for (int a = 0; a < n; ++a) {
       for (int b = 0; b < n; ++b) {
         BrdfSample s;
-        ASSERT_EQ(brdf.sample(wo, (a + 0.5) / n, (b + 0.5) / n, &s), Status::kOk);
+        ASSERT_EQ(brdf.sample(wo, (a + 0.5) / n, (b + 0.5) / n, &s), RuntimeStatus::kOk);
         albedo += s.weight.g;
       }
     }
@@ -101,8 +101,8 @@ TEST_P(ModelTest, EvalIsReciprocal) {
     const Vec3 wi = sphericalDirection(rng.next(), 2.0 * kPi * rng.next());
     const Vec3 wo = sphericalDirection(rng.next(), 2.0 * kPi * rng.next());
     Rgb a, b;
-    ASSERT_EQ(brdf.eval(wi, wo, &a), Status::kOk);
-    ASSERT_EQ(brdf.eval(wo, wi, &b), Status::kOk);
+    ASSERT_EQ(brdf.eval(wi, wo, &a), RuntimeStatus::kOk);
+    ASSERT_EQ(brdf.eval(wo, wi, &b), RuntimeStatus::kOk);
     EXPECT_NEAR(a.r, b.r, 1e-12 * std::fmax(1.0, a.r));
     EXPECT_NEAR(a.b, b.b, 1e-12 * std::fmax(1.0, a.b));
   }
@@ -118,10 +118,10 @@ TEST_P(ModelTest, SamplePdfMatchesPdfAndChiSquarePasses) {
     int checked = 0;
     auto sample = [&](double u1, double u2, Vec3* w) {
       BrdfSample s;
-      EXPECT_EQ(brdf.sample(wo, u1, u2, &s), Status::kOk);
+      EXPECT_EQ(brdf.sample(wo, u1, u2, &s), RuntimeStatus::kOk);
       if (!(s.pdf > 0.0)) return false;
       double p = 0.0;
-      EXPECT_EQ(brdf.pdf(s.wi, wo, &p), Status::kOk);
+      EXPECT_EQ(brdf.pdf(s.wi, wo, &p), RuntimeStatus::kOk);
       if (checked++ < 2000) {
         EXPECT_NEAR(p, s.pdf, 1e-9 * s.pdf);
       }
@@ -160,15 +160,15 @@ TEST(Fresnel, LimitsAndSchlick) {
 TEST(Brdf, BelowHorizonAndInvalidInput) {
   const MicrofacetBrdf brdf = MicrofacetBrdf::smooth(MicrofacetModel::kGgx, 0.3, Fresnel{});
   Rgb f{1, 1, 1};
-  ASSERT_EQ(brdf.eval(Vec3{0, 0, -1}, Vec3{0, 0, 1}, &f), Status::kOk);
+  ASSERT_EQ(brdf.eval(Vec3{0, 0, -1}, Vec3{0, 0, 1}, &f), RuntimeStatus::kOk);
   EXPECT_EQ(f.r, 0.0);
-  EXPECT_EQ(brdf.eval(Vec3{NAN, 0, 1}, Vec3{0, 0, 1}, &f), Status::kInvalidArgument);
+  EXPECT_EQ(brdf.eval(Vec3{NAN, 0, 1}, Vec3{0, 0, 1}, &f), RuntimeStatus::kInvalidArgument);
   double p = -1.0;
-  ASSERT_EQ(brdf.pdf(Vec3{0, 0, 1}, Vec3{0, 0, -1}, &p), Status::kOk);
+  ASSERT_EQ(brdf.pdf(Vec3{0, 0, 1}, Vec3{0, 0, -1}, &p), RuntimeStatus::kOk);
   EXPECT_EQ(p, 0.0);
   // A glinty BRDF without a source refuses to answer rather than crash.
   const MicrofacetBrdf broken = MicrofacetBrdf::glinty(nullptr, Footprint{}, MicrofacetModel::kGgx, 0.3, Fresnel{});
-  EXPECT_EQ(broken.eval(Vec3{0, 0, 1}, Vec3{0, 0, 1}, &f), Status::kInvalidArgument);
+  EXPECT_EQ(broken.eval(Vec3{0, 0, 1}, Vec3{0, 0, 1}, &f), RuntimeStatus::kInvalidArgument);
 }
 
 // The C API answers exactly like the C++ classes it wraps and refuses bad parameters.
@@ -189,17 +189,17 @@ TEST(BrdfCApi, MatchesCppAndValidates) {
   double f[3], pdf_c = 0.0;
   ASSERT_EQ(gb_brdf_eval(&p, wi, wo, f), 0);
   Rgb expected;
-  ASSERT_EQ(brdf.eval(Vec3{wi[0], wi[1], wi[2]}, Vec3{wo[0], wo[1], wo[2]}, &expected), Status::kOk);
+  ASSERT_EQ(brdf.eval(Vec3{wi[0], wi[1], wi[2]}, Vec3{wo[0], wo[1], wo[2]}, &expected), RuntimeStatus::kOk);
   EXPECT_EQ(f[0], expected.r);
   EXPECT_EQ(f[2], expected.b);
   ASSERT_EQ(gb_brdf_pdf(&p, wi, wo, &pdf_c), 0);
   double pdf_cpp = 0.0;
-  ASSERT_EQ(brdf.pdf(Vec3{wi[0], wi[1], wi[2]}, Vec3{wo[0], wo[1], wo[2]}, &pdf_cpp), Status::kOk);
+  ASSERT_EQ(brdf.pdf(Vec3{wi[0], wi[1], wi[2]}, Vec3{wo[0], wo[1], wo[2]}, &pdf_cpp), RuntimeStatus::kOk);
   EXPECT_EQ(pdf_c, pdf_cpp);
   double wi_s[3], pdf_s = 0.0, weight[3];
   ASSERT_EQ(gb_brdf_sample(&p, wo, 0.3, 0.7, wi_s, &pdf_s, weight), 0);
   BrdfSample s;
-  ASSERT_EQ(brdf.sample(Vec3{wo[0], wo[1], wo[2]}, 0.3, 0.7, &s), Status::kOk);
+  ASSERT_EQ(brdf.sample(Vec3{wo[0], wo[1], wo[2]}, 0.3, 0.7, &s), RuntimeStatus::kOk);
   EXPECT_EQ(pdf_s, s.pdf);
   EXPECT_EQ(wi_s[2], s.wi.z);
 

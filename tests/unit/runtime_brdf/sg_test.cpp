@@ -73,7 +73,7 @@ TEST(Sg, HalfVectorRectangleBoundsTheSupport) {
     const double eps = 1e-3;
     SRect rect;
     bool has = false;
-    ASSERT_EQ(sgHalfVectorRect(sg, eps, wo, &rect, &has), Status::kOk);
+    ASSERT_EQ(sgHalfVectorRect(sg, eps, wo, &rect, &has), RuntimeStatus::kOk);
     ASSERT_TRUE(has);
     const double c = sgSupport(sg, eps).cos_theta_max;
     double x0 = 2, x1 = -2, y0 = 2, y1 = -2;
@@ -135,7 +135,7 @@ TEST(Sg, PrefilteredShadingMatchesMonteCarloForSharpLights) {
   const SphericalGaussian sg = makeSg(Vec3{0.3, 0.2, 0.9}, 800.0, 1.0);
   const Vec3 wo = normalize(Vec3{-0.4, 0.1, 0.9});
   Rgb pre;
-  ASSERT_EQ(prefilteredSgShading(brdf, sg, 1e-4, wo, &pre), Status::kOk);
+  ASSERT_EQ(prefilteredSgShading(brdf, sg, 1e-4, wo, &pre), RuntimeStatus::kOk);
   Rng rng(9);
   double mc = 0.0;
   const int n = 100000;
@@ -143,7 +143,7 @@ TEST(Sg, PrefilteredShadingMatchesMonteCarloForSharpLights) {
     double pdf = 0.0;
     const Vec3 wi = sampleSg(sg, rng.next(), rng.next(), &pdf);
     Rgb f;
-    ASSERT_EQ(brdf.eval(wi, wo, &f), Status::kOk);
+    ASSERT_EQ(brdf.eval(wi, wo, &f), RuntimeStatus::kOk);
     mc += f.r * evalSg(sg, wi).r * std::fmax(0.0, wi.z) / pdf;
   }
   mc /= n;
@@ -151,10 +151,10 @@ TEST(Sg, PrefilteredShadingMatchesMonteCarloForSharpLights) {
   EXPECT_NEAR(pre.r, mc, 0.05 * mc);
   // Light below the horizon: nothing.
   Rgb none;
-  ASSERT_EQ(prefilteredSgShading(brdf, makeSg(Vec3{0, 0.2, -1}, 800.0, 1.0), 1e-4, wo, &none), Status::kOk);
+  ASSERT_EQ(prefilteredSgShading(brdf, makeSg(Vec3{0, 0.2, -1}, 800.0, 1.0), 1e-4, wo, &none), RuntimeStatus::kOk);
   EXPECT_EQ(none.g, 0.0);
   // Invalid input.
-  EXPECT_EQ(prefilteredSgShading(brdf, sg, 0.0, wo, &none), Status::kInvalidArgument);
+  EXPECT_EQ(prefilteredSgShading(brdf, sg, 0.0, wo, &none), RuntimeStatus::kInvalidArgument);
 }
 
 }  // namespace

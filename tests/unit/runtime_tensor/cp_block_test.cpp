@@ -32,7 +32,7 @@ TEST(CpBlock, PointValueIsTheBlendOfRankRProducts) {
   auto g0 = makeGroup(1, false), g1 = makeGroup(2, false, 12);
   const CpBlendTerm terms[3] = {{&g0->view, 5, 0.5f}, {&g0->view, 9, 0.25f}, {&g1->view, 2, 0.25f}};
   CpMix mix;
-  ASSERT_EQ(mix.init(terms, 3), Status::kOk);
+  ASSERT_EQ(mix.init(terms, 3), RuntimeStatus::kOk);
   for (int j = 0; j < 32; j += 3) {
     for (int i = 0; i < 32; i += 2) {
       const double expected = directValue(terms, 3, i, j);
@@ -141,19 +141,19 @@ TEST(CpBlock, RejectsInvalidBlends) {
   auto g0 = makeGroup(13, false, 8, 16);
   CpMix mix;
   const CpBlendTerm bad_block[1] = {{&g0->view, 16, 1.0f}};
-  EXPECT_EQ(mix.init(bad_block, 1), Status::kInvalidArgument);
+  EXPECT_EQ(mix.init(bad_block, 1), RuntimeStatus::kInvalidArgument);
   EXPECT_TRUE(mix.empty());
   EXPECT_EQ(mix.value(0, 0), 0.0f);
   const CpBlendTerm nan_weight[1] = {{&g0->view, 0, std::nanf("")}};
-  EXPECT_EQ(mix.init(nan_weight, 1), Status::kInvalidArgument);
+  EXPECT_EQ(mix.init(nan_weight, 1), RuntimeStatus::kInvalidArgument);
   CpGroupView broken = g0->view;
   broken.rank = kCpMaxRank + 1;
   const CpBlendTerm bad_view[1] = {{&broken, 0, 1.0f}};
-  EXPECT_EQ(mix.init(bad_view, 1), Status::kInvalidArgument);
+  EXPECT_EQ(mix.init(bad_view, 1), RuntimeStatus::kInvalidArgument);
   CpBlendTerm many[kCpMaxBlend + 1];
   for (auto& t : many) t = {&g0->view, 0, 0.1f};
-  EXPECT_EQ(mix.init(many, kCpMaxBlend + 1), Status::kInvalidArgument);
-  EXPECT_EQ(mix.init(many, 0), Status::kOk);
+  EXPECT_EQ(mix.init(many, kCpMaxBlend + 1), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(mix.init(many, 0), RuntimeStatus::kOk);
   CpBlockSample s;
   EXPECT_FALSE(mix.sample(0.5, 0.5, &s));
   EXPECT_EQ(mix.pdf(0, 0), 0.0);

@@ -44,7 +44,7 @@ inline CpMix makeBlend(const OwnedGroup& g0, const OwnedGroup& g1, int first_blo
     terms[t] = CpBlendTerm{&g.view, (first_block + 5 * t) % g.view.blocks, w[t]};
   }
   CpMix mix;
-  if (mix.init(terms, 8) != Status::kOk) return CpMix{};
+  if (mix.init(terms, 8) != RuntimeStatus::kOk) return CpMix{};
   return mix;
 }
 

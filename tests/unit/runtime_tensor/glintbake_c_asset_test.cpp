@@ -16,7 +16,7 @@ TEST(GlintbakeCAsset, TensorAndPyramidThroughOneHandle) {
   const TensorNdf& t = assets().nonneg;
   const std::string pyramid_path = writeReconstructedPyramid(t, "capi");
   NdfPyramid pyramid;
-  ASSERT_EQ(pyramid.open(pyramid_path.c_str()), Status::kOk);
+  ASSERT_EQ(pyramid.open(pyramid_path.c_str()), RuntimeStatus::kOk);
 
   gb_ndf_asset* ta = nullptr;
   gb_ndf_asset* pa = nullptr;
@@ -52,7 +52,7 @@ TEST(GlintbakeCAsset, TensorAndPyramidThroughOneHandle) {
     fp.sigma = 9.0;
     double a = -1.0, b = -2.0;
     ASSERT_EQ(gb_ndf_asset_eval(handles[k], fp.x, fp.y, fp.sigma, 0.03, -0.05, &a), GB_OK);
-    ASSERT_EQ(sources[k]->eval(fp, SPoint{0.03, -0.05}, &b), Status::kOk);
+    ASSERT_EQ(sources[k]->eval(fp, SPoint{0.03, -0.05}, &b), RuntimeStatus::kOk);
     EXPECT_EQ(a, b);
     ASSERT_EQ(gb_ndf_asset_average(handles[k], fp.x, fp.y, fp.sigma, -0.2, -0.1, 0.3, 0.25, &a), GB_OK);
     SRect r;
@@ -60,7 +60,7 @@ TEST(GlintbakeCAsset, TensorAndPyramidThroughOneHandle) {
     r.y0 = -0.1;
     r.x1 = 0.3;
     r.y1 = 0.25;
-    ASSERT_EQ(sources[k]->average(fp, r, &b), Status::kOk);
+    ASSERT_EQ(sources[k]->average(fp, r, &b), RuntimeStatus::kOk);
     EXPECT_EQ(a, b);
     ASSERT_EQ(gb_ndf_asset_mass(handles[k], fp.x, fp.y, fp.sigma, &a), GB_OK);
     // The weighted mean of the blended centres' masses (rank-16 models of a 64^2 map: 1 to 3%).
@@ -92,16 +92,16 @@ TEST(GlintbakeCAsset, Errors) {
   const std::string path = tempPath("other-kind.gbk");
   {
     format::Writer w;
-    ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::Status::kOk);
-    ASSERT_EQ(w.addMetadata("{}"), format::Status::kOk);
-    ASSERT_EQ(w.finish(), format::Status::kOk);
+    ASSERT_EQ(w.open(path, format::AssetKind::kLtcTable, 1), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.finish(), format::ContainerStatus::kOk);
   }
   EXPECT_EQ(gb_ndf_asset_open(path.c_str(), &a), GB_WRONG_KIND);
   std::remove(path.c_str());
   double v = 0.0;
   EXPECT_EQ(gb_ndf_asset_eval(nullptr, 0, 0, 1, 0, 0, &v), GB_INVALID_ARGUMENT);
   EXPECT_EQ(gb_ndf_asset_info(nullptr, nullptr, nullptr), GB_INVALID_ARGUMENT);
-  EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(Status::kWrongKind));
+  EXPECT_STREQ(gb_status_string(GB_WRONG_KIND), statusString(RuntimeStatus::kWrongKind));
 }
 
 }  // namespace

@@ -62,11 +62,12 @@ inline std::vector<uint8_t> packAsset(const bake::NormalMap& map, bool nonneg, i
   o.precision = precision;
   const std::string path = tempPath(name + ".gbk");
   format::Writer w;
-  if (w.open(path, format::AssetKind::kTensorNdf, 1) != format::Status::kOk) return {};
+  if (w.open(path, format::AssetKind::kTensorNdf, 1) != format::ContainerStatus::kOk) return {};
   bake::tensor::TensorPackReport report;
-  const bake::Status s = bake::tensor::packTensorNdfFromMap(map, pyramid, o, w, &report);
+  const bake::BakeStatus s = bake::tensor::packTensorNdfFromMap(map, pyramid, o, w, &report);
   EXPECT_TRUE(s.ok());
-  if (!s.ok() || w.addMetadata("{}") != format::Status::kOk || w.finish() != format::Status::kOk) return {};
+  if (!s.ok() || w.addMetadata("{}") != format::ContainerStatus::kOk || w.finish() != format::ContainerStatus::kOk)
+    return {};
   std::vector<uint8_t> bytes = readFile(path);
   std::remove(path.c_str());
   return bytes;
@@ -84,8 +85,8 @@ inline const Assets& assets() {
     const bake::NormalMap map = tinyMap();
     x->nonneg_bytes = packAsset(map, true, 16, "nonneg");
     x->signed_bytes = packAsset(map, false, 16, "signed");
-    EXPECT_EQ(x->nonneg.openMemory(x->nonneg_bytes.data(), x->nonneg_bytes.size()), Status::kOk);
-    EXPECT_EQ(x->plain.openMemory(x->signed_bytes.data(), x->signed_bytes.size()), Status::kOk);
+    EXPECT_EQ(x->nonneg.openMemory(x->nonneg_bytes.data(), x->nonneg_bytes.size()), RuntimeStatus::kOk);
+    EXPECT_EQ(x->plain.openMemory(x->signed_bytes.data(), x->signed_bytes.size()), RuntimeStatus::kOk);
     return x;
   }();
   return *a;
@@ -117,12 +118,12 @@ inline std::vector<double> modelImage(const TensorNdf& t, int l, int i, int j) {
 inline std::string writeReconstructedPyramid(const TensorNdf& t, const std::string& name) {
   const std::string path = tempPath(name + ".pyramid.gbk");
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 1), format::Status::kOk);
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 1), format::ContainerStatus::kOk);
   const int res = t.resolution();
   const size_t image = size_t(res) * res;
   for (int l = 0; l < t.levelCount(); ++l) {
     const NdfLevelRecord rec = *t.level(l);
-    EXPECT_EQ(w.addSection(format::kSectionNdfLevel, uint64_t(l), &rec, sizeof(rec)), format::Status::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionNdfLevel, uint64_t(l), &rec, sizeof(rec)), format::ContainerStatus::kOk);
     for (uint32_t ry = 0; ry < rec.regions_y; ++ry) {
       for (uint32_t rx = 0; rx < rec.regions_x; ++rx) {
         const uint32_t x0 = rx * rec.region_size, y0 = ry * rec.region_size;
@@ -140,12 +141,13 @@ inline std::string writeReconstructedPyramid(const TensorNdf& t, const std::stri
           for (size_t n = 0; n < image; ++n) dst[k * image + n] = float(std::max(0.0, img[n]));
         }
         const uint64_t key = (uint64_t(l) << 32) | (uint64_t(ry) * rec.regions_x + rx);
-        EXPECT_EQ(w.addSection(format::kSectionNdfChunk, key, bytes.data(), bytes.size()), format::Status::kOk);
+        EXPECT_EQ(w.addSection(format::kSectionNdfChunk, key, bytes.data(), bytes.size()),
+                  format::ContainerStatus::kOk);
       }
     }
   }
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return path;
 }
 

@@ -28,15 +28,15 @@ struct Container {
 
 Container decode(const std::vector<uint8_t>& bytes) {
   format::Reader r;
-  EXPECT_EQ(r.openMemory(bytes.data(), bytes.size()), format::Status::kOk);
+  EXPECT_EQ(r.openMemory(bytes.data(), bytes.size()), format::ContainerStatus::kOk);
   Container c;
   c.kind = r.kind();
-  EXPECT_EQ(r.readMetadata(&c.metadata), format::Status::kOk);
+  EXPECT_EQ(r.readMetadata(&c.metadata), format::ContainerStatus::kOk);
   for (size_t i = 0; i < r.sections().size(); ++i) {
     const format::SectionInfo& s = r.sections()[i];
     if (s.type == format::kSectionMetadata) continue;
     Section sec{s.type, s.key, {}};
-    EXPECT_EQ(r.readSection(i, &sec.data), format::Status::kOk);
+    EXPECT_EQ(r.readSection(i, &sec.data), format::ContainerStatus::kOk);
     c.sections.push_back(std::move(sec));
   }
   return c;
@@ -45,11 +45,12 @@ Container decode(const std::vector<uint8_t>& bytes) {
 std::vector<uint8_t> encode(const Container& c) {
   const std::string path = tempPath("corrupt.gbk");
   format::Writer w;
-  EXPECT_EQ(w.open(path, c.kind, 1), format::Status::kOk);
+  EXPECT_EQ(w.open(path, c.kind, 1), format::ContainerStatus::kOk);
   for (const Section& s : c.sections)
-    EXPECT_EQ(w.addSection(s.type, s.key, s.data.data(), s.data.size(), format::Codec::kRaw), format::Status::kOk);
-  EXPECT_EQ(w.addMetadata(c.metadata), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+    EXPECT_EQ(w.addSection(s.type, s.key, s.data.data(), s.data.size(), format::Codec::kRaw),
+              format::ContainerStatus::kOk);
+  EXPECT_EQ(w.addMetadata(c.metadata), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   std::vector<uint8_t> bytes = readFile(path);
   std::remove(path.c_str());
   return bytes;
@@ -71,20 +72,20 @@ void poke(Section& s, size_t offset, T value) {
   std::memcpy(s.data.data() + offset, &value, sizeof(T));
 }
 
-Status openBytes(const std::vector<uint8_t>& bytes) {
+RuntimeStatus openBytes(const std::vector<uint8_t>& bytes) {
   TensorNdf t;
   return t.openMemory(bytes.data(), bytes.size());
 }
 
 // Applies `mutate` to a decoded copy of the valid asset and opens the result.
-Status openMutated(const std::function<void(Container&)>& mutate) {
+RuntimeStatus openMutated(const std::function<void(Container&)>& mutate) {
   Container c = decode(assets().nonneg_bytes);
   mutate(c);
   return openBytes(encode(c));
 }
 
 TEST(TensorNdfCorrupt, TheUnmodifiedRoundTripOpens) {
-  EXPECT_EQ(openMutated([](Container&) {}), Status::kOk);
+  EXPECT_EQ(openMutated([](Container&) {}), RuntimeStatus::kOk);
 }
 
 TEST(TensorNdfCorrupt, TruncatedFiles) {
@@ -92,7 +93,7 @@ TEST(TensorNdfCorrupt, TruncatedFiles) {
   for (size_t n : {size_t(0), size_t(16), size_t(127), bytes.size() / 3, bytes.size() / 2, bytes.size() - 1}) {
     std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(n));
     TensorNdf t;
-    EXPECT_NE(t.openMemory(cut.empty() ? bytes.data() : cut.data(), n), Status::kOk) << n;
+    EXPECT_NE(t.openMemory(cut.empty() ? bytes.data() : cut.data(), n), RuntimeStatus::kOk) << n;
     EXPECT_FALSE(t.isOpen());
   }
 }
@@ -101,11 +102,11 @@ TEST(TensorNdfCorrupt, BadRecords) {
   using format::kSectionTensorGroup;
   using format::kSectionTensorIndex;
   using format::kSectionTensorInfo;
-  const Status bad = Status::kInvalidAsset;
+  const RuntimeStatus bad = RuntimeStatus::kInvalidAsset;
   // Info record.
   EXPECT_EQ(openMutated([](Container& c) { poke(sec(c, kSectionTensorInfo, 0), 0, uint32_t(0x12345678)); }), bad);
   EXPECT_EQ(openMutated([](Container& c) { poke(sec(c, kSectionTensorInfo, 0), 4, uint32_t(2)); }),
-            Status::kUnsupportedVersion);
+            RuntimeStatus::kUnsupportedVersion);
   EXPECT_EQ(openMutated([](Container& c) { poke(sec(c, kSectionTensorInfo, 0), 12, uint32_t(7)); }), bad);  // B
   EXPECT_EQ(openMutated([](Container& c) { poke(sec(c, kSectionTensorInfo, 0), 20, uint32_t(4)); }), bad);  // levels
   EXPECT_EQ(openMutated([](Container& c) { poke(sec(c, kSectionTensorInfo, 0), 24, uint32_t(100000)); }), bad);
@@ -154,9 +155,9 @@ TEST(TensorNdfCorrupt, BadRecords) {
 TEST(TensorNdfCorrupt, WrongKind) {
   const std::string path = writeReconstructedPyramid(assets().nonneg, "kind");
   TensorNdf t;
-  EXPECT_EQ(t.open(path.c_str()), Status::kWrongKind);
+  EXPECT_EQ(t.open(path.c_str()), RuntimeStatus::kWrongKind);
   std::remove(path.c_str());
-  EXPECT_EQ(t.open(tempPath("does-not-exist.gbk").c_str()), Status::kIoError);
+  EXPECT_EQ(t.open(tempPath("does-not-exist.gbk").c_str()), RuntimeStatus::kIoError);
 }
 
 TEST(TensorNdfCorrupt, MutationLoopNeverCrashes) {
@@ -194,7 +195,7 @@ TEST(TensorNdfCorrupt, MutationLoopNeverCrashes) {
     }
     const std::vector<uint8_t> bytes = encode(c);
     TensorNdf t;
-    if (t.openMemory(bytes.data(), bytes.size()) != Status::kOk) {
+    if (t.openMemory(bytes.data(), bytes.size()) != RuntimeStatus::kOk) {
       ++rejected;
       continue;
     }
@@ -205,18 +206,18 @@ TEST(TensorNdfCorrupt, MutationLoopNeverCrashes) {
     fp.y = 30;
     fp.sigma = 6;
     double v = -1.0, m = -1.0;
-    ASSERT_EQ(t.eval(fp, SPoint{0.01, -0.02}, &v), Status::kOk);
+    ASSERT_EQ(t.eval(fp, SPoint{0.01, -0.02}, &v), RuntimeStatus::kOk);
     ASSERT_TRUE(v >= 0.0 && std::isfinite(v));
-    ASSERT_EQ(t.mass(fp, &m), Status::kOk);
+    ASSERT_EQ(t.mass(fp, &m), RuntimeStatus::kOk);
     ASSERT_TRUE(m >= 0.0 && std::isfinite(m));
     NdfSample smp;
-    if (t.sample(fp, 0.3, 0.7, &smp) == Status::kOk) {
+    if (t.sample(fp, 0.3, 0.7, &smp) == RuntimeStatus::kOk) {
       double p = -1.0;
-      ASSERT_EQ(t.pdf(fp, smp.s, &p), Status::kOk);
+      ASSERT_EQ(t.pdf(fp, smp.s, &p), RuntimeStatus::kOk);
       ASSERT_EQ(p, smp.pdf);
     }
     SRect r;
-    ASSERT_EQ(t.average(fp, r, &v), Status::kOk);
+    ASSERT_EQ(t.average(fp, r, &v), RuntimeStatus::kOk);
     ASSERT_TRUE(v >= 0.0 && std::isfinite(v));
   }
   std::printf("[ figures  ] mutation loop: %d rejected, %d accepted with sane queries\n", rejected, accepted);

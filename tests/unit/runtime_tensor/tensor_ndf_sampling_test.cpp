@@ -33,9 +33,9 @@ std::vector<Point> drawChecked(const TensorNdf& t, const Footprint& fp, int n, u
   int mismatches = 0;
   for (int k = 0; k < n; ++k) {
     NdfSample s;
-    EXPECT_EQ(t.sample(fp, u.next(), u.next(), &s), Status::kOk);
+    EXPECT_EQ(t.sample(fp, u.next(), u.next(), &s), RuntimeStatus::kOk);
     double p = -1.0;
-    EXPECT_EQ(t.pdf(fp, s.s, &p), Status::kOk);
+    EXPECT_EQ(t.pdf(fp, s.s, &p), RuntimeStatus::kOk);
     if (p != s.pdf || !(p > 0.0)) ++mismatches;
     pts.push_back(Point{s.s.x, s.s.y});
   }
@@ -50,7 +50,7 @@ std::vector<double> pdfImage(const TensorNdf& t, const Footprint& fp) {
   for (int j = 0; j < res; ++j) {
     for (int i = 0; i < res; ++i) {
       double p = 0.0;
-      EXPECT_EQ(t.pdf(fp, SPoint{-1.0 + (i + 0.5) * 2.0 / res, 1.0 - (j + 0.5) * 2.0 / res}, &p), Status::kOk);
+      EXPECT_EQ(t.pdf(fp, SPoint{-1.0 + (i + 0.5) * 2.0 / res, 1.0 - (j + 0.5) * 2.0 / res}, &p), RuntimeStatus::kOk);
       img[size_t(j) * res + i] = p;
     }
   }
@@ -81,16 +81,16 @@ TEST(TensorNdfSampling, MillionSampleHistogramMatchesEvalImage) {
   const Footprint fp = footprint(33, 17, 8);
   const int res = t.resolution();
   std::vector<float> img(size_t(res) * res);
-  ASSERT_EQ(t.image(fp, img.data(), img.size()), Status::kOk);
+  ASSERT_EQ(t.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
   double mass = 0.0;
-  ASSERT_EQ(t.mass(fp, &mass), Status::kOk);
+  ASSERT_EQ(t.mass(fp, &mass), RuntimeStatus::kOk);
   const double bin_area = (2.0 / res) * (2.0 / res);
   constexpr int kSamples = 1000000;
   std::vector<double> hist(img.size(), 0.0);
   Uniforms u(99);
   for (int k = 0; k < kSamples; ++k) {
     NdfSample s;
-    ASSERT_EQ(t.sample(fp, u.next(), u.next(), &s), Status::kOk);
+    ASSERT_EQ(t.sample(fp, u.next(), u.next(), &s), RuntimeStatus::kOk);
     const int64_t b = stats::ndfBinIndex(s.s.x, s.s.y, res);
     ASSERT_GE(b, 0);
     hist[size_t(b)] += 1.0;

@@ -63,7 +63,7 @@ TEST(TensorNdf, EvalAtCentresEqualsTheFactors) {
           for (int j = 0; j < res; ++j) {
             for (int i = 0; i < res; ++i) {
               double v = -1.0;
-              ASSERT_EQ(t->eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), Status::kOk);
+              ASSERT_EQ(t->eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), RuntimeStatus::kOk);
               const double expected = std::max(0.0, model[size_t(j) * res + i]);
               ASSERT_NEAR(v, expected, 1e-5 * peak)
                   << "level " << l << " centre " << ci << "," << cj << " bin " << i << "," << j;
@@ -79,27 +79,27 @@ TEST(TensorNdf, BlendingMatchesNdfPyramid) {
   const TensorNdf& t = assets().nonneg;
   const std::string path = writeReconstructedPyramid(t, "blend");
   NdfPyramid ref;
-  ASSERT_EQ(ref.open(path.c_str()), Status::kOk);
+  ASSERT_EQ(ref.open(path.c_str()), RuntimeStatus::kOk);
   const int res = t.resolution();
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> pos(-40.0, 110.0), sig(0.0, 40.0), sp(-1.05, 1.05);
   std::vector<float> img_t(size_t(res) * res), img_r(size_t(res) * res);
   for (int q = 0; q < 200; ++q) {
     const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
-    ASSERT_EQ(t.image(fp, img_t.data(), img_t.size()), Status::kOk);
-    ASSERT_EQ(ref.image(fp, img_r.data(), img_r.size()), Status::kOk);
+    ASSERT_EQ(t.image(fp, img_t.data(), img_t.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(ref.image(fp, img_r.data(), img_r.size()), RuntimeStatus::kOk);
     const float peak = *std::max_element(img_r.begin(), img_r.end());
     for (size_t n = 0; n < img_t.size(); ++n) ASSERT_NEAR(img_t[n], img_r[n], 2e-5 * peak) << "bin " << n;
     for (int k = 0; k < 20; ++k) {
       const SPoint s{sp(rng), sp(rng)};
       double a = -1.0, b = -1.0;
-      ASSERT_EQ(t.eval(fp, s, &a), Status::kOk);
-      ASSERT_EQ(ref.eval(fp, s, &b), Status::kOk);
+      ASSERT_EQ(t.eval(fp, s, &a), RuntimeStatus::kOk);
+      ASSERT_EQ(ref.eval(fp, s, &b), RuntimeStatus::kOk);
       ASSERT_NEAR(a, b, 2e-5 * peak);
     }
     double ma = 0.0, mb = 0.0;
-    ASSERT_EQ(t.mass(fp, &ma), Status::kOk);
-    ASSERT_EQ(ref.mass(fp, &mb), Status::kOk);
+    ASSERT_EQ(t.mass(fp, &ma), RuntimeStatus::kOk);
+    ASSERT_EQ(ref.mass(fp, &mb), RuntimeStatus::kOk);
     EXPECT_NEAR(ma, mb, 1e-5 * mb);
   }
   std::remove(path.c_str());
@@ -117,7 +117,7 @@ double meanOfEval(const TensorNdf& t, const Footprint& fp, const SRect& r) {
       const double hx = std::min(-1.0 + (i + 1) * bin, r.x1) - std::max(-1.0 + i * bin, r.x0);
       if (hx <= 0.0) continue;
       double v = 0.0;
-      EXPECT_EQ(t.eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), Status::kOk);
+      EXPECT_EQ(t.eval(fp, SPoint{binCentreX(i, res), binCentreY(j, res)}, &v), RuntimeStatus::kOk);
       integral += hx * hy * v;
     }
   }
@@ -139,7 +139,7 @@ TEST(TensorNdf, AverageEqualsMeanOfEval) {
     r.y1 = r.y0 + w(rng);
     if (q == 0) r = SRect{};  // the whole plane: mass / 4
     double avg = -1.0;
-    ASSERT_EQ(t.average(fp, r, &avg), Status::kOk);
+    ASSERT_EQ(t.average(fp, r, &avg), RuntimeStatus::kOk);
     const double expected = meanOfEval(t, fp, r);
     ASSERT_GE(avg, 0.0);
     // Float32 prefix sums: a range sum carries a rounding error of a few ulps of the block's
@@ -156,8 +156,8 @@ TEST(TensorNdf, AverageEqualsMeanOfEval) {
   double v = 0.0;
   SRect empty;
   empty.x1 = empty.x0;
-  EXPECT_EQ(t.average(footprint(1, 1, 1), empty, &v), Status::kInvalidArgument);
-  EXPECT_EQ(t.average(footprint(1, 1, NAN), SRect{}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(t.average(footprint(1, 1, 1), empty, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(t.average(footprint(1, 1, NAN), SRect{}, &v), RuntimeStatus::kInvalidArgument);
 }
 
 // pdf * mass against eval at the sampled points; returns the mean relative gap.
@@ -166,12 +166,12 @@ double pdfEvalGap(const TensorNdf& t, const Footprint& fp, int n, uint64_t seed,
   std::uniform_real_distribution<double> u(0.0, 1.0);
   double total = 0.0, sum = 0.0;
   *worst = 0.0;
-  EXPECT_EQ(t.mass(fp, &total), Status::kOk);
+  EXPECT_EQ(t.mass(fp, &total), RuntimeStatus::kOk);
   for (int k = 0; k < n; ++k) {
     NdfSample s;
-    EXPECT_EQ(t.sample(fp, u(rng), u(rng), &s), Status::kOk);
+    EXPECT_EQ(t.sample(fp, u(rng), u(rng), &s), RuntimeStatus::kOk);
     double v = 0.0;
-    EXPECT_EQ(t.eval(fp, s.s, &v), Status::kOk);
+    EXPECT_EQ(t.eval(fp, s.s, &v), RuntimeStatus::kOk);
     const double gap = v > 0.0 ? std::fabs(s.pdf * total - v) / v : 1.0;
     sum += gap;
     *worst = std::max(*worst, gap);
@@ -184,7 +184,7 @@ TEST(TensorNdf, PdfTimesMassEqualsEvalForNonNegativeAssets) {
   double worst_all = 0.0;
   for (const Footprint& fp : {footprint(20, 30, 6), footprint(3, 60, 11), footprint(40, 40, 30)}) {
     double m = 0.0;
-    ASSERT_EQ(t.mass(fp, &m), Status::kOk);
+    ASSERT_EQ(t.mass(fp, &m), RuntimeStatus::kOk);
     EXPECT_NEAR(m, 1.0, 2e-2);  // repeat map: every footprint's NDF is (nearly) normalised
     double worst = 0.0;
     const double mean = pdfEvalGap(t, fp, 4000, 3, &worst);
@@ -228,36 +228,36 @@ TEST(TensorNdf, ValuesAreNeverNegativeAndZeroOutsideTheSquare) {
   for (int q = 0; q < 2000; ++q) {
     const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
     double v = -1.0;
-    ASSERT_EQ(t.eval(fp, SPoint{sp(rng), sp(rng)}, &v), Status::kOk);
+    ASSERT_EQ(t.eval(fp, SPoint{sp(rng), sp(rng)}, &v), RuntimeStatus::kOk);
     ASSERT_GE(v, 0.0);
-    ASSERT_EQ(t.pdf(fp, SPoint{sp(rng), sp(rng)}, &v), Status::kOk);
+    ASSERT_EQ(t.pdf(fp, SPoint{sp(rng), sp(rng)}, &v), RuntimeStatus::kOk);
     ASSERT_GE(v, 0.0);
   }
   double v = -1.0;
-  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{1.5, 0.0}, &v), Status::kOk);
+  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{1.5, 0.0}, &v), RuntimeStatus::kOk);
   EXPECT_EQ(v, 0.0);
-  EXPECT_EQ(t.pdf(footprint(1, 1, 5), SPoint{0.0, -1.01}, &v), Status::kOk);
+  EXPECT_EQ(t.pdf(footprint(1, 1, 5), SPoint{0.0, -1.01}, &v), RuntimeStatus::kOk);
   EXPECT_EQ(v, 0.0);
-  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{NAN, 0.0}, &v), Status::kInvalidArgument);
-  EXPECT_EQ(t.eval(footprint(1, 1, -1), SPoint{0.0, 0.0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(t.eval(footprint(1, 1, 5), SPoint{NAN, 0.0}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(t.eval(footprint(1, 1, -1), SPoint{0.0, 0.0}, &v), RuntimeStatus::kInvalidArgument);
   NdfSample s;
-  EXPECT_EQ(t.sample(footprint(1, 1, 5), 1.0, 0.5, &s), Status::kInvalidArgument);
+  EXPECT_EQ(t.sample(footprint(1, 1, 5), 1.0, 0.5, &s), RuntimeStatus::kInvalidArgument);
   TensorNdf closed;
-  EXPECT_EQ(closed.eval(footprint(1, 1, 5), SPoint{0, 0}, &v), Status::kInvalidArgument);
+  EXPECT_EQ(closed.eval(footprint(1, 1, 5), SPoint{0, 0}, &v), RuntimeStatus::kInvalidArgument);
 }
 
 TEST(TensorNdf, Float16FactorsMatchFloat32) {
   const bake::NormalMap map = tinyMap();
   const std::vector<uint8_t> half = packAsset(map, true, 16, "half", 1);
   TensorNdf h;
-  ASSERT_EQ(h.openMemory(half.data(), half.size()), Status::kOk);
+  ASSERT_EQ(h.openMemory(half.data(), half.size()), RuntimeStatus::kOk);
   EXPECT_EQ(h.info()->precision, 1u);
   const TensorNdf& f = assets().nonneg;
   const int res = f.resolution();
   std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
   for (const Footprint& fp : {footprint(20, 30, 6), footprint(50, 9, 14)}) {
-    ASSERT_EQ(f.image(fp, a.data(), a.size()), Status::kOk);
-    ASSERT_EQ(h.image(fp, b.data(), b.size()), Status::kOk);
+    ASSERT_EQ(f.image(fp, a.data(), a.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(h.image(fp, b.data(), b.size()), RuntimeStatus::kOk);
     double err = 0.0, norm = 0.0;
     for (size_t n = 0; n < a.size(); ++n) {
       err += (double(a[n]) - b[n]) * (double(a[n]) - b[n]);
@@ -270,16 +270,16 @@ TEST(TensorNdf, Float16FactorsMatchFloat32) {
 TEST(TensorNdf, ClampMapsClampTheCentreGrid) {
   const std::vector<uint8_t> bytes = packAsset(tinyMap(bake::MapKind::kBeckmann, true), true, 8, "clamp");
   TensorNdf t;
-  ASSERT_EQ(t.openMemory(bytes.data(), bytes.size()), Status::kOk);
+  ASSERT_EQ(t.openMemory(bytes.data(), bytes.size()), RuntimeStatus::kOk);
   EXPECT_EQ(t.level(0)->wrap, 1u);
   const std::string path = writeReconstructedPyramid(t, "clamp");
   NdfPyramid ref;
-  ASSERT_EQ(ref.open(path.c_str()), Status::kOk);
+  ASSERT_EQ(ref.open(path.c_str()), RuntimeStatus::kOk);
   const int res = t.resolution();
   std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
   for (const Footprint& fp : {footprint(-10, 3, 6), footprint(70, 80, 9), footprint(63, 1, 20)}) {
-    ASSERT_EQ(t.image(fp, a.data(), a.size()), Status::kOk);
-    ASSERT_EQ(ref.image(fp, b.data(), b.size()), Status::kOk);
+    ASSERT_EQ(t.image(fp, a.data(), a.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(ref.image(fp, b.data(), b.size()), RuntimeStatus::kOk);
     const float peak = *std::max_element(b.begin(), b.end());
     for (size_t n = 0; n < a.size(); ++n) ASSERT_NEAR(a[n], b[n], 2e-5 * peak);
   }
@@ -296,7 +296,7 @@ TEST(TensorNdf, ConcurrentQueriesGiveTheSingleThreadedAnswers) {
       const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
       NdfSample s;
       double v = 0.0, a = 0.0;
-      if (t.sample(fp, u(rng), u(rng), &s) != Status::kOk) s = NdfSample{};
+      if (t.sample(fp, u(rng), u(rng), &s) != RuntimeStatus::kOk) s = NdfSample{};
       t.eval(fp, s.s, &v);
       SRect r;
       r.x0 = s.s.x - 0.1;

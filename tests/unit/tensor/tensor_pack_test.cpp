@@ -71,14 +71,14 @@ class CaptureSink final : public ndf::PyramidSink {
   };
   std::vector<Level> levels;
 
-  Status addLevel(const NdfLevelRecord& record) override {
+  BakeStatus addLevel(const NdfLevelRecord& record) override {
     Level l;
     l.record = record;
     l.images.assign(size_t(record.grid_width) * record.grid_height * record.ndf_res * record.ndf_res, 0.0f);
     levels.push_back(std::move(l));
     return okStatus();
   }
-  Status addChunk(const ndf::PyramidChunk& chunk) override {
+  BakeStatus addChunk(const ndf::PyramidChunk& chunk) override {
     Level& l = levels.back();
     const size_t image = size_t(chunk.ndf_res) * chunk.ndf_res;
     for (int k = 0; k < chunk.width * chunk.height; ++k) {
@@ -136,7 +136,7 @@ T readRecord(const format::Reader& reader, uint32_t type, uint64_t key) {
   EXPECT_GE(i, 0) << "section " << type << " key " << key;
   if (i < 0) return rec;
   std::vector<uint8_t> bytes;
-  EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::Status::kOk);
+  EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::ContainerStatus::kOk);
   EXPECT_EQ(bytes.size(), sizeof(T));
   if (bytes.size() == sizeof(T)) std::memcpy(static_cast<void*>(&rec), bytes.data(), sizeof(T));
   return rec;
@@ -145,7 +145,7 @@ T readRecord(const format::Reader& reader, uint32_t type, uint64_t key) {
 Decoded decode(const std::string& path) {
   Decoded d;
   format::Reader reader;
-  EXPECT_EQ(reader.open(path), format::Status::kOk);
+  EXPECT_EQ(reader.open(path), format::ContainerStatus::kOk);
   EXPECT_EQ(reader.kind(), format::AssetKind::kTensorNdf);
   d.info = readRecord<TensorInfoRecord>(reader, format::kSectionTensorInfo, 0);
   EXPECT_EQ(d.info.magic, TensorInfoRecord{}.magic);
@@ -155,7 +155,7 @@ Decoded decode(const std::string& path) {
     std::vector<uint8_t> bytes;
     const int i = reader.find(format::kSectionTensorIndex, l);
     EXPECT_GE(i, 0);
-    EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::Status::kOk);
+    EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::ContainerStatus::kOk);
     const size_t entries = size_t(d.levels.back().grid_width) * d.levels.back().grid_height * d.info.blocks_per_side *
                            d.info.blocks_per_side;
     EXPECT_EQ(bytes.size(), entries * sizeof(TensorIndexEntry));
@@ -167,7 +167,7 @@ Decoded decode(const std::string& path) {
     std::vector<uint8_t> bytes;
     const int i = reader.find(format::kSectionTensorGroup, g);
     EXPECT_GE(i, 0);
-    EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::Status::kOk);
+    EXPECT_EQ(reader.readSection(size_t(i), &bytes), format::ContainerStatus::kOk);
     Decoded::Group grp;
     std::memcpy(&grp.header, bytes.data(), sizeof(grp.header));
     const size_t bins = grp.header.bins, rank = grp.header.rank, blocks = grp.header.blocks;
@@ -216,37 +216,37 @@ double decodedError(const Decoded& d, const CaptureSink& ref) {
   return std::sqrt(err / norm);
 }
 
-Status packFromMap(const NormalMap& map, const TensorPackOptions& o, const std::string& path, TensorPackReport* report,
-                   const ndf::PyramidOptions& pyr = smallPyramid()) {
+BakeStatus packFromMap(const NormalMap& map, const TensorPackOptions& o, const std::string& path,
+                       TensorPackReport* report, const ndf::PyramidOptions& pyr = smallPyramid()) {
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kTensorNdf, 3), format::Status::kOk);
-  Status s = packTensorNdfFromMap(map, pyr, o, w, report);
+  EXPECT_EQ(w.open(path, format::AssetKind::kTensorNdf, 3), format::ContainerStatus::kOk);
+  BakeStatus s = packTensorNdfFromMap(map, pyr, o, w, report);
   if (!s) return s;
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return s;
 }
 
-Status packFromPyramid(const std::string& pyramid_path, const TensorPackOptions& o, const std::string& path,
-                       TensorPackReport* report) {
+BakeStatus packFromPyramid(const std::string& pyramid_path, const TensorPackOptions& o, const std::string& path,
+                           TensorPackReport* report) {
   format::Reader reader;
-  EXPECT_EQ(reader.open(pyramid_path), format::Status::kOk);
+  EXPECT_EQ(reader.open(pyramid_path), format::ContainerStatus::kOk);
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kTensorNdf, 3), format::Status::kOk);
-  Status s = packTensorNdfFromPyramid(reader, o, w, report);
+  EXPECT_EQ(w.open(path, format::AssetKind::kTensorNdf, 3), format::ContainerStatus::kOk);
+  BakeStatus s = packTensorNdfFromPyramid(reader, o, w, report);
   if (!s) return s;
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return s;
 }
 
 std::string writePyramid(const NormalMap& map, const std::string& name) {
   const std::string path = tempPath(name + ".pyramid.gbk");
   format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::Status::kOk);
+  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
   EXPECT_TRUE(ndf::buildNdfPyramid(map, smallPyramid(), w, nullptr).ok());
-  EXPECT_EQ(w.addMetadata("{}"), format::Status::kOk);
-  EXPECT_EQ(w.finish(), format::Status::kOk);
+  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
   return path;
 }
 
@@ -492,7 +492,7 @@ TEST(TensorPack, OneAxisMapsPackWithTheDefaults) {
       const std::string name = std::string("one_axis_") + (along_x ? "x" : "y") + std::to_string(precision) + ".gbk";
       TensorPackReport rep;
       const ndf::PyramidOptions pyramid;
-      const Status s = packFromMap(map, o, tempPath(name), &rep, pyramid);
+      const BakeStatus s = packFromMap(map, o, tempPath(name), &rep, pyramid);
       ASSERT_TRUE(s.ok()) << name << ": " << s.error().message;
       EXPECT_TRUE(std::isfinite(rep.relative_error)) << name;
       EXPECT_LT(rep.relative_error, 0.5) << name;
@@ -515,8 +515,8 @@ TEST(TensorPack, RejectsBadOptionsAndAllBlankPyramids) {
   TensorPackOptions o = packOptions(8);
   o.block = 24;  // does not divide 64
   format::Writer w;
-  ASSERT_EQ(w.open(tempPath("bad.gbk"), format::AssetKind::kTensorNdf), format::Status::kOk);
-  Status s = packTensorNdfFromMap(map, smallPyramid(), o, w, nullptr);
+  ASSERT_EQ(w.open(tempPath("bad.gbk"), format::AssetKind::kTensorNdf), format::ContainerStatus::kOk);
+  BakeStatus s = packTensorNdfFromMap(map, smallPyramid(), o, w, nullptr);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ErrorCode::kBadArgument);
   o = packOptions(0);
@@ -531,7 +531,7 @@ TEST(TensorPack, RejectsBadOptionsAndAllBlankPyramids) {
   o = packOptions(8);
   o.blank_threshold = 1.0;
   format::Writer w2;
-  ASSERT_EQ(w2.open(tempPath("blank.gbk"), format::AssetKind::kTensorNdf), format::Status::kOk);
+  ASSERT_EQ(w2.open(tempPath("blank.gbk"), format::AssetKind::kTensorNdf), format::ContainerStatus::kOk);
   s = packTensorNdfFromMap(map, smallPyramid(), o, w2, nullptr);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ErrorCode::kInvalidInput);
@@ -541,8 +541,8 @@ TEST(TensorPack, CancellationStopsWithARuntimeError) {
   const NormalMap map = testMap(MapKind::kBeckmann);
   const std::atomic<bool> cancel{true};
   format::Writer w;
-  ASSERT_EQ(w.open(tempPath("cancel.gbk"), format::AssetKind::kTensorNdf), format::Status::kOk);
-  Status s = packTensorNdfFromMap(map, smallPyramid(), packOptions(8), w, nullptr, {}, &cancel);
+  ASSERT_EQ(w.open(tempPath("cancel.gbk"), format::AssetKind::kTensorNdf), format::ContainerStatus::kOk);
+  BakeStatus s = packTensorNdfFromMap(map, smallPyramid(), packOptions(8), w, nullptr, {}, &cancel);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, ErrorCode::kRuntime);
 }

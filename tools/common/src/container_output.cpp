@@ -7,8 +7,8 @@ namespace glintbake::cli {
 
 ContainerOutput::ContainerOutput(Tool& tool, const std::string& path, format::AssetKind kind, int zstd_level)
     : tool_(tool), kind_(kind), path_(path) {
-  const format::Status status = writer_.open(path, kind, zstd_level);
-  if (status != format::Status::kOk) {
+  const format::ContainerStatus status = writer_.open(path, kind, zstd_level);
+  if (status != format::ContainerStatus::kOk) {
     throw Error(kExitIo, "cannot create " + path + ": " + format::statusString(status));
   }
   temporary_ = writer_.temporaryPath();
@@ -22,8 +22,8 @@ ContainerOutput::~ContainerOutput() {
 }
 
 void ContainerOutput::addSection(uint32_t type, uint64_t key, const void* data, size_t size) {
-  const format::Status status = writer_.addSection(type, key, data, size);
-  if (status != format::Status::kOk)
+  const format::ContainerStatus status = writer_.addSection(type, key, data, size);
+  if (status != format::ContainerStatus::kOk)
     throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
 }
 
@@ -42,9 +42,9 @@ void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, in
 }
 
 void ContainerOutput::finish(const Json& metadata) {
-  format::Status status = writer_.addMetadata(metadata.dump());
-  if (status == format::Status::kOk) status = writer_.finish();
-  if (status != format::Status::kOk)
+  format::ContainerStatus status = writer_.addMetadata(metadata.dump());
+  if (status == format::ContainerStatus::kOk) status = writer_.finish();
+  if (status != format::ContainerStatus::kOk)
     throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
   finished_ = true;
 }

@@ -47,7 +47,8 @@ void resolvePyramidOptions(PyramidCliOptions& p) {
     }
   }
   check(bake::ndf::validatePyramidOptions(p.options));
-  if (p.lobes < 0 || p.lobes > bake::ndf::kMaxLobesPerTile) throw Error(kExitBadArguments, "--lobes must be in [0, 16]");
+  if (p.lobes < 0 || p.lobes > bake::ndf::kMaxLobesPerTile)
+    throw Error(kExitBadArguments, "--lobes must be in [0, 16]");
 }
 
 Json pyramidOptionsJson(const PyramidCliOptions& p) {
@@ -75,7 +76,7 @@ uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const P
                      const bake::ndf::FlakesHandover& handover) {
   if (!p.flakes) return 0;
   uint64_t bytes = 0;
-  const bake::Status s =
+  const bake::BakeStatus s =
       bake::ndf::writeFlakesSection(writer, map, p.options.rate, p.options.splat.sigma_r, handover, &bytes);
   if (!s) throw Error(int(s.error().code), s.error().message);
   return bytes;

@@ -271,8 +271,8 @@ void Tool::printJson(const Json& document) const { std::cout << document.dump(2)
 
 std::string Tool::addInput(const std::string& path) {
   std::string hex;
-  const format::Status status = format::hashFile128Hex(path, &hex);
-  if (status != format::Status::kOk) {
+  const format::ContainerStatus status = format::hashFile128Hex(path, &hex);
+  if (status != format::ContainerStatus::kOk) {
     throw Error(kExitIo, "cannot read " + path + ": " + (errno ? std::strerror(errno) : format::statusString(status)));
   }
   inputs_.push_back(path);

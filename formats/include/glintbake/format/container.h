@@ -2,7 +2,7 @@
 //
 // The byte layout is normative in formats/SPEC.md. This header is the whole public API of the
 // container library (target glintbake::format). It depends on zstd and xxhash only, throws no
-// exceptions and reports every failure through a Status code.
+// exceptions and reports every failure through a ContainerStatus code.
 #pragma once
 
 #include <cstddef>
@@ -26,7 +26,7 @@ constexpr size_t kSectionAlignment = 64;                           // every sect
 constexpr uint64_t kDefaultMaxRawSectionSize = uint64_t(1) << 32;  // 4 GiB: readers' default cap
 constexpr uint32_t kMaxSectionCount = 1u << 24;                    // readers refuse more
 
-enum class Status : int32_t {
+enum class ContainerStatus : int32_t {
   kOk = 0,
   kIoError = 1,             // open/read/write/rename failed
   kBadMagic = 2,            // not a glintbake container
@@ -41,8 +41,11 @@ enum class Status : int32_t {
   kTruncated = 11,          // the file is shorter than its header or index says
 };
 
+// The former name of ContainerStatus, kept for one minor version.
+using Status [[deprecated("use glintbake::format::ContainerStatus")]] = ContainerStatus;
+
 // Stable, human-readable name of a status ("ok", "i/o error", ...). Never returns null.
-const char* statusString(Status status);
+const char* statusString(ContainerStatus status);
 
 // What an asset file holds. Stored as uint32; unknown values are readable (kind is reported as a number).
 enum class AssetKind : uint32_t {
@@ -122,7 +125,7 @@ struct HeaderInfo {
 uint64_t hash64(const void* data, size_t size);
 std::string hash128Hex(const void* data, size_t size);
 // Hash of a whole file, streamed; returns kIoError if it cannot be read.
-Status hashFile128Hex(const std::string& path, std::string* hex_out);
+ContainerStatus hashFile128Hex(const std::string& path, std::string* hex_out);
 
 // Writes a container. Sections are compressed and appended as they are added, so a producer
 // never holds more than one section in memory; the index and header are written by finish().
@@ -138,13 +141,13 @@ class Writer {
   Writer& operator=(const Writer&) = delete;
 
   // Opens the temporary file next to `path`. zstd_level: 1..19 (default 9).
-  Status open(const std::string& path, AssetKind kind, int zstd_level = 9);
+  ContainerStatus open(const std::string& path, AssetKind kind, int zstd_level = 9);
   // Appends one section. codec kZstd falls back to kRaw when compression does not shrink the data.
-  Status addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec = Codec::kZstd);
+  ContainerStatus addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec = Codec::kZstd);
   // Convenience for the JSON metadata section (must be added exactly once before finish()).
-  Status addMetadata(const std::string& json_utf8);
+  ContainerStatus addMetadata(const std::string& json_utf8);
   // Writes index and header, flushes, renames to the final path.
-  Status finish();
+  ContainerStatus finish();
   // Drops the temporary file. Called by the destructor if finish() did not succeed.
   void abort();
   // Path of the temporary file while open (for signal handlers that must unlink it).
@@ -174,9 +177,9 @@ class Reader {
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
 
-  Status open(const std::string& path, const ReaderOptions& options = {});
+  ContainerStatus open(const std::string& path, const ReaderOptions& options = {});
   // Reads from a caller-owned buffer that must outlive the reader (fuzzing, embedded assets).
-  Status openMemory(const void* data, size_t size, const ReaderOptions& options = {});
+  ContainerStatus openMemory(const void* data, size_t size, const ReaderOptions& options = {});
   void close();
 
   const HeaderInfo& header() const;
@@ -188,17 +191,17 @@ class Reader {
   int find(uint32_t type, uint64_t key) const;
 
   // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size.
-  Status readSection(size_t i, std::vector<uint8_t>* out) const;
+  ContainerStatus readSection(size_t i, std::vector<uint8_t>* out) const;
   // Same, into a caller buffer of exactly raw_size bytes (kInvalidArgument otherwise). Raw sections
   // are read straight into dst; zstd sections of a file reader go through a temporary buffer of
   // stored_size bytes (none for openMemory), plus zstd's decoding context.
-  Status readSectionInto(size_t i, void* dst, size_t dst_size) const;
+  ContainerStatus readSectionInto(size_t i, void* dst, size_t dst_size) const;
   // Reads the stored (possibly compressed) bytes of section i without decoding.
-  Status readStored(size_t i, std::vector<uint8_t>* out) const;
+  ContainerStatus readStored(size_t i, std::vector<uint8_t>* out) const;
   // The metadata JSON text (the single kSectionMetadata section).
-  Status readMetadata(std::string* json_utf8) const;
+  ContainerStatus readMetadata(std::string* json_utf8) const;
   // Hashes every byte after the header and compares with the header's file checksum.
-  Status verifyFileChecksum() const;
+  ContainerStatus verifyFileChecksum() const;
 
  private:
   struct Impl;

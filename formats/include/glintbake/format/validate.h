@@ -31,7 +31,7 @@ struct ValidationReport {
   // The first failing container status: kIoError (the file could not be read), kUnsupportedVersion
   // (newer major), any other value (the container is corrupt). kOk when structure, checksums and
   // decoding are sound; metadata and kind-specific errors make the report invalid without a status.
-  Status status = Status::kOk;
+  ContainerStatus status = ContainerStatus::kOk;
   bool valid() const { return errorCount() == 0; }
   size_t errorCount() const;
   size_t warningCount() const;

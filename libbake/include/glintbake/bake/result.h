@@ -42,8 +42,8 @@ class [[nodiscard]] Result {
 
 // Result<void>
 struct Ok {};
-using Status = Result<Ok>;
-inline Status okStatus() { return Ok{}; }
+using BakeStatus = Result<Ok>;
+inline BakeStatus okStatus() { return Ok{}; }
 
 inline Error makeError(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
 

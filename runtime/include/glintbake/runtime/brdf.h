@@ -116,19 +116,19 @@ class MicrofacetBrdf {
   NdfKind ndfKind() const { return kind_; }
 
   // D(h) of a unit microfacet normal h (the s-plane density at (h.x, h.y); 0 for h.z <= 0).
-  Status ndf(const Vec3& h, double* value) const;
+  RuntimeStatus ndf(const Vec3& h, double* value) const;
 
   // f(wi, wo) per channel, 1/sr. kInvalidArgument for a non-finite direction or from the source.
-  Status eval(const Vec3& wi, const Vec3& wo, Rgb* f) const;
+  RuntimeStatus eval(const Vec3& wi, const Vec3& wo, Rgb* f) const;
 
   // Samples wi by drawing h from D (NdfSource::sample, or the analytic sampler) and reflecting wo
   // about it. u1, u2 in [0, 1). When h cannot reflect wo (wo . h <= 0) or the source has no mass,
   // returns kOk with pdf = 0 and zero weight (the caller discards the sample).
-  Status sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const;
+  RuntimeStatus sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const;
 
   // Density of sample() producing wi for this wo: D_s(s) cos(theta_h) / (4 |wo . h|) with the
   // source's pdf() as D_s. 0 when wo is at or below the horizon or h = 0.
-  Status pdf(const Vec3& wi, const Vec3& wo, double* value) const;
+  RuntimeStatus pdf(const Vec3& wi, const Vec3& wo, double* value) const;
 
   // Accessors used by the environment prefiltering (sg.h).
   const NdfSource* source() const { return source_; }

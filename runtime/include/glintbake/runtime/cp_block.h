@@ -62,7 +62,7 @@ struct CpGroupView {
 };
 
 // kOk, or kInvalidArgument for null pointers or sizes out of range.
-Status validateCpGroupView(const CpGroupView& view);
+RuntimeStatus validateCpGroupView(const CpGroupView& view);
 
 // One weighted block of a blend. The weight is usually an interpolation weight in [0, 1].
 struct CpBlendTerm {
@@ -85,7 +85,7 @@ class CpMix {
   // baked with spatial regions of fewer than 4 centres per side reach that); all groups must share B and hold valid
   // views (validateCpGroupView) and the block index must be in [0, K). Returns kInvalidArgument otherwise (the mix is
   // then empty: every query returns 0). Zero terms give an empty mix.
-  Status init(const CpBlendTerm* terms, int32_t count);
+  RuntimeStatus init(const CpBlendTerm* terms, int32_t count);
 
   int32_t bins() const { return bins_; }
   bool empty() const { return group_count_ == 0; }

@@ -54,7 +54,7 @@ class FlakeNdf final : public AccumulatingNdfSource {
   // intrinsic roughness sigma_r in (0, 1], image resolution R (2..4096) reported by resolution()
   // and used by image(). Memory: about 36 bytes per flake. kInvalidArgument for parameters out of
   // range or a source larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
-  Status build(const TexelSource& source, int rate, double sigma_r, int resolution);
+  RuntimeStatus build(const TexelSource& source, int rate, double sigma_r, int resolution);
   bool isBuilt() const;
 
   // kUnknown: the flakes are a part of an asset (openNdfAsset wraps them with its pyramid).
@@ -66,14 +66,14 @@ class FlakeNdf final : public AccumulatingNdfSource {
   MapWrap wrap() const override;
   double sigmaR() const;
 
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status mass(const Footprint& footprint, double* value) const override;
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const override;
   // Cost: every flake of the window (no pruning by s); a few milliseconds at sigma_p = 8 texels.
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
-  Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
+  RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
   struct Impl;

@@ -2,7 +2,7 @@
  * for engines that do not link C++ directly. The BRDF and LTC C APIs are glintbake_brdf_c.h and
  * ltc_c.h; they share the status codes below.
  *
- * Every function returns a status code (GB_OK = 0; the values equal glintbake::runtime::Status)
+ * Every function returns a status code (GB_OK = 0; the values equal glintbake::runtime::RuntimeStatus)
  * and writes results through out-parameters. Positions and sigma are in texels of the source normal
  * map (texel centres at +0.5, y downwards); s-plane points are (s_x, s_y) of the projected
  * hemisphere, values are densities per unit s-plane area. Query functions never allocate and may be

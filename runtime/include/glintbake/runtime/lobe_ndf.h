@@ -55,9 +55,9 @@ class LobeNdf final : public AccumulatingNdfSource {
   // Builds the lobe hierarchy from a texel source with the flake model of flake_ndf.h: rate flakes
   // per texel side (1..16), intrinsic roughness sigma_r in (0, 1], lobes_per_tile in
   // [1, kMaxLobesPerTile], image resolution R (2..4096). Memory: about 80 bytes per flake (at 16
-  // lobes per tile, where level 0 keeps every flake). kInvalidArgument for parameters out of range, non-finite normals or a source
-  // larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
-  Status build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution);
+  // lobes per tile, where level 0 keeps every flake). kInvalidArgument for parameters out of range, non-finite normals
+  // or a source larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
+  RuntimeStatus build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution);
   bool isBuilt() const;
 
   format::AssetKind kind() const override { return format::AssetKind::kUnknown; }
@@ -70,13 +70,13 @@ class LobeNdf final : public AccumulatingNdfSource {
   // Tile side (flakes) of the level that answers a footprint of this sigma.
   int tileFor(double sigma) const;
 
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status mass(const Footprint& footprint, double* value) const override;
-  Status image(const Footprint& footprint, float* out, size_t out_count) const override;
-  Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const override;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
+  RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
   struct Impl;

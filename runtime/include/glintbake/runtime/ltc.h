@@ -37,17 +37,17 @@ class LtcTable {
   LtcTable() = default;
 
   // Loads an ltc-table container (sections 48/0 and 48/1). Allocates once, here.
-  Status open(const char* path);
-  Status openMemory(const void* data, size_t size);
+  RuntimeStatus open(const char* path);
+  RuntimeStatus openMemory(const void* data, size_t size);
   // Adopts arrays in the published layout: size x size x 4 floats each, flat index a + size t.
-  Status fromArrays(int size, const float* ltc1, const float* ltc2);
+  RuntimeStatus fromArrays(int size, const float* ltc1, const float* ltc2);
 
   bool valid() const { return size_ > 0; }
   int size() const { return size_; }
 
   // Bilinear lookup at roughness in [0, 1] (sqrt of alpha_GGX) and cos(theta_V) in [0, 1]; both
   // are clamped. Returns kInvalidArgument on an empty table or non-finite inputs.
-  Status lookup(float roughness, float cos_theta_v, LtcCoefficients* out) const;
+  RuntimeStatus lookup(float roughness, float cos_theta_v, LtcCoefficients* out) const;
 
   // The horizon-clipping factor of a sphere light (ltc_2.w): bilinear in z (cosine of the average
   // direction's elevation, [-1, 1]) and len (its length, [0, 1]); returns 0 on an empty table.

@@ -54,7 +54,7 @@ class NdfPyramid : public PyramidNdf {
   const float* centreImage(int l, int i, int j) const;
 
  protected:
-  Status loadKind(const format::Reader& reader) override;
+  RuntimeStatus loadKind(const format::Reader& reader) override;
   void reset() override;
   bool loaded() const override { return impl_ != nullptr; }
   const NdfLevelRecord* levelRecords(int* count) const override;
@@ -68,12 +68,12 @@ class NdfPyramid : public PyramidNdf {
   // the edges of clamp maps, so pdf == eval there).
   // mass: total mass of the blend (integral over the s-plane).
   // image: the blended image the runtime sees (R * R floats).
-  Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;
-  Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
-  Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
-  Status massChecked(const Footprint& footprint, double* value) const override;
-  Status imageChecked(const Footprint& footprint, float* out) const override;
+  RuntimeStatus evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus massChecked(const Footprint& footprint, double* value) const override;
+  RuntimeStatus imageChecked(const Footprint& footprint, float* out) const override;
 
  private:
   struct Impl;

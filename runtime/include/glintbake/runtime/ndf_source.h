@@ -69,15 +69,15 @@ class NdfSource {
   virtual MapSize mapSize() const = 0;
   virtual MapWrap wrap() const = 0;
 
-  virtual Status eval(const Footprint& footprint, const SPoint& s, double* value) const = 0;
-  virtual Status average(const Footprint& footprint, const SRect& rect, double* value) const = 0;
+  virtual RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const = 0;
   // u1, u2 in [0, 1). kInvalidArgument when the footprint's NDF has no mass.
-  virtual Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
-  virtual Status pdf(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
+  virtual RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const = 0;
   // Integral of eval() over the s-plane.
-  virtual Status mass(const Footprint& footprint, double* value) const = 0;
+  virtual RuntimeStatus mass(const Footprint& footprint, double* value) const = 0;
   // The R x R image of eval() (bin averages, row 0 at s_y = +1); out_count >= R * R.
-  virtual Status image(const Footprint& footprint, float* out, size_t out_count) const = 0;
+  virtual RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const = 0;
 };
 
 // An NDF source whose image can be added, scaled, into a caller's buffer (the flakes and the
@@ -86,14 +86,14 @@ class AccumulatingNdfSource : public NdfSource {
  public:
   // Adds weight * image() to out (R * R floats); bins whose centre lies outside the unit disk are
   // left as they are.
-  virtual Status addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const = 0;
+  virtual RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const = 0;
 };
 
 // Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf), chosen by the container's
 // asset kind. kIoError, kInvalidAsset, kWrongKind (a container of another kind), kUnsupportedVersion,
 // kOutOfMemory. Safe on untrusted input. On failure *out is reset.
-Status openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out);
+RuntimeStatus openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out);
 // Same, from a caller buffer (only needed during the call).
-Status openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out);
+RuntimeStatus openNdfAssetMemory(const void* data, size_t size, std::unique_ptr<NdfSource>* out);
 
 }  // namespace glintbake::runtime

@@ -26,12 +26,12 @@ class PyramidNdf : public NdfSource {
  public:
   // Loads a container of this kind. kIoError, kInvalidAsset, kWrongKind, kUnsupportedVersion,
   // kOutOfMemory. Safe on untrusted input.
-  Status open(const char* path);
+  RuntimeStatus open(const char* path);
   // Same, from a caller buffer (only needed during the call).
-  Status openMemory(const void* data, size_t size);
+  RuntimeStatus openMemory(const void* data, size_t size);
   // Same, from a reader opened by the caller (one open for a caller that reads other sections of
   // the file too); kWrongKind when the reader's kind is not kind(). On failure the asset is empty.
-  Status load(const format::Reader& reader);
+  RuntimeStatus load(const format::Reader& reader);
   bool isOpen() const { return loaded(); }
 
   int levelCount() const;
@@ -48,19 +48,19 @@ class PyramidNdf : public NdfSource {
   // is not open, an output pointer is null, the footprint or s is not finite, sigma < 0, a
   // rectangle is empty, a uniform is outside [0, 1), or out_count < R * R), then the kind's
   // checked query.
-  Status eval(const Footprint& footprint, const SPoint& s, double* value) const final;
-  Status average(const Footprint& footprint, const SRect& rect, double* value) const final;
-  Status sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const final;
-  Status pdf(const Footprint& footprint, const SPoint& s, double* value) const final;
-  Status mass(const Footprint& footprint, double* value) const final;
-  Status image(const Footprint& footprint, float* out, size_t out_count) const final;
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const final;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const final;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const final;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const final;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const final;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const final;
 
  protected:
   PyramidNdf() = default;
 
   // Loads the kind's sections from a reader of the right kind into fresh state; on failure the
   // caller resets. Called by open(), openMemory() and load().
-  virtual Status loadKind(const format::Reader& reader) = 0;
+  virtual RuntimeStatus loadKind(const format::Reader& reader) = 0;
   // Drops everything loaded (after this loaded() is false).
   virtual void reset() = 0;
   virtual bool loaded() const = 0;
@@ -68,12 +68,12 @@ class PyramidNdf : public NdfSource {
   virtual const NdfLevelRecord* levelRecords(int* count) const = 0;
 
   // Queries on checked arguments (the asset is loaded, pointers are valid, the footprint is valid).
-  virtual Status evalChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
-  virtual Status averageChecked(const Footprint& footprint, const SRect& rect, double* value) const = 0;
-  virtual Status sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
-  virtual Status pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
-  virtual Status massChecked(const Footprint& footprint, double* value) const = 0;
-  virtual Status imageChecked(const Footprint& footprint, float* out) const = 0;
+  virtual RuntimeStatus evalChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual RuntimeStatus averageChecked(const Footprint& footprint, const SRect& rect, double* value) const = 0;
+  virtual RuntimeStatus sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* sample) const = 0;
+  virtual RuntimeStatus pdfChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;
+  virtual RuntimeStatus massChecked(const Footprint& footprint, double* value) const = 0;
+  virtual RuntimeStatus imageChecked(const Footprint& footprint, float* out) const = 0;
 };
 
 }  // namespace glintbake::runtime

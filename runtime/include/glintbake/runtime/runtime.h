@@ -6,7 +6,7 @@
 
 namespace glintbake::runtime {
 
-enum class Status : int32_t {
+enum class RuntimeStatus : int32_t {
   kOk = 0,
   kIoError = 1,
   kInvalidAsset = 2,        // the container or its sections are malformed
@@ -16,8 +16,11 @@ enum class Status : int32_t {
   kOutOfMemory = 6,
 };
 
+// The former name of RuntimeStatus, kept for one minor version.
+using Status [[deprecated("use glintbake::runtime::RuntimeStatus")]] = RuntimeStatus;
+
 // Stable, human-readable name of a status. Never returns null.
-const char* statusString(Status status);
+const char* statusString(RuntimeStatus status);
 
 // A Gaussian pixel footprint on the surface: centre (x, y) and standard deviation sigma, all in
 // texels of the source normal map (texel centres at +0.5, y grows downwards; formats/SPEC.md).

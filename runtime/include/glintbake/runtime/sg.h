@@ -53,18 +53,18 @@ SgSupport sgSupport(const SphericalGaussian& sg, double eps);
 // [-1, 1]^2 when the cone contains -wo (h unbounded) or reaches the extreme s = (+-1, 0), (0, +-1).
 // kInvalidArgument for non-finite input, eps <= 0 or lambda <= 0. *rect untouched then, and also
 // when the support is empty (returns kOk with *has_support = false).
-Status sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo, SRect* rect, bool* has_support);
+RuntimeStatus sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo, SRect* rect, bool* has_support);
 
 // Average of the BRDF's D over the half-vector rectangle of the SG's support: NdfSource::average
 // for P-NDF BRDFs, and for the smooth BRDF the mean of the analytic D at 8 x 8 rectangle points.
-Status sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
-                     double* value);
+RuntimeStatus sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
+                            double* value);
 
 // Prefiltered outgoing radiance towards wo of the SG light reflected by the BRDF (formula above),
 // per channel. 0 when wo or mu is at or below the horizon, or the support is empty.
 // eps: the support threshold in radiance units (e.g. 1e-3 of the amplitude).
-Status prefilteredSgShading(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
-                            Rgb* radiance);
+RuntimeStatus prefilteredSgShading(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
+                                   Rgb* radiance);
 
 // Importance sampling of the direction distribution G(v) / integral(G) (for a scalar lobe:
 // the channels share the shape): cos(theta) = 1 + ln(1 - u1 (1 - exp(-2 lambda))) / lambda.

@@ -39,15 +39,15 @@ constexpr const char* kNormalEncodingAttribute = "glintbake:normal_encoding";
 // on failure nothing is left behind. Bytes depend only on the arguments: no timestamps, host or
 // software names are written. Thread-safe (distinct paths). Errors: kBadArgument (bad sizes,
 // channels not in 1..4, png_bits not 8 or 16), kUnsupported (unknown extension), kIo.
-Status writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
-                  const ImageWriteOptions& options = {});
+BakeStatus writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
+                      const ImageWriteOptions& options = {});
 
 // Writes a normal map as an image a renderer or this library can read back:
 //  - float formats (.exr, ...): signed RGB = (n_x, n_y, n_z) as stored (loadNormalMap's auto
 //    encoding detects them as signed whenever any component is negative);
 //  - integer formats (.png, .tif, ...): RGB = (n + 1) / 2 quantised to png_bits (16 by default).
 // Same atomicity, determinism and errors as writeImage.
-Status writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options = {});
+BakeStatus writeNormalMap(const std::string& path, const NormalMap& map, const ImageWriteOptions& options = {});
 
 // True when writeImage stores float values for this path's extension (.exr, .hdr, .pfm).
 bool isFloatImagePath(const std::string& path);

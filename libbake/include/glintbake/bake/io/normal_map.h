@@ -96,6 +96,6 @@ Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const
 // options.fix_nonfinite, which sets them to (0, 0, 1). Fills texels, far_from_unit, nz_nonpositive,
 // nonfinite and mean_length (over finite texels, before renormalisation) of `report` (may be null).
 // Multithreaded (TBB); results and counts do not depend on the thread count.
-Status normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report);
+BakeStatus normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report);
 
 }  // namespace glintbake::bake

@@ -34,10 +34,10 @@ Result<std::vector<RoughnessLevel>> bakeRoughness(const NormalMap& map, const Ro
 
 // Adds one section per level to an open writer of a roughness asset (formats/SPEC.md 10.3: type
 // 64, key = level, width x height x 1 image sections). kIo on a writer failure.
-Status writeRoughnessSections(const std::vector<RoughnessLevel>& levels, format::Writer& writer);
+BakeStatus writeRoughnessSections(const std::vector<RoughnessLevel>& levels, format::Writer& writer);
 
 // Writes the levels as one tiled, mipmapped single-channel float EXR (channel "Y"), atomically and
 // byte-reproducibly (no capture date).
-Status writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path);
+BakeStatus writeRoughnessExr(const std::vector<RoughnessLevel>& levels, const std::string& path);
 
 }  // namespace glintbake::bake::ltc

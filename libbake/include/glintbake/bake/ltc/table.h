@@ -87,7 +87,7 @@ PublishedTable packPublished(const FittedTable& table);
 
 // Adds the two sections of an ltc-table asset (formats/SPEC.md 10.2: type 48, keys 0 and 1,
 // size x size x 4 image sections) to an open writer of that kind. kIo on a writer failure.
-Status writeLtcTableSections(const PublishedTable& table, format::Writer& writer);
+BakeStatus writeLtcTableSections(const PublishedTable& table, format::Writer& writer);
 
 // The horizon-clipped, cosine-weighted solid angle of a spherical cap divided by that of the
 // unclipped cap (Snyder 1996 / Heitz et al. 2017 "sphere" table): rows j (len = j/(N-1), the length
@@ -134,7 +134,7 @@ std::string publishedCHeader(const PublishedTable& table, const std::string& gua
 
 // Writes the two published-layout images as N x N RGBA float EXR files <prefix>_1.exr and
 // <prefix>_2.exr (row t = 0 at the top), each atomically.
-Status writePublishedExr(const PublishedTable& table, const std::string& prefix);
+BakeStatus writePublishedExr(const PublishedTable& table, const std::string& prefix);
 
 // Reads a table in the published layout from two square RGBA images of equal size (any float or
 // integer format OpenImageIO reads; EXR in practice). Safe on untrusted files: sizes are checked

@@ -69,7 +69,7 @@ double effectiveCell(MapKind kind, const MapParams& params);
 
 // Checks the parameters that `kind` uses; the error (kBadArgument) names the parameter, its value
 // and the accepted range. Parameters the kind does not use are not checked.
-Status validateMapParams(MapKind kind, const MapParams& params);
+BakeStatus validateMapParams(MapKind kind, const MapParams& params);
 
 // Generates the map (wrap mode repeat, unit normals, n_z > 0). The parameters must pass
 // validateMapParams (checked: violating it aborts). Multithreaded with TBB; the result is

@@ -46,7 +46,7 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
 // format::checkFlakesRecord before it is written. *bytes (may be null) receives the raw section size.
 // Errors: kBadArgument (a record the check refuses: map too large, rate, sigma_r or hand-over out of
 // range), kIo (the writer failed).
-Status writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
-                          const FlakesHandover& handover, uint64_t* bytes);
+BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
+                              const FlakesHandover& handover, uint64_t* bytes);
 
 }  // namespace glintbake::bake::ndf

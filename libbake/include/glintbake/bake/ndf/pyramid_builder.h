@@ -59,7 +59,7 @@ struct PyramidOptions {
 };
 
 // Validates the options (kBadArgument with a message naming the option).
-Status validatePyramidOptions(const PyramidOptions& options);
+BakeStatus validatePyramidOptions(const PyramidOptions& options);
 
 struct LevelGeometry {
   int grid_width = 0, grid_height = 0;
@@ -114,9 +114,9 @@ struct PyramidChunk {
 class PyramidSink {
  public:
   virtual ~PyramidSink() = default;
-  virtual Status addLevel(const format::NdfLevelRecord& record) = 0;
-  virtual Status addChunk(const PyramidChunk& chunk) = 0;
-  virtual Status endLevel(int level) { return (void)level, okStatus(); }
+  virtual BakeStatus addLevel(const format::NdfLevelRecord& record) = 0;
+  virtual BakeStatus addChunk(const PyramidChunk& chunk) = 0;
+  virtual BakeStatus endLevel(int level) { return (void)level, okStatus(); }
   // Bytes the sink has written so far (for PyramidLevelReport::stored_bytes; 0 if it writes none).
   virtual uint64_t storedBytes() const { return 0; }
 };
@@ -127,8 +127,8 @@ class PyramidSink {
 class WriterPyramidSink final : public PyramidSink {
  public:
   explicit WriterPyramidSink(format::Writer& writer) : writer_(writer) {}
-  Status addLevel(const format::NdfLevelRecord& record) override;
-  Status addChunk(const PyramidChunk& chunk) override;
+  BakeStatus addLevel(const format::NdfLevelRecord& record) override;
+  BakeStatus addChunk(const PyramidChunk& chunk) override;
   uint64_t storedBytes() const override { return writer_.bytesWritten(); }
 
  private:
@@ -139,14 +139,15 @@ class WriterPyramidSink final : public PyramidSink {
 // Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an
 // open writer (the caller adds metadata and calls finish()). Errors: kBadArgument (options),
 // kRuntime (cancelled, out of memory), kIo (writer failure).
-Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
-                       PyramidReport* report, const PyramidProgress& progress = {},
-                       const std::atomic<bool>* cancel = nullptr);
+BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
+                           PyramidReport* report, const PyramidProgress& progress = {},
+                           const std::atomic<bool>* cancel = nullptr);
 
 // The same, streaming every level and chunk into `sink` instead (the builder's determinism holds:
 // the sink sees identical data whatever the thread count). Errors: those above, plus whatever the
 // sink returns.
-Status buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport* report,
-                       const PyramidProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
+BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink,
+                           PyramidReport* report, const PyramidProgress& progress = {},
+                           const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace glintbake::bake::ndf

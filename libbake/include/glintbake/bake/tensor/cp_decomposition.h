@@ -109,7 +109,7 @@ struct CpOptions {
 };
 
 // Validates ranges (kBadArgument naming the option).
-Status validateCpOptions(const CpOptions& options);
+BakeStatus validateCpOptions(const CpOptions& options);
 
 // A rank-R model of one group. Matrices are row-major: A(i, r) = a[i * rank + r] (bins x rank),
 // B(j, r) = b[j * rank + r], C(k, r) = c[k * rank + r] (blocks x rank, lambda folded in).

@@ -69,7 +69,7 @@ struct TensorPackOptions {
 };
 
 // Validates ranges (kBadArgument naming the option, as the tool spells it).
-Status validateTensorPackOptions(const TensorPackOptions& options);
+BakeStatus validateTensorPackOptions(const TensorPackOptions& options);
 
 struct TensorPackLevelReport {
   int level = 0;
@@ -112,15 +112,16 @@ struct TensorPackReport {
 // section of the asset except the metadata. `progress` is the builder's (per chunk). Errors:
 // kBadArgument (options), kInvalidInput (every block of the pyramid blank), kRuntime (cancelled,
 // CP failure, out of memory), kIo (writer failure).
-Status packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
-                            format::Writer& writer, TensorPackReport* report, const ndf::PyramidProgress& progress = {},
-                            const std::atomic<bool>* cancel = nullptr);
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
+                                const ndf::PyramidProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
 
 // From an ndf-pyramid container (reads one chunk at a time). The output is byte-identical to
 // packTensorNdfFromMap with the pyramid options that built the container. Errors: as above, plus
 // kInvalidInput for a container that is not a valid ndf-pyramid and kIo for read failures.
-Status packTensorNdfFromPyramid(const format::Reader& pyramid, const TensorPackOptions& options, format::Writer& writer,
-                                TensorPackReport* report, const std::atomic<bool>* cancel = nullptr);
+BakeStatus packTensorNdfFromPyramid(const format::Reader& pyramid, const TensorPackOptions& options,
+                                    format::Writer& writer, TensorPackReport* report,
+                                    const std::atomic<bool>* cancel = nullptr);
 
 // IEEE 754 binary16 conversion (the container library's codec, glintbake/format/binary16.h).
 using format::floatToHalf;

@@ -18,16 +18,16 @@ inline int exitCodeOf(const bake::Error& error) { return exitCodeOf(error.code);
 
 // Container reads: kIoError -> 2, kUnsupportedVersion -> 5, kInvalidArgument and kNotFound -> 1,
 // anything else (a corrupt or foreign file) -> 3.
-inline int exitCodeOf(format::Status status) {
+inline int exitCodeOf(format::ContainerStatus status) {
   switch (status) {
-    case format::Status::kOk:
+    case format::ContainerStatus::kOk:
       return kExitOk;
-    case format::Status::kIoError:
+    case format::ContainerStatus::kIoError:
       return kExitIo;
-    case format::Status::kUnsupportedVersion:
+    case format::ContainerStatus::kUnsupportedVersion:
       return kExitUnsupported;
-    case format::Status::kInvalidArgument:
-    case format::Status::kNotFound:
+    case format::ContainerStatus::kInvalidArgument:
+    case format::ContainerStatus::kNotFound:
       return kExitBadArguments;
     default:
       return kExitInvalidInput;
@@ -36,16 +36,16 @@ inline int exitCodeOf(format::Status status) {
 
 // Runtime opens: kIoError -> 2, kWrongKind and kUnsupportedVersion -> 5, kOutOfMemory -> 4,
 // anything else (malformed asset) -> 3.
-inline int exitCodeOf(runtime::Status status) {
+inline int exitCodeOf(runtime::RuntimeStatus status) {
   switch (status) {
-    case runtime::Status::kOk:
+    case runtime::RuntimeStatus::kOk:
       return kExitOk;
-    case runtime::Status::kIoError:
+    case runtime::RuntimeStatus::kIoError:
       return kExitIo;
-    case runtime::Status::kWrongKind:
-    case runtime::Status::kUnsupportedVersion:
+    case runtime::RuntimeStatus::kWrongKind:
+    case runtime::RuntimeStatus::kUnsupportedVersion:
       return kExitUnsupported;
-    case runtime::Status::kOutOfMemory:
+    case runtime::RuntimeStatus::kOutOfMemory:
       return kExitRuntime;
     default:
       return kExitInvalidInput;
@@ -54,7 +54,7 @@ inline int exitCodeOf(runtime::Status status) {
 
 // Throws cli::Error with the error's exit code and message (prefixed by `context` when given)
 // if the result failed; unwrap returns the value otherwise.
-inline void check(const bake::Status& status, const std::string& context = "") {
+inline void check(const bake::BakeStatus& status, const std::string& context = "") {
   if (!status.ok()) throw Error(exitCodeOf(status.error()), context + status.error().message);
 }
 template <typename T>

@@ -6,6 +6,6 @@
 
 namespace glintbake::cli {
 
-inline int exitCodeOfRuntime(runtime::Status status) { return exitCodeOf(status); }
+inline int exitCodeOfRuntime(runtime::RuntimeStatus status) { return exitCodeOf(status); }
 
 }  // namespace glintbake::cli
