@@ -26,8 +26,8 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile) {
   }
   h.flakes_up_to = kFlakesUpTo;
   h.lobes_per_tile = lobes_per_tile;
-  h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, sigma0 / kHalfOctave);
-  h.pyramid_from = std::max(sigma0, h.lobes_up_to);
+  h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, sigma0 * kHalfOctave);
+  h.pyramid_from = std::max(2.0 * sigma0, h.lobes_up_to);
   return h;
 }
 
@@ -43,8 +43,10 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   if (first == levels) {
     h.lobes_up_to = h.pyramid_from = kLobesUnbounded;
   } else {
-    h.pyramid_from = std::max(level_sigmas[first], kFlakesUpTo * format::kLobesBand);
-    h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, h.pyramid_from / kHalfOctave);
+    // As for an uncompressed pyramid: between the centres of its first level the pyramid blends
+    // images, so the lobes answer up to sqrt(2) x its sigma and the pyramid alone from 2 x.
+    h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, level_sigmas[first] * kHalfOctave);
+    h.pyramid_from = std::max(2.0 * level_sigmas[first], h.lobes_up_to);
   }
   return h;
 }

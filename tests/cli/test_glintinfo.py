@@ -142,19 +142,29 @@ class GlintinfoTest(clitest.ToolTestCase):
     def test_info_footprint_ranges(self):
         # NDF assets say their map and which footprints each path answers.
         nmap = self.mapgen("beckmann", "b.exr", "--size", "32", "--seed", "3")
-        for flakes in (True, False):
+        for flakes, lobes in ((True, 16), (True, 0), (False, 16)):
             asset = self.path("a.gbk")
             self.run_ok("ndfgen", nmap, "-o", asset, "--stride", "8", "--sigma0", "4", "--levels", "2", "--ndf-res", "32",
-                        "--quiet", *([] if flakes else ["--no-flakes"]))
+                        "--lobes", str(lobes), "--quiet", *([] if flakes else ["--no-flakes"]))
             doc = self.run_json("glintinfo", "info", asset, schema="glintinfo-info.schema.json")
             self.assertEqual(doc["map"], {"width": 32, "height": 32, "wrap": "repeat"})
             fp = doc["footprints"]
             self.assertEqual((fp["levels"], fp["pyramid_min_sigma"], fp["pyramid_max_sigma"]), (2, 4.0, 8.0))
             self.assertEqual(fp["exact_max_sigma"], 4.0 if flakes else 0.0)
-            self.assertAlmostEqual(fp["handover_max_sigma"], 4.0 * 2 ** 0.5 if flakes else 0.0)
+            if flakes and lobes:
+                # Flakes to 4, the lobes from 4 sqrt(2) to sqrt(2) sigma0 (the larger), the pyramid from 2 sigma0.
+                self.assertAlmostEqual(fp["clustered_min_sigma"], 4.0 * 2 ** 0.5)
+                self.assertAlmostEqual(fp["clustered_max_sigma"], 4.0 * 2 ** 0.5)
+                self.assertEqual(fp["lobes_per_tile"], 16)
+                self.assertAlmostEqual(fp["handover_max_sigma"], 8.0)
+            else:
+                self.assertEqual(fp["clustered_max_sigma"], 0.0)
+                self.assertAlmostEqual(fp["handover_max_sigma"], 4.0 * 2 ** 0.5 if flakes else 0.0)
             self.assertTrue(fp["unbounded_above_top"])
             out, _ = self.run_ok("glintinfo", "info", asset)
             self.assertIn("exact from the flakes" if flakes else "no flakes", out)
+            if flakes and lobes:
+                self.assertIn("clustered lobes (16 per tile)", out)
         # Containers without levels have neither.
         doc = self.run_json("glintinfo", "info", self.image_container("c.gbk"), schema="glintinfo-info.schema.json")
         self.assertNotIn("footprints", doc)

@@ -22,6 +22,9 @@ constexpr double kTileRatio = 0.5;  // a footprint is answered on tiles of at mo
 // about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
 constexpr double kWindowSigmas = 3.0;
 constexpr double kMaxSpatial = kWindowSigmas * kWindowSigmas / 2;
+// The footprint weights are scaled by the inverse of the share of a Gaussian inside the window
+// (1 - e^-4.5), so that the NDF of a footprint inside the map integrates to 1 as on every path.
+const double kWindowNorm = 1.0 / (1.0 - std::exp(-kMaxSpatial));
 constexpr double kMaxExponent = 18.0;  // lobes below e^-18 of their peak at s are left out
 constexpr int kMaxWindowTiles = 40;    // tiles per side of a window at most
 constexpr int kLloydPasses = 4;
@@ -451,7 +454,7 @@ void LobeNdf::Impl::forEachLobe(const Block& b, const Bound& bound, double bx, d
     g.cyy = std::max(double(b.syy[i]) - (h10 * s10 + h11 * s11), 1e-12);
     const double lim = std::sqrt(g.cxx * g.cyy) * 0.999999;
     g.cxy = std::clamp(g.cxy, -lim, lim);
-    visit(g, double(b.w[i]) * std::exp(-spatial) / (kTwoPi * std::sqrt(det_a)));
+    visit(g, kWindowNorm * double(b.w[i]) * std::exp(-spatial) / (kTwoPi * std::sqrt(det_a)));
   }
 }
 
@@ -500,7 +503,7 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
     acc.store(lanes);
     sum += (double(lanes[0]) + double(lanes[1])) + (double(lanes[2]) + double(lanes[3]));
   });
-  return sum / (kTwoPi * kTwoPi);
+  return sum * kWindowNorm / (kTwoPi * kTwoPi);
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {

@@ -27,7 +27,7 @@ using runtime::SPoint;
 
 // Writes an ndf-pyramid of `map` (sigma0 4, stride 8, 2 levels, R 32) with the flakes of `flakes_map`.
 std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes_map, const std::string& name,
-                       bool with_flakes = true) {
+                       bool with_flakes = true, int lobes = 0) {
   bake::ndf::PyramidOptions o;
   o.splat.ndf_res = 32;
   o.stride0 = 8;
@@ -39,7 +39,7 @@ std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
   if (with_flakes) {
     EXPECT_TRUE(
-        bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0, 0), nullptr)
+        bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0, lobes), nullptr)
             .ok());
   }
   EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
@@ -105,6 +105,43 @@ TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
     ASSERT_EQ(asset->eval(fp, smp.s, &e), RuntimeStatus::kOk);
     EXPECT_EQ(pdf, smp.pdf);
     EXPECT_NEAR(pdf * m, e, 1e-12 * e);
+  }
+}
+
+TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
+  const bake::NormalMap map = beckmann(32, 4);
+  std::unique_ptr<runtime::NdfSource> asset, pyramid;
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "l.gbk", true, 16).c_str(), &asset), RuntimeStatus::kOk);
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "q.gbk", false).c_str(), &pyramid), RuntimeStatus::kOk);
+  // sigma0 4: flakes to 4, the lobes alone at 4 sqrt(2), the pyramid alone from 8.
+  const runtime::FootprintRange r = asset->footprintRange();
+  EXPECT_EQ(r.exact_max_sigma, 4.0);
+  EXPECT_NEAR(r.clustered_min_sigma, 4.0 * std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(r.clustered_max_sigma, 4.0 * std::sqrt(2.0), 1e-12);
+  EXPECT_EQ(r.handover_max_sigma, 8.0);
+  const SPoint s{0.05, -0.03};
+  double a = 0.0, b = 0.0;
+  ASSERT_EQ(asset->eval({13.2, 7.7, 9.0}, s, &a), RuntimeStatus::kOk);
+  ASSERT_EQ(pyramid->eval({13.2, 7.7, 9.0}, s, &b), RuntimeStatus::kOk);
+  EXPECT_EQ(a, b);
+  // Both bands (flakes to lobes, lobes to pyramid): sample, pdf, eval and mass agree, and the
+  // mass of the blend stays that of a footprint inside the map.
+  for (double sigma : {4.7, 6.8}) {
+    const Footprint fp{13.2, 7.7, sigma};
+    double m = 0.0;
+    ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
+    EXPECT_NEAR(m, 1.0, 0.01) << sigma;
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < 200; ++i) {
+      runtime::NdfSample smp;
+      ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
+      double pdf = -1.0, e = -1.0;
+      ASSERT_EQ(asset->pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
+      ASSERT_EQ(asset->eval(fp, smp.s, &e), RuntimeStatus::kOk);
+      EXPECT_EQ(pdf, smp.pdf);
+      EXPECT_NEAR(pdf * m, e, 1e-12 * e);
+    }
   }
 }
 

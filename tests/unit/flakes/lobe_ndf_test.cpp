@@ -1,0 +1,230 @@
+// LobeNdf (runtime) against the exact flakes: a lobe of one flake is that flake (so level 0, where
+// every flake keeps its own lobe, is exact but for the window), clustered levels stay close, a
+// flat map gives the intrinsic Gaussian, a rotated map rotates the NDF, samples follow their pdf
+// (chi-square) with pdf == eval / mass, and the asset's hand-overs stay consistent.
+#include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/bake/ndf/flakes_section.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/format/container.h>
+#include <glintbake/reference/pndf.h>
+#include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/lobe_ndf.h>
+
+#include "../../stats/chi_square.h"
+#include "../reference/test_maps.h"
+#include "../temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+namespace glintbake {
+namespace {
+
+using runtime::Footprint;
+using runtime::LobeNdf;
+using runtime::RuntimeStatus;
+using runtime::SPoint;
+
+runtime::InterleavedTexels mapTexels(const bake::NormalMap& map) {
+  return runtime::InterleavedTexels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(), 3);
+}
+
+bake::NormalMap mapOf(bake::MapKind kind, int size, uint64_t seed) {
+  bake::MapParams p;
+  p.size = size;
+  p.seed = seed;
+  return bake::generateMap(kind, p);
+}
+
+// Relative L1 distance between two images.
+double relativeL1(const std::vector<float>& a, const std::vector<float>& ref) {
+  double num = 0.0, den = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    num += std::fabs(double(a[i]) - double(ref[i]));
+    den += std::fabs(double(ref[i]));
+  }
+  return num / den;
+}
+
+struct Pair {
+  bake::NormalMap map;
+  runtime::FlakeNdf flakes;
+  LobeNdf lobes;
+  int res;
+  Pair(bake::NormalMap m, int lobes_per_tile, int r = 64) : map(std::move(m)), res(r) {
+    const auto texels = mapTexels(map);
+    EXPECT_EQ(flakes.build(texels, 1, reference::kDefaultSigmaR, res), RuntimeStatus::kOk);
+    EXPECT_EQ(lobes.build(texels, 1, reference::kDefaultSigmaR, lobes_per_tile, res), RuntimeStatus::kOk);
+  }
+  double imageError(const Footprint& fp) const {
+    std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
+    EXPECT_EQ(lobes.image(fp, a.data(), a.size()), RuntimeStatus::kOk);
+    EXPECT_EQ(flakes.image(fp, b.data(), b.size()), RuntimeStatus::kOk);
+    return relativeL1(a, b);
+  }
+};
+
+TEST(LobeNdf, UnclusteredLevelIsTheExactFlakesButForTheWindow) {
+  // 16 lobes per tile keep every flake of a 4 x 4 tile: the only difference to the exact path is
+  // the 3-sigma window (about 1% of the mass).
+  for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kScratches}) {
+    Pair p(mapOf(kind, 64, 5), 16);
+    for (double sigma : {4.0, 7.0}) {
+      ASSERT_EQ(p.lobes.tileFor(sigma), 4);
+      const Footprint fp{21.3, 40.8, sigma};
+      EXPECT_LT(p.imageError(fp), 0.03) << "kind " << int(kind) << " sigma " << sigma;
+      double ml = 0.0, mf = 0.0;
+      ASSERT_EQ(p.lobes.mass(fp, &ml), RuntimeStatus::kOk);
+      ASSERT_EQ(p.flakes.mass(fp, &mf), RuntimeStatus::kOk);
+      EXPECT_NEAR(ml / mf, 1.0, 0.01);
+    }
+  }
+}
+
+TEST(LobeNdf, ClusteredLevelsStayCloseToTheExactFlakes) {
+  for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kBrushed}) {
+    Pair p(mapOf(kind, 128, 8), 16);
+    for (double sigma : {16.0, 24.0}) {
+      EXPECT_GT(p.lobes.tileFor(sigma), 4);
+      const double e = p.imageError({70.2, 33.9, sigma});
+      EXPECT_LT(e, 0.2) << "kind " << int(kind) << " sigma " << sigma;
+      std::printf("kind %d sigma %g: relative L1 %.3f\n", int(kind), sigma, e);
+    }
+  }
+}
+
+TEST(LobeNdf, FlatMapIsTheIntrinsicGaussian) {
+  const bake::NormalMap map = reference::testing::constantMap(64, 64, 0.1, -0.2);
+  const auto texels = mapTexels(map);
+  LobeNdf ndf;
+  ASSERT_EQ(ndf.build(texels, 1, reference::kDefaultSigmaR, 8, 64), RuntimeStatus::kOk);
+  const double sr = reference::kDefaultSigmaR;
+  for (double sigma : {6.0, 15.0, 40.0}) {
+    const Footprint fp{17.0, 9.0, sigma};
+    double mass = 0.0;
+    ASSERT_EQ(ndf.mass(fp, &mass), RuntimeStatus::kOk);
+    EXPECT_NEAR(mass, 1.0, 2e-3) << sigma;
+    const float nx = float(0.1), ny = float(-0.2);
+    for (SPoint s : {SPoint{0.1, -0.2}, SPoint{0.104, -0.197}, SPoint{0.09, -0.21}}) {
+      double v = 0.0;
+      ASSERT_EQ(ndf.eval(fp, s, &v), RuntimeStatus::kOk);
+      const double d2 = (s.x - nx) * (s.x - nx) + (s.y - ny) * (s.y - ny);
+      const double expected = std::exp(-d2 / (2 * sr * sr)) / (2 * M_PI * sr * sr);
+      EXPECT_NEAR(v / mass, expected, 1e-3 * expected + 1e-6);
+    }
+  }
+}
+
+TEST(LobeNdf, RotatedMapRotatesTheNdf) {
+  // Rotating the map by 90 degrees (texel (x, y) -> (h - 1 - y, x), normal (nx, ny) -> (-ny, nx))
+  // rotates the NDF at the rotated footprint centre.
+  const bake::NormalMap map = mapOf(bake::MapKind::kBeckmann, 64, 13);
+  bake::NormalMap rot = map;
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      const float* n = map.normals.data() + (size_t(y) * map.width + x) * 3;
+      float* r = rot.normals.data() + (size_t(x) * map.width + (map.height - 1 - y)) * 3;
+      r[0] = -n[1];
+      r[1] = n[0];
+      r[2] = n[2];
+    }
+  }
+  const auto ta = mapTexels(map), tb = mapTexels(rot);
+  LobeNdf a, b;
+  ASSERT_EQ(a.build(ta, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  ASSERT_EQ(b.build(tb, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  const double ux = 20.0, uy = 36.0;  // a multiple of the tile side: the same tiles after rotation
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> any(-0.3, 0.3);
+  double num = 0.0, den = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const SPoint s{any(rng), any(rng)};
+    double va = 0.0, vb = 0.0;
+    ASSERT_EQ(a.eval({ux, uy, 6.0}, s, &va), RuntimeStatus::kOk);
+    ASSERT_EQ(b.eval({64.0 - uy, ux, 6.0}, {-s.y, s.x}, &vb), RuntimeStatus::kOk);
+    num += std::fabs(va - vb);
+    den += va;
+  }
+  EXPECT_LT(num / den, 1e-3);
+}
+
+TEST(LobeNdf, SamplesFollowTheirPdf) {
+  Pair p(mapOf(bake::MapKind::kBeckmann, 128, 21), 16, 32);
+  for (double sigma : {6.0, 14.0}) {
+    const Footprint fp{40.5, 22.25, sigma};
+    double mass = 0.0;
+    ASSERT_EQ(p.lobes.mass(fp, &mass), RuntimeStatus::kOk);
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    struct S {
+      double sx, sy;
+    };
+    std::vector<S> samples;
+    for (int i = 0; i < 20000; ++i) {
+      runtime::NdfSample smp;
+      ASSERT_EQ(p.lobes.sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
+      double pdf = -1.0, e = -1.0;
+      ASSERT_EQ(p.lobes.pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
+      ASSERT_EQ(p.lobes.eval(fp, smp.s, &e), RuntimeStatus::kOk);
+      EXPECT_EQ(pdf, smp.pdf);
+      EXPECT_NEAR(pdf * mass, e, 1e-12 * e);
+      samples.push_back({smp.s.x, smp.s.y});
+    }
+    std::vector<float> img(32 * 32);
+    ASSERT_EQ(p.lobes.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
+    const std::vector<double> image(img.begin(), img.end());
+    const stats::ChiSquareResult r = stats::chiSquareNdfTest(samples, image, 32, mass);
+    EXPECT_GT(r.p_value, 0.01) << "sigma " << sigma << ": " << r.message;
+  }
+}
+
+TEST(LobeNdf, AverageIsTheMeanOfTheImageBins) {
+  Pair p(mapOf(bake::MapKind::kFlakes, 64, 3), 8, 32);
+  const Footprint fp{30.0, 12.5, 9.0};
+  std::vector<float> img(32 * 32);
+  ASSERT_EQ(p.lobes.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
+  const double bin = 2.0 / 32;
+  for (int j = 8; j < 24; j += 3) {
+    for (int i = 8; i < 24; i += 3) {
+      const runtime::SRect r{-1.0 + i * bin, 1.0 - (j + 1) * bin, -1.0 + (i + 1) * bin, 1.0 - j * bin};
+      double avg = 0.0;
+      ASSERT_EQ(p.lobes.average(fp, r, &avg), RuntimeStatus::kOk);
+      EXPECT_NEAR(avg, img[size_t(j) * 32 + i], 1e-4 * avg + 1e-6);
+    }
+  }
+}
+
+TEST(LobeNdf, DeterministicAndRejectsBadArguments) {
+  const bake::NormalMap map = mapOf(bake::MapKind::kScratches, 64, 4);
+  const auto texels = mapTexels(map);
+  LobeNdf a, b;
+  ASSERT_EQ(a.build(texels, 1, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kOk);
+  ASSERT_EQ(b.build(texels, 1, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kOk);
+  for (double sigma : {5.0, 12.0, 30.0}) {
+    double va = 0.0, vb = 0.0;
+    ASSERT_EQ(a.eval({3.0, 60.0, sigma}, {0.01, 0.02}, &va), RuntimeStatus::kOk);
+    ASSERT_EQ(b.eval({3.0, 60.0, sigma}, {0.01, 0.02}, &vb), RuntimeStatus::kOk);
+    EXPECT_EQ(va, vb);
+  }
+  double v = 0.0;
+  EXPECT_EQ(a.eval({1.0, 1.0, std::nan("")}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(a.eval({1.0, 1.0, 4.0}, {std::nan(""), 0}, &v), RuntimeStatus::kInvalidArgument);
+  const double too_large = a.footprintRange().clustered_max_sigma * 1.5;
+  EXPECT_EQ(a.eval({1.0, 1.0, too_large}, {0, 0}, &v), RuntimeStatus::kInvalidArgument);
+  LobeNdf c;
+  EXPECT_EQ(c.build(texels, 1, reference::kDefaultSigmaR, 0, 32), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(c.build(texels, 1, reference::kDefaultSigmaR, 17, 32), RuntimeStatus::kInvalidArgument);
+  EXPECT_EQ(c.build(texels, 0, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kInvalidArgument);
+  std::vector<float> bad = map.normals;
+  bad[7] = std::nanf("");
+  const runtime::InterleavedTexels bad_texels(map.width, map.height, true, bad.data(), 3);
+  EXPECT_EQ(c.build(bad_texels, 1, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kInvalidArgument);
+  EXPECT_FALSE(c.isBuilt());
+}
+
+}  // namespace
+}  // namespace glintbake
