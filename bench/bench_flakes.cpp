@@ -7,6 +7,7 @@
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/lobe_ndf.h>
 
 #include <benchmark/benchmark.h>
 
@@ -33,6 +34,7 @@ struct Subject {
   std::string name;
   bake::NormalMap map;
   rt::FlakeNdf ndf;
+  rt::LobeNdf lobes;
   glintbake::reference::FlakeSet set;
 };
 
@@ -67,6 +69,7 @@ std::vector<std::unique_ptr<Subject>>& subjects() {
     for (auto& s : v) {
       const auto texels = mapTexels(s->map);
       if (s->ndf.build(texels, 1, 0.005, 128) != rt::RuntimeStatus::kOk) std::abort();
+      if (s->lobes.build(texels, 1, 0.005, 16, 128) != rt::RuntimeStatus::kOk) std::abort();
       s->set = glintbake::reference::buildFlakes(s->map, 1);
     }
     return v;
@@ -122,6 +125,31 @@ void sampleBench(benchmark::State& state, size_t subject, double sigma) {
   }
 }
 
+// The clustered lobes (lobe_ndf.h) at the defaults (16 lobes per tile), at the same queries.
+void lobeEvalBench(benchmark::State& state, size_t subject, double sigma) {
+  const Subject& s = *subjects()[subject];
+  const std::vector<Query> q = queries(s, sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    double v;
+    s.lobes.eval(q[i].fp, q[i].s, &v);
+    benchmark::DoNotOptimize(v);
+    i = (i + 1) & 1023;
+  }
+}
+
+void lobeSampleBench(benchmark::State& state, size_t subject, double sigma) {
+  const Subject& s = *subjects()[subject];
+  const std::vector<Query> q = queries(s, sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    rt::NdfSample smp;
+    s.lobes.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
+    benchmark::DoNotOptimize(smp);
+    i = (i + 1) & 1023;
+  }
+}
+
 void referenceBench(benchmark::State& state, size_t subject, double sigma) {
   const Subject& s = *subjects()[subject];
   const std::vector<Query> q = queries(s, sigma);
@@ -141,6 +169,12 @@ const int registered = [] {
       const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
       benchmark::RegisterBenchmark(("flake_eval/" + tag).c_str(), evalBench, k, sigma);
       benchmark::RegisterBenchmark(("flake_sample/" + tag).c_str(), sampleBench, k, sigma);
+    }
+    for (double sigma : {6.0, 12.0, 24.0, 48.0}) {
+      const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
+      benchmark::RegisterBenchmark(("lobe_eval/" + tag).c_str(), lobeEvalBench, k, sigma)->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("lobe_sample/" + tag).c_str(), lobeSampleBench, k, sigma)
+          ->Unit(benchmark::kMicrosecond);
     }
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
         ->Unit(benchmark::kMicrosecond);
