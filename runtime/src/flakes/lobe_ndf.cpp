@@ -17,7 +17,7 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
 constexpr int kFinestTile = 4;      // flakes per side of a level-0 tile
-constexpr double kTileRatio = 0.5;  // a footprint is answered on tiles of at most this x its std
+constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
 // Spatial truncation, in standard deviations of a lobe's footprint weight: the lobes beyond hold
 // about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
 constexpr double kWindowSigmas = 3.0;

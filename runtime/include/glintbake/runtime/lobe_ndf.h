@@ -18,8 +18,8 @@
 // children, each into at most `lobes_per_tile` lobes by k-means (deterministic farthest-point
 // seeds, four Lloyd passes) on the lobe normal means and spreads (the std of a lobe's normals, so
 // that the narrow inside of a flake and its wide edges stay apart), then moment matching. A
-// footprint is answered on the level whose tiles are at most half its std (so the footprint weight
-// varies little across a tile and 12-24 tiles span the window per side), from every lobe within
+// footprint is answered on the level whose tiles are at most 0.35 times its std (so the footprint
+// weight varies little across a tile and 19-36 tiles span the window per side), from every lobe within
 // 3 standard deviations of the footprint centre; tiles whose lobes cannot reach s are skipped.
 // The cost is then about constant in the footprint size: a few thousand lobes per query.
 //
