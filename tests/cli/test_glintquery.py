@@ -3,6 +3,7 @@
 import json
 import math
 import os
+import subprocess
 import tempfile
 
 import clitest
@@ -149,6 +150,22 @@ class GlintQuery(ToolTestCase):
         self.assertIn("error", lines[1])
         self.assertIn("error", lines[2])
         self.assertEqual(len([l for l in err.splitlines() if l.strip()]), 1)
+
+    def test_batch_hostile_lines(self):
+        # A deeply nested id and invalid UTF-8 each cost one error object (or a replaced character),
+        # never the whole batch.
+        deep = '{"op":"mass","x":1,"y":1,"sigma":2,"id":' + "[" * 100000 + "]" * 100000 + "}"
+        utf8 = b'{"op":"mass","x":1,"y":1,"sigma":2,"id":"\xff\xfe"}'
+        good = b'{"op":"mass","x":1,"y":1,"sigma":2}'
+        stdin = deep.encode() + b"\n" + utf8 + b"\n" + good + b"\n"
+        proc = subprocess.run([clitest.tool_path("glintquery"), "batch", self.asset], input=stdin, capture_output=True,
+                              timeout=120)
+        self.assertEqual(proc.returncode, clitest.INVALID)
+        lines = [json.loads(l) for l in proc.stdout.decode("utf-8").splitlines()]
+        self.assertEqual(len(lines), 3)
+        self.assertIn("nested deeper than 64", lines[0]["error"])
+        self.assertTrue("mass" in lines[1] or "error" in lines[1])
+        self.assertIn("mass", lines[2])
 
     def test_errors(self):
         self.assert_fails(clitest.IO, "glintquery", "point", self.path("none.gbk"), "--at", "1,1", "--sigma", "1",

@@ -2,6 +2,7 @@
 // (schemas/glintquery-batch.schema.json).
 #include "commands.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <iostream>
 #include <stdexcept>
@@ -104,6 +105,35 @@ Json answer(const rt::NdfSource& ndf, const Json& q) {
   return out;
 }
 
+// Deepest nesting of arrays and objects in a JSON text, outside strings, found by one scan (no
+// recursion, so any line is safe to measure before it is parsed).
+size_t nestingDepth(const std::string& text) {
+  size_t depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// A query line nested deeper than this is refused (its parse, echo and destruction would recurse
+// that deep).
+constexpr size_t kMaxQueryDepth = 64;
+
 }  // namespace
 
 CLI::App* addBatchCommand(CLI::App& app, BatchOptions& options) {
@@ -126,6 +156,8 @@ int runBatch(cli::Tool& tool, const BatchOptions& options) {
     ++count;
     Json out;
     try {
+      if (nestingDepth(line) > kMaxQueryDepth)
+        throw std::invalid_argument("the line is nested deeper than " + std::to_string(kMaxQueryDepth) + " levels");
       out = answer(*ndf.source, Json::parse(line));
     } catch (const std::exception& e) {
       ++failed;
@@ -134,7 +166,8 @@ int runBatch(cli::Tool& tool, const BatchOptions& options) {
       out = Json::object();
       out["error"] = msg;
     }
-    std::cout << out.dump() << "\n";
+    // Invalid UTF-8 (in an echoed id or a message quoting the line) is replaced, not fatal.
+    std::cout << out.dump(-1, ' ', false, Json::error_handler_t::replace) << "\n";
   }
   std::cout.flush();
   if (failed > 0) {
