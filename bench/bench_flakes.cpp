@@ -172,7 +172,8 @@ const int registered = [] {
     }
     for (double sigma : {6.0, 12.0, 24.0, 48.0}) {
       const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
-      benchmark::RegisterBenchmark(("lobe_eval/" + tag).c_str(), lobeEvalBench, k, sigma)->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("lobe_eval/" + tag).c_str(), lobeEvalBench, k, sigma)
+          ->Unit(benchmark::kMicrosecond);
       benchmark::RegisterBenchmark(("lobe_sample/" + tag).c_str(), lobeSampleBench, k, sigma)
           ->Unit(benchmark::kMicrosecond);
     }

@@ -4,6 +4,8 @@
 // texel on each side.
 #pragma once
 
+#include <glintbake/runtime/runtime.h>
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -55,6 +57,14 @@ inline void flakeAt(const float* normals, int w, int h, bool repeat, double ux, 
   j[1] = float((down[0] - up[0]) * 0.5);
   j[2] = float((right[1] - left[1]) * 0.5);
   j[3] = float((down[1] - up[1]) * 0.5);
+}
+
+// Query arguments shared by the flake and lobe evaluators.
+inline bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
+inline bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+inline bool validRect(const SRect& r) {
+  return std::isfinite(r.x0) && std::isfinite(r.x1) && std::isfinite(r.y0) && std::isfinite(r.y1) && r.x1 > r.x0 &&
+         r.y1 > r.y0;
 }
 
 }  // namespace glintbake::runtime::flakes

@@ -443,10 +443,9 @@ FootprintRange FlakeNdf::footprintRange() const {
 }
 double FlakeNdf::sigmaR() const { return impl_ ? impl_->sigma_r : 0.0; }
 
-namespace {
-bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
-bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
-}  // namespace
+using flakes::inSquare;
+using flakes::validPoint;
+using flakes::validRect;
 
 RuntimeStatus FlakeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
   if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
@@ -474,9 +473,7 @@ RuntimeStatus FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double*
 }
 
 RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
-      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !validRect(rect)) return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   FootprintTerms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
@@ -503,15 +500,6 @@ RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, d
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
   return RuntimeStatus::kOk;
-}
-
-RuntimeStatus FlakeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return RuntimeStatus::kInvalidArgument;
-  const int res = impl_->res;
-  const size_t n = size_t(res) * size_t(res);
-  if (!out || out_count < n) return RuntimeStatus::kInvalidArgument;
-  std::fill(out, out + n, 0.0f);
-  return addImage(footprint, 1.0, out, out_count);
 }
 
 RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {

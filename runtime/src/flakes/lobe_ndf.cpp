@@ -16,7 +16,7 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
-constexpr int kFinestTile = 4;      // flakes per side of a level-0 tile
+constexpr int kFinestTile = 4;       // flakes per side of a level-0 tile
 constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
 // Spatial truncation, in standard deviations of a lobe's footprint weight: the lobes beyond hold
 // about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
@@ -547,10 +547,9 @@ FootprintRange LobeNdf::footprintRange() const {
   return r;
 }
 
-namespace {
-bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
-bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
-}  // namespace
+using flakes::inSquare;
+using flakes::validPoint;
+using flakes::validRect;
 
 RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
   if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
@@ -578,9 +577,7 @@ RuntimeStatus LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* 
 }
 
 RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !std::isfinite(rect.x0) || !std::isfinite(rect.x1) ||
-      !std::isfinite(rect.y0) || !std::isfinite(rect.y1) || !(rect.x1 > rect.x0) || !(rect.y1 > rect.y0))
-    return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !validRect(rect)) return RuntimeStatus::kInvalidArgument;
   const Impl& m = *impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
@@ -596,14 +593,6 @@ RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, do
   }
   *value = integral / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
   return RuntimeStatus::kOk;
-}
-
-RuntimeStatus LobeNdf::image(const Footprint& footprint, float* out, size_t out_count) const {
-  if (!impl_) return RuntimeStatus::kInvalidArgument;
-  const size_t n = size_t(impl_->res) * size_t(impl_->res);
-  if (!out || out_count < n) return RuntimeStatus::kInvalidArgument;
-  std::fill(out, out + n, 0.0f);
-  return addImage(footprint, 1.0, out, out_count);
 }
 
 RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {

@@ -71,8 +71,8 @@ class FlakeNdf final : public AccumulatingNdfSource {
   RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
   RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus mass(const Footprint& footprint, double* value) const override;
-  // Cost: every flake of the window (no pruning by s); a few milliseconds at sigma_p = 8 texels.
-  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
+  // image() and addImage() cost every flake of the window (no pruning by s): a few milliseconds at
+  // sigma_p = 8 texels.
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:

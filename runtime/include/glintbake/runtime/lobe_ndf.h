@@ -75,7 +75,6 @@ class LobeNdf final : public AccumulatingNdfSource {
   RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
   RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus mass(const Footprint& footprint, double* value) const override;
-  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:

@@ -87,6 +87,13 @@ class AccumulatingNdfSource : public NdfSource {
   // Adds weight * image() to out (R * R floats); bins whose centre lies outside the unit disk are
   // left as they are.
   virtual RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const = 0;
+  // The R x R bins set to 0, then addImage() with weight 1.
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override {
+    const size_t n = size_t(resolution()) * size_t(resolution());
+    if (n == 0 || !out || out_count < n) return RuntimeStatus::kInvalidArgument;
+    for (size_t i = 0; i < n; ++i) out[i] = 0.0f;
+    return addImage(footprint, 1.0, out, out_count);
+  }
 };
 
 // Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf), chosen by the container's

@@ -16,15 +16,15 @@ namespace glintbake::format {
 struct FlakesRecord {
   uint32_t magic = 0x4B4C4647;  // "GFLK"
   uint32_t version = 2;         // 1: no clustered path (lobes_per_tile and lobes_up_to are ignored)
-  uint32_t map_width = 0;   // texels
-  uint32_t map_height = 0;  // texels
-  uint32_t wrap = 0;        // 0 repeat, 1 clamp: how the map continues beyond its edges
-  uint32_t rate = 1;        // flakes per texel side (1..16)
-  uint32_t precision = 0;   // 0: float32 normals (the only value)
+  uint32_t map_width = 0;       // texels
+  uint32_t map_height = 0;      // texels
+  uint32_t wrap = 0;            // 0 repeat, 1 clamp: how the map continues beyond its edges
+  uint32_t rate = 1;            // flakes per texel side (1..16)
+  uint32_t precision = 0;       // 0: float32 normals (the only value)
   uint32_t lobes_per_tile = 0;  // version 2: lobes per tile of the clustered path, 1..16; 0: none
-  double sigma_r = 0.0;       // intrinsic roughness, s-plane std of every flake (0, 1]
-  double flakes_up_to = 0.0;  // footprints with sigma <= this (texels) are answered by the flakes alone
-  double pyramid_from = 0.0;  // footprints with sigma >= this are answered by the pyramid alone
+  double sigma_r = 0.0;         // intrinsic roughness, s-plane std of every flake (0, 1]
+  double flakes_up_to = 0.0;    // footprints with sigma <= this (texels) are answered by the flakes alone
+  double pyramid_from = 0.0;    // footprints with sigma >= this are answered by the pyramid alone
   // Version 2 with lobes_per_tile > 0: the clustered lobes answer alone from kLobesBand x
   // flakes_up_to to this, and hand over to the pyramid from here to pyramid_from. Every band
   // blends its two paths linearly in log(sigma).

@@ -29,15 +29,15 @@ constexpr int kMaxLobesPerTile = 16;
 // The hand-over for a pyramid whose finest level has footprint std sigma0 (texels) and is faithful
 // from there on (an uncompressed pyramid). With lobes (1..16 per tile): the flakes answer up to 4
 // texels, the lobes from 4 sqrt(2) to sqrt(2) sigma0 (between the centres of its finest level the
-// pyramid blends images, a few percent off), and the pyramid alone from 2 sigma0. Without (lobes_per_tile 0): the flakes answer up to max(4, sigma0) and the pyramid takes
-// over across a half octave above that.
+// pyramid blends images, a few percent off), and the pyramid alone from 2 sigma0. Without (lobes_per_tile 0): the
+// flakes answer up to max(4, sigma0) and the pyramid takes over across a half octave above that.
 FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
 
 // The hand-over for a compressed pyramid: level_sigmas[l] is the footprint std of level l and
 // level_errors[l] the relative error of its compression. The pyramid answers from the first level
 // from which every level's error is at most max_level_error, as defaultHandover places it above
-// an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such level exists the lobes answer every footprint they can (the
-// runtime bounds them by their window) and the pyramid only above.
+// an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such level exists the
+// lobes answer every footprint they can (the runtime bounds them by their window) and the pyramid only above.
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
                                   double max_level_error, int lobes_per_tile);
 
