@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <new>
 
 namespace glintbake::runtime {
@@ -205,6 +206,12 @@ struct LobeNdf::Impl {
   // footprint-conditioned s-plane lobe and its footprint weight.
   template <typename Visit>
   void forEachLobe(const Block& b, const Bound& bound, double bx, double by, double sp2, Visit&& visit) const;
+  // The footprint-conditioned s-plane lobe of lane i and its footprint weight (scalar, double).
+  double lobeAt(const Block& b, int i, double bx, double by, double sp2, flakes::Lobe* g) const;
+  // The footprint weights of a block's lanes, four at a time (0 beyond the spatial truncation),
+  // written to lanes[kLanes]; returns their sum. mass and sample share it, so that sampling picks a
+  // lobe with exactly the probability its weight has in the mass.
+  double laneWeights(const Block& b, const Bound& bound, double bx, double by, double sp2, float* lanes) const;
   double evalAt(const Terms& t, double sx, double sy) const;
   double massOf(const Terms& t) const;
 };
@@ -432,30 +439,59 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   }
 }
 
+double LobeNdf::Impl::lobeAt(const Block& b, int i, double bx, double by, double sp2, flakes::Lobe* g) const {
+  const double a00 = double(b.uxx[i]) + sp2, a01 = b.uxy[i], a11 = double(b.uyy[i]) + sp2;
+  const double det_a = a00 * a11 - a01 * a01;
+  const double i00 = a11 / det_a, i01 = -a01 / det_a, i11 = a00 / det_a;
+  const double dx = bx - double(b.cx[i]), dy = by - double(b.cy[i]);
+  const double gx = i00 * dx + i01 * dy, gy = i01 * dx + i11 * dy;
+  const double spatial = 0.5 * (dx * gx + dy * gy);
+  const double s00 = b.s00[i], s01 = b.s01[i], s10 = b.s10[i], s11 = b.s11[i];
+  const double h00 = s00 * i00 + s01 * i01, h01 = s00 * i01 + s01 * i11;
+  const double h10 = s10 * i00 + s11 * i01, h11 = s10 * i01 + s11 * i11;
+  g->mx = double(b.mx[i]) + s00 * gx + s01 * gy;
+  g->my = double(b.my[i]) + s10 * gx + s11 * gy;
+  g->cxx = std::max(double(b.sxx[i]) - (h00 * s00 + h01 * s01), 1e-12);
+  g->cxy = double(b.sxy[i]) - (h00 * s10 + h01 * s11);
+  g->cyy = std::max(double(b.syy[i]) - (h10 * s10 + h11 * s11), 1e-12);
+  const double lim = std::sqrt(g->cxx * g->cyy) * 0.999999;
+  g->cxy = std::clamp(g->cxy, -lim, lim);
+  if (spatial > kMaxSpatial) return 0.0;
+  return kWindowNorm * double(b.w[i]) * std::exp(-spatial) / (kTwoPi * std::sqrt(det_a));
+}
+
 template <typename Visit>
 void LobeNdf::Impl::forEachLobe(const Block& b, const Bound& bound, double bx, double by, double sp2,
                                 Visit&& visit) const {
   for (uint32_t i = 0; i < bound.count; ++i) {
-    const double a00 = double(b.uxx[i]) + sp2, a01 = b.uxy[i], a11 = double(b.uyy[i]) + sp2;
-    const double det_a = a00 * a11 - a01 * a01;
-    const double i00 = a11 / det_a, i01 = -a01 / det_a, i11 = a00 / det_a;
-    const double dx = bx - double(b.cx[i]), dy = by - double(b.cy[i]);
-    const double gx = i00 * dx + i01 * dy, gy = i01 * dx + i11 * dy;
-    const double spatial = 0.5 * (dx * gx + dy * gy);
-    if (spatial > kMaxSpatial) continue;
-    const double s00 = b.s00[i], s01 = b.s01[i], s10 = b.s10[i], s11 = b.s11[i];
-    const double h00 = s00 * i00 + s01 * i01, h01 = s00 * i01 + s01 * i11;
-    const double h10 = s10 * i00 + s11 * i01, h11 = s10 * i01 + s11 * i11;
     flakes::Lobe g;
-    g.mx = double(b.mx[i]) + s00 * gx + s01 * gy;
-    g.my = double(b.my[i]) + s10 * gx + s11 * gy;
-    g.cxx = std::max(double(b.sxx[i]) - (h00 * s00 + h01 * s01), 1e-12);
-    g.cxy = double(b.sxy[i]) - (h00 * s10 + h01 * s11);
-    g.cyy = std::max(double(b.syy[i]) - (h10 * s10 + h11 * s11), 1e-12);
-    const double lim = std::sqrt(g.cxx * g.cyy) * 0.999999;
-    g.cxy = std::clamp(g.cxy, -lim, lim);
-    visit(g, kWindowNorm * double(b.w[i]) * std::exp(-spatial) / (kTwoPi * std::sqrt(det_a)));
+    const double w = lobeAt(b, int(i), bx, by, sp2, &g);
+    if (w > 0.0) visit(g, w);
   }
+}
+
+double LobeNdf::Impl::laneWeights(const Block& b, const Bound& bound, double bx, double by, double sp2,
+                                  float* lanes) const {
+  using flakes::F4;
+  const F4 vsp2 = F4::splat(float(sp2)), half = F4::splat(0.5f), spatial_cut = F4::splat(float(kMaxSpatial));
+  const F4 vbx = F4::splat(float(bx)), vby = F4::splat(float(by)), zero = F4::splat(0.0f);
+  const F4 scale = F4::splat(float(kWindowNorm / kTwoPi));
+  double sum = 0.0;
+  for (uint32_t h = 0; h < uint32_t(kLanes); h += 4) {
+    if (h >= bound.count) {
+      zero.store(lanes + h);
+      continue;
+    }
+    const F4 a00 = F4::load(b.uxx + h) + vsp2, a01 = F4::load(b.uxy + h), a11 = F4::load(b.uyy + h) + vsp2;
+    const F4 det_a = a00 * a11 - a01 * a01;
+    const F4 inv = F4::splat(1.0f) / det_a;
+    const F4 dx = vbx - F4::load(b.cx + h), dy = vby - F4::load(b.cy + h);
+    const F4 spatial = half * (a11 * dx * dx - F4::splat(2.0f) * a01 * dx * dy + a00 * dy * dy) * inv;
+    const F4 w = selectLess(spatial, spatial_cut, scale * F4::load(b.w + h) * flakes::expNeg4(spatial) / sqrt(det_a));
+    w.store(lanes + h);
+    sum += (double(lanes[h]) + double(lanes[h + 1])) + (double(lanes[h + 2]) + double(lanes[h + 3]));
+  }
+  return sum;
 }
 
 double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
@@ -508,8 +544,9 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
   double sum = 0.0;
+  float lanes[kLanes];
   forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
-    forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe&, double weight) { sum += weight; });
+    sum += laneWeights(b, bound, bx, by, t.sp2, lanes);
   });
   return sum;
 }
@@ -620,25 +657,51 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double total = m.massOf(t);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
-  // A lobe in proportion to its weight (the same traversal as massOf), u1 rescaled within it.
-  double target = u1 * total, v1 = 0.5;
+  // A tile in proportion to its mass, then a lane of it in proportion to its weight (the sums of
+  // massOf, tile by tile), u1 rescaled within the lane. Rounding that leaves the target past the
+  // end takes the last lobe of the last tile with mass.
+  double target = u1 * total, v1 = 0.99999999999999989;
+  flakes::Lobe picked{0.0, 0.0, 1.0, 0.0, 1.0};
+  float lanes[kLanes];
+  const Block* last_block = nullptr;
+  const Bound* last_bound = nullptr;
+  double last_bx = 0.0, last_by = 0.0;
   bool found = false;
-  flakes::Lobe picked{0.0, 0.0, 1.0, 0.0, 1.0}, last = picked;
+  auto pickIn = [&](const Block& b, const Bound& bound, double bx, double by) {
+    m.laneWeights(b, bound, bx, by, t.sp2, lanes);
+    int lane = -1;
+    for (uint32_t i = 0; i < bound.count; ++i) {
+      const double w = lanes[i];
+      if (!(w > 0.0)) continue;
+      lane = int(i);
+      if (target < w) {
+        v1 = std::clamp(target / w, 0.0, 0.99999999999999989);
+        break;
+      }
+      target -= w;
+    }
+    m.lobeAt(b, std::max(lane, 0), bx, by, t.sp2, &picked);
+    found = true;
+  };
   m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
     if (found) return;
-    m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double w) {
-      if (found || !(w > 0.0)) return;
-      last = g;
-      if (target < w) {
-        picked = g;
-        v1 = std::clamp(target / w, 0.0, 0.99999999999999989);
-        found = true;
-      } else {
-        target -= w;
-      }
-    });
+    const double tile_mass = m.laneWeights(b, bound, bx, by, t.sp2, lanes);
+    if (!(tile_mass > 0.0)) return;
+    if (target < tile_mass) {
+      pickIn(b, bound, bx, by);
+      return;
+    }
+    target -= tile_mass;
+    last_block = &b;
+    last_bound = &bound;
+    last_bx = bx;
+    last_by = by;
   });
-  if (!found) picked = last;  // rounding left the target past the last lobe
+  if (!found) {
+    if (!last_block || !last_bound) return RuntimeStatus::kInvalidArgument;  // no tile had mass
+    target = std::numeric_limits<double>::infinity();
+    pickIn(*last_block, *last_bound, last_bx, last_by);
+  }
   const double radius = std::sqrt(-2.0 * std::log1p(-v1));
   const double z0 = radius * std::cos(kTwoPi * u2), z1 = radius * std::sin(kTwoPi * u2);
   const double l11 = std::sqrt(picked.cxx), l21 = picked.cxy / l11;
