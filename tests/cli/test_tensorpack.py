@@ -154,7 +154,7 @@ class TensorPack(ToolTestCase):
                                "--json")
         doc = json.loads(out)
         clitest.validate(doc, "tensorpack.schema.json")
-        self.assertLessEqual(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertLessEqual(doc["gated_error"]["error"], 0.5)
         self.assertEqual(doc["warnings"], [])
         self.assertEqual(self.warnings_on_stderr(err), [])
         # Rank 1 leaves most of the structure: above the default bound 0.5, one warning line, the
@@ -163,7 +163,7 @@ class TensorPack(ToolTestCase):
         out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json")
         doc = json.loads(out)
         clitest.validate(doc, "tensorpack.schema.json")
-        self.assertGreater(max(doc["relative_error"], doc["max_group_error"]), 0.5)
+        self.assertGreater(doc["gated_error"]["error"], 0.5)
         self.assertEqual(len(doc["warnings"]), 1)
         self.assertIn("default bound 0.5", doc["warnings"][0])
         lines = self.warnings_on_stderr(err)
@@ -188,7 +188,7 @@ class TensorPack(ToolTestCase):
         m = self.mapgen("scratches", "s.png", "--size", "32", "--seed", "5")
         ref = self.path("ref.gbk")
         doc = self.run_json("tensorpack", m, "-o", ref, *PYRAMID, *PACK, schema="tensorpack.schema.json")
-        achieved = max(doc["relative_error"], doc["max_group_error"])
+        achieved = doc["gated_error"]["error"]
         # Exceeded: runtime failure, one line naming the achieved error, nothing written.
         out = self.path("gated.gbk")
         err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error",
@@ -202,6 +202,35 @@ class TensorPack(ToolTestCase):
         for bad in ("-1", "nan", "inf"):
             self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID, *PACK,
                               "--max-error", bad, outputs=[self.path("x.gbk")])
+
+    def test_gate_skips_the_levels_the_lobes_answer(self):
+        m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
+        # With lobes the gate covers only the levels the pyramid answers with: from the first
+        # level from which every level is within the faithful bound, or the top level alone.
+        doc = self.run_json("tensorpack", m, "-o", self.path("b.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
+                            schema="tensorpack.schema.json")
+        gated = doc["gated_error"]
+        self.assertIsNotNone(gated["from_sigma"])
+        sigmas = [lv["sigma"] for lv in doc["levels"]]
+        levels = [lv["relative_error"] for lv in doc["levels"]]
+        first = sigmas.index(gated["from_sigma"])
+        self.assertAlmostEqual(gated["error"], max(levels[first:]), places=12)
+        self.assertLessEqual(gated["error"], max(doc["relative_error"], doc["max_group_error"]))
+        # Without lobes every level answers and is gated.
+        doc = self.run_json("tensorpack", m, "-o", self.path("c.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
+                            "--lobes", "0", schema="tensorpack.schema.json")
+        self.assertIsNone(doc["gated_error"]["from_sigma"])
+        self.assertEqual(doc["gated_error"]["error"], max(doc["relative_error"], doc["max_group_error"]))
+
+    def test_from_container_keeps_the_lobes_of_its_source(self):
+        m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
+        for lobes in ("0", "4"):
+            src = self.path("p%s.gbk" % lobes)
+            self.run_ok("ndfgen", m, "-o", src, *PYRAMID, "--lobes", lobes, "--quiet")
+            out = self.path("t%s.gbk" % lobes)
+            self.run_ok("tensorpack", src, "-o", out, *PACK)
+            info = self.run_json("glintinfo", "info", out, "--json")
+            self.assertEqual(info["footprints"].get("lobes_per_tile", 0), int(lobes), info["footprints"])
 
     def test_bad_arguments(self):
         m = self.mapgen("beckmann", "m.png", "--size", "32")

@@ -69,31 +69,59 @@ std::string errorText(double e) {
   return text;
 }
 
-// The error a gate compares: the larger of the whole pyramid's relative error (dropped blocks
-// included) and the largest group's (its kept blocks).
-double gatedError(const tensor::TensorPackReport& r) { return std::max(r.relative_error, r.max_group_error); }
+// The error a gate compares: that of the compressed levels that answer footprints. Without lobes
+// every level answers: the larger of the whole pyramid's relative error (dropped blocks included)
+// and the largest group's (its kept blocks). With lobes, the levels the lobes stand in for never
+// answer (compressedHandover): the largest relative error of the levels the pyramid blends in
+// above lobes_up_to, or of the top level alone when the lobes answer every footprint their window
+// allows (the top level answers beyond it).
+struct GatedError {
+  double error = 0.0;
+  double from_sigma = 0.0;  // sigma of the first level gated
+  bool whole = true;        // every level answers
+};
 
-std::string achievedText(const tensor::TensorPackReport& r) {
-  return "relative error " + errorText(r.relative_error) + " (largest group " + errorText(r.max_group_error) + ")";
+GatedError gatedError(const tensor::TensorPackReport& r, const bake::ndf::FlakesHandover& h) {
+  GatedError g;
+  if (h.lobes_per_tile <= 0 || r.levels.empty()) {
+    g.error = std::max(r.relative_error, r.max_group_error);
+    return g;
+  }
+  g.whole = false;
+  size_t first = r.levels.size() - 1;
+  while (first > 0 && 2.0 * r.levels[first - 1].sigma > h.lobes_up_to) --first;
+  g.from_sigma = r.levels[first].sigma;
+  for (size_t l = first; l < r.levels.size(); ++l) g.error = std::max(g.error, r.levels[l].relative_error);
+  return g;
+}
+
+std::string achievedText(const tensor::TensorPackReport& r, const GatedError& g) {
+  if (g.whole)
+    return "relative error " + errorText(r.relative_error) + " (largest group " + errorText(r.max_group_error) + ")";
+  char sigma[32];
+  std::snprintf(sigma, sizeof(sigma), "%g", g.from_sigma);
+  return "relative error " + errorText(g.error) + " of the levels that answer footprints (sigma " + sigma +
+         " and up; the clustered lobes answer below)";
 }
 
 // --max-error: fails (runtime failure, before anything is written) when the gated error exceeds E.
-void checkMaxError(const tensor::TensorPackReport& r, double max_error, const std::string& input) {
-  if (max_error < 0.0 || !(gatedError(r) > max_error)) return;
-  throw Error(cli::kExitRuntime,
-              input + ": " + achievedText(r) + " exceeds --max-error " + errorText(max_error) + "; no output written");
+void checkMaxError(const tensor::TensorPackReport& r, const GatedError& g, double max_error, const std::string& input) {
+  if (max_error < 0.0 || !(g.error > max_error)) return;
+  throw Error(cli::kExitRuntime, input + ": " + achievedText(r, g) + " exceeds --max-error " + errorText(max_error) +
+                                     "; no output written");
 }
 
 // One warning when the gated error misses --error-target (when given) or the default bound.
-std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, double error_target, int rank) {
+std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, const GatedError& g, double error_target,
+                                         int rank) {
   std::vector<std::string> warnings;
   if (error_target >= 0.0) {
-    if (gatedError(r) > error_target) {
-      warnings.push_back(achievedText(r) + " misses --error-target " + errorText(error_target) + " at --rank " +
+    if (g.error > error_target) {
+      warnings.push_back(achievedText(r, g) + " misses --error-target " + errorText(error_target) + " at --rank " +
                          std::to_string(rank));
     }
-  } else if (gatedError(r) > kDefaultErrorBound) {
-    warnings.push_back(achievedText(r) + " exceeds the default bound " + errorText(kDefaultErrorBound) +
+  } else if (g.error > kDefaultErrorBound) {
+    warnings.push_back(achievedText(r, g) + " exceeds the default bound " + errorText(kDefaultErrorBound) +
                        " (raise --rank, or gate with --max-error)");
   }
   return warnings;
@@ -260,6 +288,20 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   params["source"] = "normal-map";
 }
 
+// The lobes per tile the source container's flakes record asks for (what its ndfgen --lobes was);
+// 0 without a flakes section.
+int sourceLobesPerTile(const format::Reader& reader, const std::string& input) {
+  const int idx = reader.find(format::kSectionFlakes, 0);
+  if (idx < 0) return 0;
+  std::vector<uint8_t> flakes;
+  if (reader.readSection(size_t(idx), &flakes) != format::ContainerStatus::kOk ||
+      flakes.size() < sizeof(format::FlakesRecord))
+    throw Error(cli::kExitInvalidInput, input + ": the flakes section is unreadable or truncated");
+  format::FlakesRecord rec;
+  std::memcpy(&rec, flakes.data(), sizeof(rec));
+  return rec.version >= 2 ? int(rec.lobes_per_tile) : 0;
+}
+
 // Stage 3: packs the input into the (temporary) output container; nothing is in place yet.
 tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out,
                                    bake::ndf::FlakesHandover& handover, uint64_t* flake_bytes) {
@@ -282,7 +324,7 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     sigmas.push_back(l.sigma);
     errors.push_back(l.relative_error);
   }
-  const int lobes = in.from_container ? bake::ndf::kDefaultLobesPerTile : o.pyramid.lobes;
+  const int lobes = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
   handover =
       bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), kFaithfulLevelError, lobes);
   if (!in.from_container) {
@@ -344,8 +386,8 @@ void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& par
 
 // Stage 5: the warnings, then the --json summary or the one-line summary.
 void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& params,
-                 const tensor::TensorPackReport& report, const std::vector<std::string>& warnings, uint64_t file_bytes,
-                 double seconds) {
+                 const tensor::TensorPackReport& report, const GatedError& gated,
+                 const std::vector<std::string>& warnings, uint64_t file_bytes, double seconds) {
   for (const std::string& w : warnings) t.warning(o.input + ": " + w);
   const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
   if (!t.common().json) {
@@ -374,6 +416,7 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
   doc["blocks_dropped"] = report.blocks_dropped;
   doc["rank_histogram"] = rankHistogramJson(report);
   doc["max_rank"] = report.max_rank;
+  doc["gated_error"] = {{"error", gated.error}, {"from_sigma", gated.whole ? Json(nullptr) : Json(gated.from_sigma)}};
   doc["raw_bytes"] = report.raw_bytes;
   doc["stored_bytes"] = report.stored_bytes;
   doc["file_bytes"] = file_bytes;
@@ -406,12 +449,13 @@ int main(int argc, char** argv) {
     uint64_t flake_bytes = 0;
     const tensor::TensorPackReport report = packAsset(t, o, in, out, handover, &flake_bytes);
     // The gate runs before anything is in place: a failure leaves no output.
-    checkMaxError(report, o.max_error, o.input);
-    const std::vector<std::string> warnings = qualityWarnings(report, o.error_target, o.pack.cp.rank);
+    const GatedError gated = gatedError(report, handover);
+    checkMaxError(report, gated, o.max_error, o.input);
+    const std::vector<std::string> warnings = qualityWarnings(report, gated, o.error_target, o.pack.cp.rank);
     const Json flakes = flake_bytes > 0 ? cli::flakesJson(handover, flake_bytes) : Json(nullptr);
     writeAsset(t, o, in, params, report, flakes, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    printReport(t, o, in, params, report, warnings, out.bytesWritten(), seconds);
+    printReport(t, o, in, params, report, gated, warnings, out.bytesWritten(), seconds);
     return cli::kExitOk;
   });
 }
