@@ -624,7 +624,7 @@ RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, do
   if (x1 > x0 && y1 > y0) {
     m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
       m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double weight) {
-        integral += weight * flakes::lobeRectProbability(g, x0, x1, y0, y1);
+        integral += weight * flakes::lobeRectProbability(g, x0, x1, y0, y1, flakes::LobeAccuracy::kImage);
       });
     });
   }
@@ -643,8 +643,9 @@ RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float
   const double bin = 2.0 / m.res;
   const double to_density = weight / (bin * bin);
   m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
-    m.forEachLobe(b, bound, bx, by, t.sp2,
-                  [&](const flakes::Lobe& g, double w) { flakes::splatLobe(g, to_density * w, m.res, out); });
+    m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double w) {
+      flakes::splatLobe(g, to_density * w, m.res, out, flakes::LobeAccuracy::kImage);
+    });
   });
   return RuntimeStatus::kOk;
 }
