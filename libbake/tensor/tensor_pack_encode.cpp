@@ -122,16 +122,12 @@ size_t groupSectionBytes(int bins, int rank, int blocks, int precision) {
   return size_t(format::tensorGroupSectionBytes(uint64_t(bins), uint64_t(rank), uint64_t(blocks), uint32_t(precision)));
 }
 
-Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Result<CpFactors> decomposed = options.error_target < 0.0
-                                     ? decomposeCp(tensor, options.cp)
-                                     : decomposeCpToError(tensor, options.cp, options.error_target);
-  if (!decomposed) return decomposed.error();
-  CpFactors& f = decomposed.value();
-  retryDeadColumns(tensor, options.cp, f);
-  balanceColumns(f);
+namespace {
 
+// The section of a group with these factors (rounded to the storage precision in place) and the
+// error of the stored model against the tensor.
+Result<EncodedGroup> encodeGroup(const GroupTensor& tensor, CpFactors& f, int level, int region,
+                                 const TensorPackOptions& options, std::chrono::steady_clock::time_point t0) {
   const int bins = f.bins, rank = f.rank, blocks = f.blocks;
   EncodedGroup g;
   g.rank = rank;
@@ -175,6 +171,38 @@ Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int reg
   }
   g.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return g;
+}
+
+}  // namespace
+
+Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<CpFactors> decomposed = options.error_target < 0.0
+                                     ? decomposeCp(tensor, options.cp)
+                                     : decomposeCpToError(tensor, options.cp, options.error_target);
+  if (!decomposed) return decomposed.error();
+  CpFactors& f = decomposed.value();
+  retryDeadColumns(tensor, options.cp, f);
+  balanceColumns(f);
+  return encodeGroup(tensor, f, level, region, options, t0);
+}
+
+Result<EncodedGroup> exactGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  GLINTBAKE_CHECK(tensor.blocks == 1 && tensor.bins <= int(format::kTensorMaxRank));
+  // Rank B with A the identity: bin (i, j) = sum_r [i == r] B(j, r) C(0, r) = B(j, i).
+  CpFactors f;
+  f.bins = tensor.bins;
+  f.blocks = 1;
+  f.rank = tensor.bins;
+  const size_t b = size_t(f.bins);
+  f.a.assign(b * b, 0.0f);
+  f.b.assign(b * b, 0.0f);
+  f.c.assign(b, 1.0f);
+  for (size_t i = 0; i < b; ++i) f.a[i * b + i] = 1.0f;
+  for (int j = 0; j < f.bins; ++j)
+    for (int i = 0; i < f.bins; ++i) f.b[size_t(j) * b + size_t(i)] = tensor.at(0, i, j);
+  return encodeGroup(tensor, f, level, region, options, t0);
 }
 
 }  // namespace detail

@@ -33,6 +33,10 @@ struct EncodedGroup {
 // storage precision, builds the prefix sums of the stored values and measures the error of the
 // stored model. Reentrant; sequential (one TBB task per group).
 Result<EncodedGroup> compressGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options);
+// One block stored exactly as a group of rank B: A the identity, B the block's bins, C one
+// (tensor.blocks == 1, B <= kTensorMaxRank). The stored model equals the block to the storage
+// precision.
+Result<EncodedGroup> exactGroup(const GroupTensor& tensor, int level, int region, const TensorPackOptions& options);
 
 // Bytes of a tensor-group section.
 size_t groupSectionBytes(int bins, int rank, int blocks, int precision);
@@ -65,6 +69,8 @@ class TensorPackSink final : public ndf::PyramidSink {
   };
 
   BakeStatus writeFront();  // waits for the oldest pending group and writes it
+  // The kept blocks of a chunk of an exact level, one exact group each, in (centre, block) order.
+  BakeStatus addExactBlocks(const ndf::PyramidChunk& chunk, const std::vector<uint8_t>& keep);
   BakeStatus writeSection(uint32_t type, uint64_t key, const void* data, size_t size);
 
   format::Writer& writer_;
@@ -76,10 +82,13 @@ class TensorPackSink final : public ndf::PyramidSink {
   int ndf_res_ = 0;
   int blocks_per_side_ = 0;
   int level_ = -1;
+  bool exact_level_ = false;      // the current level's blocks are stored exactly, one group each
   format::NdfLevelRecord below_;  // the last level added (when level_ >= 0)
   int grid_width_ = 0, grid_height_ = 0;
   uint64_t level_bytes_before_ = 0;
   std::vector<format::TensorIndexEntry> index_;  // of the current level
+  std::vector<double> level_sum_;                // sum of the current level's images, bin by bin
+  uint64_t level_images_ = 0;                    // images summed into it
   uint32_t next_group_ = 0;
   std::deque<std::unique_ptr<Pending>> pending_;
   double seconds_inside_ = 0.0;

@@ -88,11 +88,17 @@ BakeStatus TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   } catch (const std::bad_alloc&) {
     return makeError(ErrorCode::kRuntime, "out of memory allocating the index of level " + std::to_string(level_));
   }
+  level_sum_.assign(size_t(res) * size_t(res), 0.0);
+  level_images_ = 0;
+  const uint64_t level_bytes = uint64_t(grid_width_) * uint64_t(grid_height_) * uint64_t(res) * uint64_t(res) * 4u;
+  exact_level_ = options_.exact_level_bytes > 0 && level_bytes <= options_.exact_level_bytes &&
+                 options_.block <= int(format::kTensorMaxRank);
   TensorPackLevelReport lrep;
   lrep.level = level_;
   lrep.grid_width = grid_width_;
   lrep.grid_height = grid_height_;
   lrep.sigma = record.sigma_texels;
+  lrep.exact = exact_level_;
   report_.levels.push_back(lrep);
   return writeSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
 }
@@ -107,6 +113,11 @@ BakeStatus TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
   const double bin_area = (2.0 / res) * (2.0 / res);
   const int centres = chunk.width * chunk.height;
   lrep.raw_bytes += uint64_t(centres) * image_floats * sizeof(float);
+  for (int k = 0; k < centres; ++k) {
+    const float* image = chunk.images + size_t(k) * image_floats;
+    for (size_t i = 0; i < image_floats; ++i) level_sum_[i] += double(image[i]);
+  }
+  level_images_ += uint64_t(centres);
 
   // Pass 1: which blocks stay (mass >= threshold and not all zero), in (centre, block) order.
   std::vector<uint8_t> keep(size_t(centres) * size_t(nb) * size_t(nb), 0);
@@ -137,6 +148,7 @@ BakeStatus TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
     }
   }
   if (kept == 0) return okStatus();
+  if (exact_level_) return addExactBlocks(chunk, keep);
 
   // Pass 2: copy the kept blocks into the group tensor and point the index at them.
   auto p = std::make_unique<Pending>();
@@ -186,6 +198,43 @@ BakeStatus TensorPackSink::addChunk(const ndf::PyramidChunk& chunk) {
   return okStatus();
 }
 
+BakeStatus TensorPackSink::addExactBlocks(const ndf::PyramidChunk& chunk, const std::vector<uint8_t>& keep) {
+  TensorPackLevelReport& lrep = report_.levels.back();
+  const int res = ndf_res_, bins = options_.block, nb = blocks_per_side_;
+  const size_t image_floats = size_t(res) * size_t(res);
+  for (int k = 0; k < chunk.width * chunk.height; ++k) {
+    const float* image = chunk.images + size_t(k) * image_floats;
+    const size_t centre = size_t(chunk.y0 + k / chunk.width) * size_t(grid_width_) + size_t(chunk.x0 + k % chunk.width);
+    for (int b = 0; b < nb * nb; ++b) {
+      if (!keep[size_t(k) * nb * nb + size_t(b)]) continue;
+      const int bx = b % nb, by = b / nb;
+      auto p = std::make_unique<Pending>();
+      p->level = level_;
+      p->region = chunk.region;
+      p->tensor.bins = bins;
+      p->tensor.blocks = 1;
+      try {
+        p->tensor.values.resize(size_t(bins) * size_t(bins));
+      } catch (const std::bad_alloc&) {
+        return makeError(ErrorCode::kRuntime, "out of memory allocating a block");
+      }
+      for (int j = 0; j < bins; ++j) {
+        std::memcpy(p->tensor.values.data() + size_t(j) * bins,
+                    image + size_t(by * bins + j) * size_t(res) + size_t(bx * bins), size_t(bins) * sizeof(float));
+      }
+      index_[centre * size_t(nb) * size_t(nb) + size_t(b)] = format::TensorIndexEntry{next_group_++, 0};
+      p->result.emplace(exactGroup(p->tensor, p->level, p->region, options_));
+      pending_.push_back(std::move(p));
+      ++lrep.blocks_kept;
+      ++lrep.groups;
+      while (pending_.size() > max_in_flight_) {
+        if (BakeStatus s = writeFront(); !s) return s;
+      }
+    }
+  }
+  return okStatus();
+}
+
 BakeStatus TensorPackSink::writeFront() {
   Pending& p = *pending_.front();
   {
@@ -228,6 +277,16 @@ BakeStatus TensorPackSink::endLevel(int level) {
   TensorPackLevelReport& lrep = report_.levels.back();
   lrep.stored_bytes = writer_.bytesWritten() - level_bytes_before_;
   lrep.relative_error = lrep.norm_squared > 0.0 ? std::sqrt(lrep.error_squared / lrep.norm_squared) : 0.0;
+  // |D - mean|^2 = |D|^2 - N |mean|^2 over the level's N images.
+  double mean_squared = 0.0;
+  if (level_images_ > 0) {
+    for (double v : level_sum_) mean_squared += v * v;
+    mean_squared /= double(level_images_);
+  }
+  const double spread_squared = std::max(lrep.norm_squared - mean_squared, 0.0);
+  lrep.variation = lrep.norm_squared > 0.0 ? std::sqrt(spread_squared / lrep.norm_squared) : 0.0;
+  level_sum_.clear();
+  level_sum_.shrink_to_fit();
   index_.clear();
   index_.shrink_to_fit();
   return okStatus();

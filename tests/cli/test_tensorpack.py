@@ -13,6 +13,9 @@ from clitest import ToolTestCase, run
 
 PYRAMID = ["--ndf-res", "32", "--stride", "8", "--sigma0", "4"]
 PACK = ["--rank", "8", "--block", "16", "--quiet"]
+# These tests are about the compression: on their small maps every level would fit the default
+# budget of levels stored exactly (test_exact_levels covers that).
+NOEXACT = ["--exact-levels", "0"]
 
 
 def write_half_exr(path, width, height, texel):
@@ -62,7 +65,7 @@ class TensorPack(ToolTestCase):
 
     def test_json_report_and_default_output_name(self):
         m = self.mapgen("scratches", "scr.png", "--size", "32", "--seed", "5")
-        doc = self.run_json("tensorpack", m, *PYRAMID, *PACK, schema="tensorpack.schema.json")
+        doc = self.run_json("tensorpack", *NOEXACT, m, *PYRAMID, *PACK, schema="tensorpack.schema.json")
         out = self.path("scr.gbk")  # beside the input, extension replaced
         self.assertTrue(os.path.exists(out))
         self.assertEqual(doc["output"], "scr.gbk")
@@ -77,7 +80,7 @@ class TensorPack(ToolTestCase):
         self.assertGreater(doc["relative_error"], 0.0)
         self.assertLess(doc["relative_error"], 1.0)
         self.assertEqual(doc["negative_mass_fraction"], 0.0)  # non-negative factors by default
-        signed = self.run_json("tensorpack", m, "-o", self.path("signed.gbk"), *PYRAMID, *PACK, "--no-nonneg",
+        signed = self.run_json("tensorpack", *NOEXACT, m, "-o", self.path("signed.gbk"), *PYRAMID, *PACK, "--no-nonneg",
                                schema="tensorpack.schema.json")
         self.assertFalse(signed["parameters"]["nonneg"])
         self.assertGreater(signed["negative_mass_fraction"], 0.0)
@@ -92,7 +95,7 @@ class TensorPack(ToolTestCase):
         m = self.mapgen("flakes", "fl.png", "--size", "32")
         pyramid = self.path("fl.gbk")
         self.run_ok("ndfgen", m, "-o", pyramid, *PYRAMID, "--quiet")
-        doc = self.run_json("tensorpack", pyramid, *PACK, "--error-target", "0.2",
+        doc = self.run_json("tensorpack", *NOEXACT, pyramid, *PACK, "--error-target", "0.2",
                             schema="tensorpack.schema.json")
         self.assertEqual(doc["source"], "ndf-pyramid")
         self.assertIsNone(doc["map"])
@@ -101,22 +104,22 @@ class TensorPack(ToolTestCase):
         self.assertLessEqual(doc["max_rank"], 8)
         # Pyramid options belong to map inputs.
         out = self.path("x.gbk")
-        self.assert_fails(clitest.BAD_ARGS, "tensorpack", pyramid, "-o", out, *PACK, "--ndf-res", "64",
+        self.assert_fails(clitest.BAD_ARGS, "tensorpack", *NOEXACT, pyramid, "-o", out, *PACK, "--ndf-res", "64",
                           outputs=[out])
 
     def test_identical_bytes_for_any_thread_count_and_run(self):
         m = self.mapgen("beckmann", "b.png", "--size", "48")
         a, b, c = self.path("a.gbk"), self.path("b.gbk"), self.path("c.gbk")
-        self.run_ok("tensorpack", m, "-o", a, *PYRAMID, *PACK, "-j", "1")
-        self.run_ok("tensorpack", m, "-o", b, *PYRAMID, *PACK, "-j", "2")
-        self.run_ok("tensorpack", m, "-o", c, *PYRAMID, *PACK, "-j", "2")
+        self.run_ok("tensorpack", *NOEXACT, m, "-o", a, *PYRAMID, *PACK, "-j", "1")
+        self.run_ok("tensorpack", *NOEXACT, m, "-o", b, *PYRAMID, *PACK, "-j", "2")
+        self.run_ok("tensorpack", *NOEXACT, m, "-o", c, *PYRAMID, *PACK, "-j", "2")
         self.assertEqual(clitest.file_hash(a), clitest.file_hash(b))
         self.assertEqual(clitest.file_hash(b), clitest.file_hash(c))
 
     def test_depfile(self):
         m = self.mapgen("brushed", "br.png", "--size", "32")
         out, dep = self.path("br.gbk"), self.path("br.d")
-        self.run_ok("tensorpack", m, "-o", out, *PYRAMID, *PACK, "--depfile", dep)
+        self.run_ok("tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, *PACK, "--depfile", dep)
         with open(dep) as f:
             text = f.read()
         self.assertIn("br.gbk", text)
@@ -130,7 +133,7 @@ class TensorPack(ToolTestCase):
         for axis in ("x", "y"):
             m = self.path(f"one_axis_{axis}.exr")
             write_half_exr(m, size, size, lambda x, y: one_axis_normal(x if axis == "x" else y, size))
-            doc = self.run_json("tensorpack", m, "--rank", "16", "--quiet", schema="tensorpack.schema.json")
+            doc = self.run_json("tensorpack", *NOEXACT, m, "--rank", "16", "--quiet", schema="tensorpack.schema.json")
             self.assertEqual(doc["map"], {"width": size, "height": size, "wrap": "repeat"})
             self.assertTrue(doc["parameters"]["nonneg"])
             self.assertEqual(doc["negative_mass_fraction"], 0.0)
@@ -150,7 +153,7 @@ class TensorPack(ToolTestCase):
     def test_quality_warnings(self):
         m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
         # A fit within the default bound: no warning.
-        out, err = self.run_ok("tensorpack", m, "-o", self.path("good.gbk"), *PYRAMID, "--rank", "8", "--block", "16",
+        out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", self.path("good.gbk"), *PYRAMID, "--rank", "8", "--block", "16",
                                "--json")
         doc = json.loads(out)
         clitest.validate(doc, "tensorpack.schema.json")
@@ -160,7 +163,7 @@ class TensorPack(ToolTestCase):
         # Rank 1 leaves most of the structure: above the default bound 0.5, one warning line, the
         # same message in --json, and the asset is still written.
         bad = self.path("bad.gbk")
-        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json")
+        out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json")
         doc = json.loads(out)
         clitest.validate(doc, "tensorpack.schema.json")
         self.assertGreater(doc["gated_error"]["error"], 0.5)
@@ -171,12 +174,12 @@ class TensorPack(ToolTestCase):
         self.assertIn(doc["warnings"][0], lines[0])
         self.assertTrue(os.path.exists(bad))
         # --quiet drops the stderr line (the reporter's convention for warnings); --json keeps it.
-        out, err = self.run_ok("tensorpack", m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
+        out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
                                "--quiet")
         self.assertEqual(self.warnings_on_stderr(err), [])
         self.assertEqual(len(json.loads(out)["warnings"]), 1)
         # A missed --error-target warns whatever the default bound says.
-        out, err = self.run_ok("tensorpack", m, "-o", self.path("target.gbk"), *PYRAMID, "--rank", "2", "--block",
+        out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", self.path("target.gbk"), *PYRAMID, "--rank", "2", "--block",
                                "16", "--error-target", "0.001", "--json")
         doc = json.loads(out)
         clitest.validate(doc, "tensorpack.schema.json")
@@ -187,27 +190,27 @@ class TensorPack(ToolTestCase):
     def test_max_error_gate(self):
         m = self.mapgen("scratches", "s.png", "--size", "32", "--seed", "5")
         ref = self.path("ref.gbk")
-        doc = self.run_json("tensorpack", m, "-o", ref, *PYRAMID, *PACK, schema="tensorpack.schema.json")
+        doc = self.run_json("tensorpack", *NOEXACT, m, "-o", ref, *PYRAMID, *PACK, schema="tensorpack.schema.json")
         achieved = doc["gated_error"]["error"]
         # Exceeded: runtime failure, one line naming the achieved error, nothing written.
         out = self.path("gated.gbk")
-        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error",
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, *PACK, "--max-error",
                                 "%.6f" % (achieved * 0.5), outputs=[out])
         self.assertIn("--max-error", err)
-        err = self.assert_fails(clitest.RUNTIME, "tensorpack", m, "-o", out, *PYRAMID, *PACK, "--json",
+        err = self.assert_fails(clitest.RUNTIME, "tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, *PACK, "--json",
                                 "--max-error", "0", outputs=[out])
         # Met: the gate does not change a byte.
-        self.run_ok("tensorpack", m, "-o", out, *PYRAMID, *PACK, "--max-error", "%.6f" % (achieved * 1.01 + 1e-6))
+        self.run_ok("tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, *PACK, "--max-error", "%.6f" % (achieved * 1.01 + 1e-6))
         self.assertEqual(clitest.file_hash(out), clitest.file_hash(ref))
         for bad in ("-1", "nan", "inf"):
-            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID, *PACK,
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", *NOEXACT, m, "-o", self.path("x.gbk"), *PYRAMID, *PACK,
                               "--max-error", bad, outputs=[self.path("x.gbk")])
 
     def test_gate_skips_the_levels_the_lobes_answer(self):
         m = self.mapgen("flakes", "fl.png", "--size", "32", "--seed", "3")
         # With lobes the gate covers only the levels the pyramid answers with: from the first
         # level from which every level is within the faithful bound, or the top level alone.
-        doc = self.run_json("tensorpack", m, "-o", self.path("b.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
+        doc = self.run_json("tensorpack", *NOEXACT, m, "-o", self.path("b.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
                             schema="tensorpack.schema.json")
         gated = doc["gated_error"]
         self.assertIsNotNone(gated["from_sigma"])
@@ -217,7 +220,7 @@ class TensorPack(ToolTestCase):
         self.assertAlmostEqual(gated["error"], max(levels[first:]), places=12)
         self.assertLessEqual(gated["error"], max(doc["relative_error"], doc["max_group_error"]))
         # Without lobes every level answers and is gated.
-        doc = self.run_json("tensorpack", m, "-o", self.path("c.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
+        doc = self.run_json("tensorpack", *NOEXACT, m, "-o", self.path("c.gbk"), *PYRAMID, "--rank", "1", "--block", "16",
                             "--lobes", "0", schema="tensorpack.schema.json")
         self.assertIsNone(doc["gated_error"]["from_sigma"])
         self.assertEqual(doc["gated_error"]["error"], max(doc["relative_error"], doc["max_group_error"]))
@@ -228,23 +231,50 @@ class TensorPack(ToolTestCase):
             src = self.path("p%s.gbk" % lobes)
             self.run_ok("ndfgen", m, "-o", src, *PYRAMID, "--lobes", lobes, "--quiet")
             out = self.path("t%s.gbk" % lobes)
-            self.run_ok("tensorpack", src, "-o", out, *PACK)
+            self.run_ok("tensorpack", *NOEXACT, src, "-o", out, *PACK)
             info = self.run_json("glintinfo", "info", out, "--json")
             self.assertEqual(info["footprints"].get("lobes_per_tile", 0), int(lobes), info["footprints"])
+
+    def test_exact_levels(self):
+        # A 64^2 map at R = 32 and sigma0 4: levels of 8 x 8 (256 KiB), 4 x 4 (64 KiB), ... centres.
+        m = self.mapgen("flakes", "fl.png", "--size", "64", "--seed", "3")
+        doc = self.run_json("tensorpack", m, "-o", self.path("e.gbk"), *PYRAMID, "--rank", "4", "--block", "16",
+                            "--exact-levels", "0.1", schema="tensorpack.schema.json")
+        levels = doc["levels"]
+        self.assertGreaterEqual(len(levels), 2)
+        for lv in levels:
+            fits = lv["raw_bytes"] <= 0.1 * 1048576
+            self.assertEqual(lv["exact"], fits, lv)
+            if fits:
+                self.assertLess(lv["relative_error"], 1e-5)
+                self.assertEqual(lv["groups"], lv["blocks_kept"])
+            else:
+                self.assertGreater(lv["relative_error"], 1e-3)
+        self.assertTrue(levels[0]["exact"] is False and levels[-1]["exact"] is True)
+        self.assertEqual(doc["max_rank"], 16)
+        self.assertEqual(doc["parameters"]["exact_levels_mib"], 0.1)
+        # The exact levels are faithful: the pyramid answers from the first of them.
+        first = next(lv["sigma"] for lv in levels if lv["exact"])
+        self.assertEqual(doc["gated_error"]["from_sigma"], first)
+        info = self.run_json("glintinfo", "info", self.path("e.gbk"), "--json")
+        self.assertAlmostEqual(info["footprints"]["handover_max_sigma"], 2 * first, places=6)
+        for bad in ("-1", "2000", "nan"):
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID,
+                              "--exact-levels", bad, outputs=[self.path("x.gbk")])
 
     def test_bad_arguments(self):
         m = self.mapgen("beckmann", "m.png", "--size", "32")
         out = self.path("out.gbk")
         for args in (["--rank", "0"], ["--rank", "65"], ["--block", "12"], ["--method", "svd"],
                      ["--precision", "float8"], ["--error-target", "2"], ["--blank-threshold", "-1"]):
-            self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", out, *PYRAMID, "--quiet", *args, outputs=[out])
+            self.assert_fails(clitest.BAD_ARGS, "tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, "--quiet", *args, outputs=[out])
 
     def test_bad_inputs(self):
         out = self.path("out.gbk")
-        self.assert_fails(clitest.IO, "tensorpack", self.path("missing.png"), "-o", out, *PACK, outputs=[out])
+        self.assert_fails(clitest.IO, "tensorpack", *NOEXACT, self.path("missing.png"), "-o", out, *PACK, outputs=[out])
         # Every block blank: no block of a normalised NDF image carries the whole mass.
         m = self.mapgen("beckmann", "m.png", "--size", "32")
-        err = self.assert_fails(clitest.INVALID, "tensorpack", m, "-o", out, *PYRAMID, *PACK,
+        err = self.assert_fails(clitest.INVALID, "tensorpack", *NOEXACT, m, "-o", out, *PYRAMID, *PACK,
                                 "--blank-threshold", "1", outputs=[out])
         self.assertIn("blank", err)
         # A corrupt container: one byte flipped inside a chunk.
@@ -257,18 +287,18 @@ class TensorPack(ToolTestCase):
             byte = f.read(1)
             f.seek(300)
             f.write(bytes([byte[0] ^ 0x5A]))
-        self.assert_fails(clitest.INVALID, "tensorpack", corrupt, "-o", out, *PACK, outputs=[out])
+        self.assert_fails(clitest.INVALID, "tensorpack", *NOEXACT, corrupt, "-o", out, *PACK, outputs=[out])
         # A truncated container.
         truncated = self.path("trunc.gbk")
         with open(pyramid, "rb") as f:
             data = f.read()
         with open(truncated, "wb") as f:
             f.write(data[: len(data) // 2])
-        self.assert_fails(clitest.INVALID, "tensorpack", truncated, "-o", out, *PACK, outputs=[out])
+        self.assert_fails(clitest.INVALID, "tensorpack", *NOEXACT, truncated, "-o", out, *PACK, outputs=[out])
         # A container of another kind.
         tensor = self.path("t.gbk")
-        self.run_ok("tensorpack", pyramid, "-o", tensor, *PACK)
-        self.assert_fails(clitest.INVALID, "tensorpack", tensor, "-o", out, *PACK, outputs=[out])
+        self.run_ok("tensorpack", *NOEXACT, pyramid, "-o", tensor, *PACK)
+        self.assert_fails(clitest.INVALID, "tensorpack", *NOEXACT, tensor, "-o", out, *PACK, outputs=[out])
 
 
 if __name__ == "__main__":

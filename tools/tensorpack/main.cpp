@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -62,6 +63,20 @@ constexpr double kDefaultErrorBound = 0.5;
 // footprints; below the first level from which every level meets it, the clustered lobes answer
 // (README, "How an NDF asset answers a footprint").
 constexpr double kFaithfulLevelError = 0.15;
+// ... and at most this share of the level's variation (|D - mean image| / |D|): the footprints of
+// a level differ from each other by about that much, which is what the smooth baseline misses, so
+// an error near it keeps no more of the glints than one smooth image would. On the real maps of
+// the fidelity table rank 16 stays near or above the variation at every level (README, "Figures").
+constexpr double kFaithfulVariationShare = 0.25;
+
+// How far a level is from faithful: at most 1 when it meets both bounds.
+double unfaithfulness(const tensor::TensorPackLevelReport& l) {
+  if (l.exact) return 0.0;
+  const double by_norm = l.relative_error / kFaithfulLevelError;
+  if (!(l.relative_error > 0.0)) return 0.0;
+  if (!(l.variation > 0.0)) return std::numeric_limits<double>::infinity();
+  return std::max(by_norm, l.relative_error / (kFaithfulVariationShare * l.variation));
+}
 
 std::string errorText(double e) {
   char text[32];
@@ -138,6 +153,8 @@ Json levelJson(const tensor::TensorPackLevelReport& l) {
   j["raw_bytes"] = l.raw_bytes;
   j["stored_bytes"] = l.stored_bytes;
   j["relative_error"] = l.relative_error;
+  j["variation"] = l.variation;
+  j["exact"] = l.exact;
   return j;
 }
 
@@ -154,6 +171,7 @@ struct Options {
   cli::PyramidCliOptions pyramid;
   tensor::TensorPackOptions pack;
   double error_target = -1.0, max_error = -1.0;
+  double exact_mib = 4.0;
   int zstd_level = 9;
 };
 
@@ -188,6 +206,10 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--blank-threshold", opt.blank_threshold, "Drop blocks whose mass is below this (0..1)")
       ->capture_default_str();
   app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
+  app.add_option("--exact-levels", o.exact_mib,
+                 "Store the levels whose NDF images take at most this many MiB (float32) exactly instead of "
+                 "compressed (0..1024; 0: compress every level)")
+      ->capture_default_str();
   app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
   app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
@@ -212,6 +234,9 @@ void resolveOptions(const CLI::App& app, Options& o) {
     throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
   }
   if (o.zstd_level < 1 || o.zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
+  if (!(o.exact_mib >= 0.0 && o.exact_mib <= 1024.0))
+    throw Error(cli::kExitBadArguments, "--exact-levels must be in [0, 1024] MiB");
+  o.pack.exact_level_bytes = uint64_t(o.exact_mib * 1048576.0);
   if (bake::BakeStatus s = tensor::validateTensorPackOptions(o.pack); !s)
     throw Error(exitCodeOf(s.error()), s.error().message);
 }
@@ -230,6 +255,7 @@ Json parametersJson(const Options& o) {
   params["error_target"] = o.error_target < 0.0 ? Json(nullptr) : Json(o.error_target);
   params["blank_threshold"] = opt.blank_threshold;
   params["precision"] = o.precision_text;
+  params["exact_levels_mib"] = o.exact_mib;
   params["seed"] = opt.cp.seed;
   params["zstd_level"] = o.zstd_level;
   return params;
@@ -274,6 +300,10 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   }
   cli::resolvePyramidOptions(o.pyramid);
   const int ndf_res = o.pyramid.options.splat.ndf_res;
+  // The automatic level count may stop only once the pyramid has reached the levels stored exactly
+  // (side^2 R^2 4 bytes within the budget), so that the top level is not a lossy one.
+  const double exact_side = std::sqrt(double(o.pack.exact_level_bytes) / (4.0 * double(ndf_res) * double(ndf_res)));
+  o.pyramid.options.converge_from_grid = int(std::min(exact_side, 65536.0));
   if (ndf_res % o.pack.block != 0) {
     throw Error(cli::kExitBadArguments,
                 "--block " + std::to_string(o.pack.block) + " must divide --ndf-res " + std::to_string(ndf_res));
@@ -322,11 +352,10 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   std::vector<double> sigmas, errors;
   for (const auto& l : report.levels) {
     sigmas.push_back(l.sigma);
-    errors.push_back(l.relative_error);
+    errors.push_back(unfaithfulness(l));
   }
   const int lobes = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
-  handover =
-      bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), kFaithfulLevelError, lobes);
+  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes);
   if (!in.from_container) {
     *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {

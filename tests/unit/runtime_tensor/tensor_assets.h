@@ -54,12 +54,14 @@ inline bake::NormalMap tinyMap(bake::MapKind kind = bake::MapKind::kBeckmann, bo
 
 // Packs `map` into a tensor-ndf container file and returns its bytes (empty on failure).
 inline std::vector<uint8_t> packAsset(const bake::NormalMap& map, bool nonneg, int rank, const std::string& name,
-                                      int precision = 0, const bake::ndf::PyramidOptions& pyramid = tinyPyramid()) {
+                                      int precision = 0, const bake::ndf::PyramidOptions& pyramid = tinyPyramid(),
+                                      uint64_t exact_level_bytes = 0) {
   bake::tensor::TensorPackOptions o;
   o.cp.rank = rank;
   o.cp.nonneg = nonneg;
   o.block = 16;
   o.precision = precision;
+  o.exact_level_bytes = exact_level_bytes;
   const std::string path = tempPath(name + ".gbk");
   format::Writer w;
   if (w.open(path, format::AssetKind::kTensorNdf, 1) != format::ContainerStatus::kOk) return {};
@@ -73,11 +75,15 @@ inline std::vector<uint8_t> packAsset(const bake::NormalMap& map, bool nonneg, i
   return bytes;
 }
 
-// The shared assets of a test program: HALS (non-negative) and plain-ALS packs of one map.
+// The shared assets of a test program: HALS (non-negative) and plain-ALS packs of one map, and a
+// HALS pack whose levels of 2 x 2 and 1 x 1 centres are stored exactly.
 struct Assets {
-  std::vector<uint8_t> nonneg_bytes, signed_bytes;
-  TensorNdf nonneg, plain;
+  std::vector<uint8_t> nonneg_bytes, signed_bytes, exact_bytes;
+  TensorNdf nonneg, plain, exact;
 };
+
+// Bytes of a level of 2 x 2 centres of tinyPyramid() (R = 32, float32): the exact-level budget.
+constexpr uint64_t kTinyExactBytes = 4 * 32 * 32 * 4;
 
 inline const Assets& assets() {
   static const Assets* a = [] {
@@ -85,6 +91,8 @@ inline const Assets& assets() {
     const bake::NormalMap map = tinyMap();
     x->nonneg_bytes = packAsset(map, true, 16, "nonneg");
     x->signed_bytes = packAsset(map, false, 16, "signed");
+    x->exact_bytes = packAsset(map, true, 16, "exact", 0, tinyPyramid(), kTinyExactBytes);
+    EXPECT_EQ(x->exact.openMemory(x->exact_bytes.data(), x->exact_bytes.size()), RuntimeStatus::kOk);
     EXPECT_EQ(x->nonneg.openMemory(x->nonneg_bytes.data(), x->nonneg_bytes.size()), RuntimeStatus::kOk);
     EXPECT_EQ(x->plain.openMemory(x->signed_bytes.data(), x->signed_bytes.size()), RuntimeStatus::kOk);
     return x;

@@ -58,7 +58,7 @@ std::vector<double> pdfImage(const TensorNdf& t, const Footprint& fp) {
 }
 
 TEST(TensorNdfSampling, ChiSquareAgainstPdf) {
-  for (const TensorNdf* t : {&assets().nonneg, &assets().plain}) {
+  for (const TensorNdf* t : {&assets().nonneg, &assets().plain, &assets().exact}) {
     for (const Footprint& fp : {footprint(20, 30, 6), footprint(61, 2, 10), footprint(40, 40, 40)}) {
       const std::vector<Point> pts = drawChecked(*t, fp, 100000, 41);
       // pdf() integrates to 1: the chi-square total mass is 1.

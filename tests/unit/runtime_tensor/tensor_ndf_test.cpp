@@ -105,6 +105,50 @@ TEST(TensorNdf, BlendingMatchesNdfPyramid) {
   std::remove(path.c_str());
 }
 
+// An asset with exact levels (rank-B groups, one per block) blends like any other: its answers
+// equal NdfPyramid's on a pyramid of its own reconstructed images at every footprint, and above
+// the top level, where only the exact top level answers, they equal the uncompressed pyramid's.
+TEST(TensorNdf, ExactLevelsBlendLikeTheUncompressedPyramid) {
+  const TensorNdf& t = assets().exact;
+  ASSERT_EQ(t.levelCount(), 3);
+  EXPECT_EQ(int(t.info()->max_rank), 16);  // the exact groups have rank B = 16
+  const std::string recon_path = writeReconstructedPyramid(t, "exact_blend");
+  const std::string plain_path = tempPath("exact.pyramid.gbk");
+  {
+    format::Writer w;
+    ASSERT_EQ(w.open(plain_path, format::AssetKind::kNdfPyramid, 1), format::ContainerStatus::kOk);
+    ASSERT_TRUE(bake::ndf::buildNdfPyramid(tinyMap(), tinyPyramid(), w, nullptr).ok());
+    ASSERT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.finish(), format::ContainerStatus::kOk);
+  }
+  NdfPyramid recon, plain;
+  ASSERT_EQ(recon.open(recon_path.c_str()), RuntimeStatus::kOk);
+  ASSERT_EQ(plain.open(plain_path.c_str()), RuntimeStatus::kOk);
+  const int res = t.resolution();
+  const double top = t.level(2)->sigma_texels;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> pos(-40.0, 110.0), sig(0.0, 60.0), sp(-1.05, 1.05);
+  std::vector<float> img_t(size_t(res) * res), img_r(size_t(res) * res);
+  auto compare = [&](const NdfPyramid& ref, const Footprint& fp) {
+    ASSERT_EQ(t.image(fp, img_t.data(), img_t.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(ref.image(fp, img_r.data(), img_r.size()), RuntimeStatus::kOk);
+    const float peak = *std::max_element(img_r.begin(), img_r.end());
+    for (size_t n = 0; n < img_t.size(); ++n) ASSERT_NEAR(img_t[n], img_r[n], 1e-5 * peak) << "bin " << n;
+    for (int k = 0; k < 10; ++k) {
+      const SPoint s{sp(rng), sp(rng)};
+      double a = -1.0, b = -1.0;
+      ASSERT_EQ(t.eval(fp, s, &a), RuntimeStatus::kOk);
+      ASSERT_EQ(ref.eval(fp, s, &b), RuntimeStatus::kOk);
+      ASSERT_NEAR(a, b, 1e-5 * peak);
+    }
+  };
+  for (int q = 0; q < 60; ++q) compare(recon, footprint(pos(rng), pos(rng), sig(rng)));
+  std::uniform_real_distribution<double> above(1.25 * top, 80.0);
+  for (int q = 0; q < 30; ++q) compare(plain, footprint(pos(rng), pos(rng), above(rng)));
+  std::remove(recon_path.c_str());
+  std::remove(plain_path.c_str());
+}
+
 // Exact average of the piecewise-constant eval() over a rectangle, bin by bin.
 double meanOfEval(const TensorNdf& t, const Footprint& fp, const SRect& r) {
   const int res = t.resolution();

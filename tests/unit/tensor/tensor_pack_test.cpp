@@ -307,6 +307,78 @@ TEST(TensorPack, ErrorFallsWithRankOnEveryMapKind) {
 // Every index entry points at a block of the right group, blank entries are exactly the blocks
 // below the threshold, the prefix sums are those of the stored factors, and the decoded images
 // reproduce the report's error.
+// The level variation |D - mean| / |D| equals the one computed from the captured images, is near 0
+// for a flat map (every footprint sees the same lobe) and clearly positive for a glinty one.
+TEST(TensorPack, LevelVariationIsTheSpreadOfTheImagesAboutTheirMean) {
+  for (MapKind kind : {MapKind::kFlat, MapKind::kFlakes}) {
+    const NormalMap map = testMap(kind);
+    const CaptureSink ref = capturePyramid(map, smallPyramid());
+    TensorPackReport rep;
+    ASSERT_TRUE(
+        packFromMap(map, packOptions(8), tempPath(std::string("variation_") + mapKindString(kind) + ".gbk"), &rep)
+            .ok());
+    ASSERT_EQ(rep.levels.size(), ref.levels.size());
+    const size_t image = size_t(rep.ndf_res) * size_t(rep.ndf_res);
+    for (size_t l = 0; l < ref.levels.size(); ++l) {
+      const std::vector<float>& all = ref.levels[l].images;
+      const size_t centres = all.size() / image;
+      std::vector<double> mean(image, 0.0);
+      for (size_t c = 0; c < centres; ++c)
+        for (size_t n = 0; n < image; ++n) mean[n] += all[c * image + n] / double(centres);
+      double spread = 0.0, norm = 0.0;
+      for (size_t c = 0; c < centres; ++c) {
+        for (size_t n = 0; n < image; ++n) {
+          const double x = all[c * image + n];
+          spread += (x - mean[n]) * (x - mean[n]);
+          norm += x * x;
+        }
+      }
+      const double expected = std::sqrt(spread / norm);
+      EXPECT_NEAR(rep.levels[l].variation, expected, 1e-6 + 1e-4 * expected) << mapKindString(kind) << " level " << l;
+      if (kind == MapKind::kFlat) {
+        EXPECT_LT(rep.levels[l].variation, 1e-3);
+      } else {
+        EXPECT_GT(rep.levels[l].variation, 0.05);
+      }
+    }
+  }
+}
+
+// Levels within the exact budget decode to the pyramid's images to float rounding, one rank-B
+// group per kept block; the others stay compressed.
+TEST(TensorPack, ExactLevelsDecodeToThePyramidImages) {
+  const NormalMap map = testMap(MapKind::kFlakes);
+  const CaptureSink ref = capturePyramid(map, smallPyramid());
+  TensorPackOptions o = packOptions(8);
+  // smallPyramid(): level 0 has 4 x 4 centres, level 1 2 x 2 (R = 64); only level 1 fits.
+  o.exact_level_bytes = 4 * 64 * 64 * 4;
+  TensorPackReport rep;
+  const std::string out = tempPath("exact.gbk");
+  ASSERT_TRUE(packFromMap(map, o, out, &rep).ok());
+  ASSERT_EQ(rep.levels.size(), 2u);
+  EXPECT_FALSE(rep.levels[0].exact);
+  EXPECT_TRUE(rep.levels[1].exact);
+  EXPECT_GT(rep.levels[0].relative_error, 1e-3);
+  EXPECT_LT(rep.levels[1].relative_error, 1e-5);  // the blank blocks dropped
+  EXPECT_EQ(rep.levels[1].groups, rep.levels[1].blocks_kept);
+  const Decoded d = decode(out);
+  const size_t image = size_t(d.info.ndf_res) * d.info.ndf_res;
+  const std::vector<float>& all = ref.levels[1].images;
+  double worst = 0.0, peak = 0.0;
+  for (size_t c = 0; c < all.size() / image; ++c) {
+    const std::vector<float> rec = d.image(1, c);
+    for (size_t n = 0; n < image; ++n) {
+      worst = std::max(worst, std::fabs(double(rec[n]) - all[c * image + n]));
+      peak = std::max(peak, double(all[c * image + n]));
+    }
+  }
+  EXPECT_LE(worst, 1e-5 * peak);
+  // Exact levels count as rank B in the histogram; the compressed ones keep --rank.
+  EXPECT_EQ(rep.max_rank, 16);
+  EXPECT_GT(rep.rank_histogram[16], 0u);
+  EXPECT_GT(rep.rank_histogram[8], 0u);
+}
+
 TEST(TensorPack, IndexBlankBlocksAndPrefixSumsAreConsistent) {
   const NormalMap map = testMap(MapKind::kScratches);
   const CaptureSink ref = capturePyramid(map, smallPyramid());

@@ -56,6 +56,10 @@ struct PyramidOptions {
   int levels = 0;              // 0 = automatic, else exactly this many, [1, kMaxPyramidLevels]
   double converge_mse = 1e-2;  // relative MSE threshold of the automatic level count, > 0
   int region_size = 16;        // centres per region side, [1, 256]
+  // Automatic level count: the convergence test runs only above a level of at most this many
+  // centres per side (0: above every level). tensorpack sets it so that the pyramid reaches the
+  // small levels it stores exactly before it may stop.
+  int converge_from_grid = 0;
 };
 
 // Validates the options (kBadArgument with a message naming the option).

@@ -66,6 +66,12 @@ struct TensorPackOptions {
                                // relative error is <= error_target, [0, 1]
   int precision = 0;           // factor storage: 0 float32, 1 float16
   int threads = 0;             // TBB workers, 0 = all cores (the tool's -j)
+  // Levels whose NDF images take at most this many bytes (float32, R^2 * 4 per centre) are stored
+  // exactly instead of compressed: every kept block its own group of rank B with the identity as
+  // A (4 B^2 + 12 B values a block on load, about four times the images). The coarse levels are
+  // small and CP keeps little of their glints at rank 16 (README, "Figures"). 0: none; needs
+  // B <= 64.
+  uint64_t exact_level_bytes = 0;
 };
 
 // Validates ranges (kBadArgument naming the option, as the tool spells it).
@@ -83,6 +89,10 @@ struct TensorPackLevelReport {
   double relative_error = 0.0;  // |D - model|_F / |D|_F over every bin of the level (dropped blocks included)
   double error_squared = 0.0;   // |D - model|_F^2
   double norm_squared = 0.0;    // |D|_F^2
+  // |D - mean image|_F / |D|_F: how far the level's images stand from their mean (what a single
+  // smooth image per level would miss). A compression error well below it keeps the glints.
+  double variation = 0.0;
+  bool exact = false;  // stored exactly (TensorPackOptions::exact_level_bytes)
 };
 
 struct TensorPackReport {
