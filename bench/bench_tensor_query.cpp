@@ -1,5 +1,6 @@
-// Query latency of the tensor-ndf runtime (rank 16, R = 128, blocks of 32) against the
-// uncompressed ndf-pyramid it was packed from: point eval, range average, sample and pdf. Queries
+// Query latency of the tensor-ndf runtime (rank 16, R = 128, blocks of 32; also with the small
+// levels stored exactly, tensorpack's default) against the uncompressed ndf-pyramid it was packed
+// from: point eval, range average, sample and pdf. Queries
 // cycle through 1024 precomputed random footprints, points and uniforms so that neither the
 // branch predictor nor the caches see one repeated query.
 #include <glintbake/bake/mapgen/mapgen.h>
@@ -27,7 +28,8 @@ namespace fmt = glintbake::format;
 struct Assets {
   rt::NdfPyramid pyramid;
   rt::TensorNdf tensor;     // plain (signed) CP: tensorpack --no-nonneg
-  rt::TensorNdf tensor_nn;  // non-negative CP (the tensorpack default)
+  rt::TensorNdf tensor_nn;  // non-negative CP, every level compressed (--exact-levels 0)
+  rt::TensorNdf tensor_ex;  // non-negative CP with the small levels exact (the tensorpack default)
 };
 
 [[noreturn]] void fail(const char* what) {
@@ -35,13 +37,15 @@ struct Assets {
   std::abort();
 }
 
-void pack(const std::string& pyramid_path, bool nonneg, const std::string& path, rt::TensorNdf* out) {
+void pack(const std::string& pyramid_path, bool nonneg, const std::string& path, rt::TensorNdf* out,
+          uint64_t exact_level_bytes = 0) {
   fmt::Reader reader;
   if (reader.open(pyramid_path) != fmt::ContainerStatus::kOk) fail("read the pyramid");
   bake::tensor::TensorPackOptions o;
   o.cp.rank = 16;
   o.cp.nonneg = nonneg;
   o.block = 32;
+  o.exact_level_bytes = exact_level_bytes;
   fmt::Writer w;
   bake::tensor::TensorPackReport report;
   if (w.open(path, fmt::AssetKind::kTensorNdf, 1) != fmt::ContainerStatus::kOk ||
@@ -74,6 +78,8 @@ const Assets& assets() {
     if (x->pyramid.open(path.c_str()) != rt::RuntimeStatus::kOk) fail("open the pyramid");
     pack(path, false, "bench_tensor_query_cp.gbk", &x->tensor);
     pack(path, true, "bench_tensor_query_nn.gbk", &x->tensor_nn);
+    // tensorpack's default budget (4 MiB): the 8 x 8 and 4 x 4 levels exact, level 0 compressed.
+    pack(path, true, "bench_tensor_query_ex.gbk", &x->tensor_ex, uint64_t(4) << 20);
     std::remove(path.c_str());
     return x;
   }();
@@ -113,11 +119,12 @@ const rt::NdfSource& source(int which) {
   const Assets& a = assets();
   if (which == 0) return a.tensor;
   if (which == 1) return a.tensor_nn;
+  if (which == 3) return a.tensor_ex;
   return a.pyramid;
 }
 
 void label(benchmark::State& state) {
-  static const char* names[] = {"tensor-cp", "tensor-nonneg", "pyramid"};
+  static const char* names[] = {"tensor-cp", "tensor-nonneg", "pyramid", "tensor-exact-levels"};
   state.SetLabel(names[state.range(0)]);
 }
 
@@ -133,7 +140,7 @@ void BM_Eval(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Eval)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_Eval)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 void BM_Range(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -147,7 +154,7 @@ void BM_Range(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Range)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_Range)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 void BM_Sample(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -161,7 +168,7 @@ void BM_Sample(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Sample)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_Sample)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 void BM_Pdf(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -175,7 +182,7 @@ void BM_Pdf(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Pdf)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(BM_Pdf)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 }  // namespace
 
