@@ -253,11 +253,13 @@ class TensorPack(ToolTestCase):
         self.assertTrue(levels[0]["exact"] is False and levels[-1]["exact"] is True)
         self.assertEqual(doc["max_rank"], 16)
         self.assertEqual(doc["parameters"]["exact_levels_mib"], 0.1)
-        # The exact levels are faithful: the pyramid answers from the first of them.
+        # The exact levels are faithful: the lobes hand over at the first of them and the pyramid
+        # answers alone from sqrt(2) times its sigma.
         first = next(lv["sigma"] for lv in levels if lv["exact"])
         self.assertEqual(doc["gated_error"]["from_sigma"], first)
         info = self.run_json("glintinfo", "info", self.path("e.gbk"), "--json")
-        self.assertAlmostEqual(info["footprints"]["handover_max_sigma"], 2 * first, places=6)
+        self.assertAlmostEqual(info["footprints"]["clustered_max_sigma"], first, places=6)
+        self.assertAlmostEqual(info["footprints"]["handover_max_sigma"], 2 ** 0.5 * first, places=6)
         for bad in ("-1", "2000", "nan"):
             self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID,
                               "--exact-levels", bad, outputs=[self.path("x.gbk")])

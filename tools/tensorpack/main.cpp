@@ -350,12 +350,14 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   // answers only from the first level from which every level is faithful (kFaithfulLevelError),
   // the clustered lobes below it.
   std::vector<double> sigmas, errors;
-  for (const auto& l : report.levels) {
-    sigmas.push_back(l.sigma);
-    errors.push_back(unfaithfulness(l));
+  std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
+  for (size_t l = 0; l < report.levels.size(); ++l) {
+    sigmas.push_back(report.levels[l].sigma);
+    errors.push_back(unfaithfulness(report.levels[l]));
+    exact[l] = report.levels[l].exact;
   }
   const int lobes = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
-  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes);
+  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes, exact.get());
   if (!in.from_container) {
     *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {

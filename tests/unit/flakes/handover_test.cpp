@@ -145,6 +145,36 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
   }
 }
 
+// Where a compressed pyramid takes over from the lobes: above its first level from which every
+// level is faithful (sqrt(2) and 2 times that level's sigma), at that level's own sigma when it is
+// stored exactly, and nowhere (the lobes answer everything) when no level is faithful.
+TEST(Handover, CompressedPyramidsHandOverAtTheirFirstFaithfulLevel) {
+  const double sigmas[4] = {8, 16, 32, 64};
+  const double mixed[4] = {2.0, 1.5, 0.5, 0.2};
+  bake::ndf::FlakesHandover h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16);
+  EXPECT_DOUBLE_EQ(h.flakes_up_to, 4.0);
+  EXPECT_EQ(h.lobes_per_tile, 16);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 64.0);
+  const bool exact[4] = {false, false, true, true};
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
+  const double none[4] = {2.0, 2.0, 2.0, 2.0};
+  h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 16);
+  EXPECT_GE(h.lobes_up_to, 1e6);
+  EXPECT_GE(h.pyramid_from, 1e6);
+  // Every level faithful: as for an uncompressed pyramid.
+  const double all[4] = {0.1, 0.1, 0.1, 0.1};
+  h = bake::ndf::compressedHandover(sigmas, all, 4, 1.0, 16);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, bake::ndf::defaultHandover(8.0, 16).lobes_up_to);
+  EXPECT_DOUBLE_EQ(h.pyramid_from, bake::ndf::defaultHandover(8.0, 16).pyramid_from);
+  // Without lobes the flakes hand over to the pyramid whatever the errors.
+  h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 0, exact);
+  EXPECT_EQ(h.lobes_per_tile, 0);
+  EXPECT_DOUBLE_EQ(h.flakes_up_to, bake::ndf::defaultHandover(8.0, 0).flakes_up_to);
+}
+
 TEST(Handover, FlakesOfAnotherMapAreRefused) {
   const bake::NormalMap map = beckmann(32, 4), other = beckmann(16, 5);
   std::unique_ptr<runtime::NdfSource> asset;

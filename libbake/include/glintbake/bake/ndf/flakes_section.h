@@ -38,8 +38,10 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
 // from which every level's error is at most max_level_error, as defaultHandover places it above
 // an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such level exists the
 // lobes answer every footprint they can (the runtime bounds them by their window) and the pyramid only above.
+// When that first level is stored exactly (level_exact[l], may be null), the lobes answer up to its
+// sigma and the pyramid alone from sqrt(2) times it.
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
-                                  double max_level_error, int lobes_per_tile);
+                                  double max_level_error, int lobes_per_tile, const bool* level_exact = nullptr);
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
 // mode, rate (1..16) and sigma_r, and the hand-over. The record is checked by
