@@ -1,4 +1,4 @@
-"""Procedural glitter: glintref glitter (schema-valid --json, hierarchy equal to explicit
+"""Procedural glitter: glintref glitter and tensorpack --procedural glitter (schema-valid --json, hierarchy equal to explicit
 enumeration, D near the smooth NDF for large N, the same answer twice) and ndfgen --procedural
 glitter (a pyramid glintinfo validates and glintquery reads, a glitter asset, byte-identical for
 -j1 and -j2, one-line errors with exit 1 for bad parameters and nothing left behind)."""
@@ -61,6 +61,16 @@ class Glitter(ToolTestCase):
         self.run_ok("glintinfo", "validate", asset)
         q = self.run_json("glintquery", "point", asset, "--at", "20,30", "--sigma", "2", "--s", "0.1,0.1")
         self.assertGreaterEqual(q["value"], 0.0)
+
+    def test_tensorpack_procedural(self):
+        out = self.path("t.gbk")
+        doc = self.run_json("tensorpack", "--procedural", "glitter", "--particles", "100000", "--alpha", "0.3",
+                            "--size", "64,64", "--ndf-res", "16", "--block", "8", "--stride", "16", "--sigma0", "8",
+                            "-o", out, "--quiet", schema="tensorpack.schema.json")
+        self.assertEqual(doc["source"], "glitter")
+        self.run_ok("glintinfo", "validate", out)
+        self.assert_fails(1, "tensorpack", "--procedural", "glitter", "--alpha", "-1", "-o", out + "2",
+                          outputs=[out + "2"])
 
     def test_ndfgen_procedural_bad_arguments(self):
         out = self.path("bad.gbk")

@@ -11,7 +11,7 @@ void addGlitterOptions(CLI::App& app, GlitterCliOptions& o) {
   app.add_option("--particles", o.particles, "glitter: facets N on the surface (1..2^40)")->capture_default_str();
   app.add_option("--alpha", o.alpha, "glitter: roughness of the smooth NDF (0.001..4)")->capture_default_str();
   app.add_option("--distribution", o.distribution, "glitter: beckmann or ggx")->capture_default_str();
-  app.add_option("--seed", o.seed, "glitter: realisation")->capture_default_str();
+  app.add_option("--glitter-seed", o.seed, "glitter: realisation")->capture_default_str();
   app.add_option("--size", o.size_text, "glitter: surface size W,H in texels (1..65536)")->capture_default_str();
   app.add_option("--gamma", o.gamma_deg, "glitter: cone half-angle of point queries, degrees (0..28.6)")
       ->capture_default_str();

@@ -1,5 +1,5 @@
 // The procedural-surface options of the tools that bake a pyramid (ndfgen, tensorpack), with the
-// same names and defaults: --procedural glitter, --particles, --alpha, --distribution, --seed,
+// same names and defaults: --procedural glitter, --particles, --alpha, --distribution, --glitter-seed,
 // --size, --gamma. A procedural surface replaces the normal map as the source of the NDF images
 // (libbake/glitter; formats/SPEC.md 10.6).
 #pragma once
