@@ -176,8 +176,10 @@ namespace {
 class PyramidBuild {
  public:
   PyramidBuild(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink, PyramidReport& report,
-               const PyramidProgress& progress, const std::atomic<bool>* cancel)
+               const PyramidProgress& progress, const std::atomic<bool>* cancel,
+               const FootprintImageSource* source = nullptr)
       : map_(map),
+        source_(source),
         options_(options),
         sink_(sink),
         rep_(report),
@@ -206,6 +208,7 @@ class PyramidBuild {
   static BakeStatus cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
 
   BakeStatus prepare();
+  BakeStatus allocateBuffers();
   Level planLevel(int level, std::vector<Sample> samples);
   // Computes the probe images; *converged when the level below already predicts this one.
   BakeStatus probe(Level& lv, bool* converged);
@@ -217,7 +220,8 @@ class PyramidBuild {
   PyramidChunk chunkOf(const Level& lv, int r, std::vector<float>& buf) const;
   void collectSamples(Level& lv, const PyramidChunk& chunk, double* mse_sum) const;
 
-  const NormalMap& map_;
+  const NormalMap& map_;  // geometry only (no normals) when source_ is set
+  const FootprintImageSource* source_;
   const PyramidOptions& options_;
   PyramidSink& sink_;
   PyramidReport& rep_;
@@ -232,6 +236,7 @@ class PyramidBuild {
 };
 
 BakeStatus PyramidBuild::prepare() {
+  if (source_) return allocateBuffers();
   const auto t_flakes = Clock::now();
   Result<FlakeSet> flakes_or = buildFlakes(map_, options_.rate);
   if (!flakes_or) return flakes_or.error();
@@ -239,6 +244,10 @@ BakeStatus PyramidBuild::prepare() {
   rep_.flakes = uint64_t(flakes_->grid_width) * uint64_t(flakes_->grid_height);
   rep_.flake_seconds = secondsSince(t_flakes);
   splatters_.emplace(*flakes_, options_.splat);
+  return allocateBuffers();
+}
+
+BakeStatus PyramidBuild::allocateBuffers() {
   const size_t max_layers = size_t(options_.region_size) * size_t(options_.region_size);
   try {
     buffers_[0].resize(8 + max_layers * image_floats_);
@@ -264,7 +273,7 @@ PyramidBuild::Level PyramidBuild::planLevel(int level, std::vector<Sample> sampl
   lv.next = planSamples(levelGeometry(map_.width, map_.height, options_, level + 1), lv.rec, image_floats_);
   // Footprints with very many flakes (the top levels: few images, each costing up to several
   // map's worth of flakes) are split; the split depends only on the level.
-  lv.split = splatters_->local().flakesPerImage(lv.geo.sigma) > kSplitFlakes;
+  lv.split = !source_ && splatters_->local().flakesPerImage(lv.geo.sigma) > kSplitFlakes;
   return lv;
 }
 
@@ -272,6 +281,10 @@ PyramidBuild::Level PyramidBuild::planLevel(int level, std::vector<Sample> sampl
 // from one thread at a time.
 void PyramidBuild::computeImage(const Level& lv, int i, int j, float* out) {
   const double x = (i + 0.5) * lv.geo.stride_x, y = (j + 0.5) * lv.geo.stride_y;
+  if (source_) {
+    source_->image(x, y, lv.geo.sigma, out);
+    return;
+  }
   if (!lv.split) {
     splatters_->local().image(x, y, lv.geo.sigma, out);
     return;
@@ -477,6 +490,25 @@ BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, 
   rep = PyramidReport{};
   PyramidBuild build(map, options, sink, rep, progress, cancel);
   return build.run();
+}
+
+BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOptions& options, PyramidSink& sink,
+                           PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  if (BakeStatus s = validatePyramidOptions(options); !s) return s;
+  NormalMap geometry;  // the level records need the surface's size and wrap only
+  source.mapSize(&geometry.width, &geometry.height);
+  geometry.wrap = Wrap::kRepeat;
+  PyramidReport local_report;
+  PyramidReport& rep = report ? *report : local_report;
+  rep = PyramidReport{};
+  PyramidBuild build(geometry, options, sink, rep, progress, cancel, &source);
+  return build.run();
+}
+
+BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOptions& options, format::Writer& writer,
+                           PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  WriterPyramidSink sink(writer);
+  return buildNdfPyramid(source, options, sink, report, progress, cancel);
 }
 
 }  // namespace glintbake::bake::ndf

@@ -5,5 +5,6 @@ glintbake_add_library(reference
           ${CMAKE_CURRENT_LIST_DIR}/pndf.cpp
           ${CMAKE_CURRENT_LIST_DIR}/bin_image.cpp
           ${CMAKE_CURRENT_LIST_DIR}/sampling.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/glitter.cpp
   PUBLIC_DEPS glintbake::bake
   PRIVATE_DEPS TBB::tbb)

@@ -65,9 +65,13 @@ BakeStatus validateTensorPackOptions(const TensorPackOptions& o) {
   return okStatus();
 }
 
-BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
-                                const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
-                                const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
+namespace {
+
+// The pyramid of a map or of a procedural source, compressed region by region as it is built.
+template <typename Build>
+BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
+                            format::Writer& writer, TensorPackReport* report, const std::atomic<bool>* cancel,
+                            const Build& build) {
   const auto t0 = Clock::now();
   if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
   if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
@@ -81,12 +85,32 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
   return inArena(options.threads, [&]() -> BakeStatus {
     detail::TensorPackSink sink(writer, options, rep, cancel);
     const auto t_build = Clock::now();
-    if (BakeStatus s = ndf::buildNdfPyramid(map, pyramid, sink, &rep.pyramid, progress, cancel); !s) return s;
+    if (BakeStatus s = build(sink, rep.pyramid); !s) return s;
     rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
     if (BakeStatus s = sink.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
     return okStatus();
   });
+}
+
+}  // namespace
+
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
+                                const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+                          [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
+                            return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
+                          });
+}
+
+BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
+                                   const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
+                                   const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+                          [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
+                            return ndf::buildNdfPyramid(source, pyramid, sink, &built, progress, cancel);
+                          });
 }
 
 BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPackOptions& options,

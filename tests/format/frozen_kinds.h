@@ -143,4 +143,27 @@ inline std::vector<uint8_t> roughnessMip(uint32_t level) {
                       [level](uint32_t x, uint32_t y, uint32_t, uint32_t) { return roughnessValue(level, x, y); });
 }
 
+// --- glitter (SPEC 10.6): 1000 Beckmann facets, alpha 0.3, a 16 x 16 map, R = 8, an 8-entry
+// integral table (root 0 with four tabulated children). ------------------------------------------
+
+inline std::vector<uint8_t> glitterRecord() {
+  Bytes b(80);
+  b.u32(0, 0x544C4747).u32(4, 1).u32(8, 0).u32(12, 20);
+  b.u32(16, 1000).u32(20, 0);  // particles (u64)
+  b.u32(24, 5).u32(28, 0);     // seed (u64)
+  b.f64(32, 0.3).f64(40, 0.05);
+  b.u32(48, 16).u32(52, 16).u32(56, 8).u32(60, 8);
+  b.f64(64, 0.01).f64(72, 0.01);
+  return b.bytes();
+}
+
+constexpr double kGlitterIntegrals[8] = {0.25, 0.25, 0.25, 0.25, 0.1, 0.05, 0.05, 0.05};
+
+inline std::vector<uint8_t> glitterIntegrals() {
+  Bytes b(8 * 16);
+  for (size_t i = 0; i < 8; ++i) b.f64(16 * i, kGlitterIntegrals[i]);
+  b.u32(8, 4);  // entry 0: first child 4
+  return b.bytes();
+}
+
 }  // namespace glintbake::format::frozen

@@ -4,6 +4,7 @@
 // record passes its check. README.md: the files are never regenerated.
 #include <glintbake/format/binary16.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/glitter.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
 #include <glintbake/format/validate.h>
@@ -139,6 +140,20 @@ TEST(FrozenKindsV1_0, Roughness) {
   openFrozen("v1_0_roughness.gbk", AssetKind::kRoughness, &reader);
   ASSERT_EQ(reader.sections().size(), 4u);
   for (uint32_t l = 0; l < 3; ++l) EXPECT_EQ(section(reader, kSectionRoughness, l), frozen::roughnessMip(l));
+}
+
+TEST(FrozenKindsV1_0, Glitter) {
+  Reader reader;
+  openFrozen("v1_0_glitter.gbk", AssetKind::kGlitter, &reader);
+  ASSERT_EQ(reader.sections().size(), 3u);
+  const std::vector<uint8_t> rec = section(reader, kSectionGlitterInfo, 0);
+  EXPECT_EQ(rec, frozen::glitterRecord());
+  EXPECT_EQ(checkGlitterRecord(as<GlitterRecord>(rec)), nullptr);
+  const std::vector<uint8_t> table = section(reader, kSectionGlitterIntegrals, 0);
+  EXPECT_EQ(table, frozen::glitterIntegrals());
+  std::vector<GlitterIntegral> entries(table.size() / sizeof(GlitterIntegral));
+  std::memcpy(static_cast<void*>(entries.data()), table.data(), table.size());
+  EXPECT_EQ(checkGlitterIntegrals(entries.data(), entries.size()), nullptr);
 }
 
 }  // namespace

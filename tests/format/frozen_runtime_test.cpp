@@ -1,5 +1,6 @@
 // The runtime reads the frozen 1.0 container of every kind it knows and answers from the frozen
 // records exactly (frozen_kinds.h).
+#include <glintbake/runtime/glitter_ndf.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf.h>
@@ -12,6 +13,31 @@ namespace glintbake::runtime {
 namespace {
 
 std::string frozenPath(const char* name) { return std::string(GLINTBAKE_TEST_DATA_DIR) + "/" + name; }
+
+// The glitter surface is procedural: the frozen record and table must keep producing the same
+// facets, so the answers of the model (hashes, draws, split rule) are pinned here.
+TEST(FrozenRuntimeV1_0, Glitter) {
+  GlitterNdf glitter;
+  ASSERT_EQ(glitter.open(frozenPath("v1_0_glitter.gbk").c_str()), RuntimeStatus::kOk);
+  EXPECT_EQ(glitter.resolution(), 8);
+  EXPECT_EQ(glitter.mapSize().width, 16);
+  const format::GlitterUvRegion all = format::GlitterUvRegion::box(0.5, 0.5, 1.0, 1.0);
+  format::GlitterCountOptions exact;
+  exact.early_stop = false;
+  EXPECT_EQ(
+      format::glitterCount(glitter.surface(), glitter.shape(), all, format::GlitterDirRegion::all(), exact, nullptr),
+      1000.0);
+  const double quadrant = format::glitterCount(glitter.surface(), glitter.shape(), all,
+                                               format::GlitterDirRegion::rect(0.0, 0.0, 1.0, 1.0), exact, nullptr);
+  const double box =
+      format::glitterCount(glitter.surface(), glitter.shape(), format::GlitterUvRegion::box(0.3, 0.6, 0.25, 0.25),
+                           format::GlitterDirRegion::all(), exact, nullptr);
+  EXPECT_EQ(quadrant, 229.0);
+  EXPECT_EQ(box, 55.0);
+  double mass = 0.0;
+  ASSERT_EQ(glitter.mass(Footprint{5.0, 9.0, 2.0}, &mass), RuntimeStatus::kOk);
+  EXPECT_NEAR(mass, 0.9799817112940431, 1e-12);
+}
 
 TEST(FrozenRuntimeV1_0, NdfPyramid) {
   NdfPyramid pyramid;

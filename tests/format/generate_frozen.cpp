@@ -3,6 +3,7 @@
 //   c++ -std=c++17 -I formats/include generate_frozen.cpp -L<build>/formats -lglintbake_format ...
 //   ./a.out v1_0        v1_0_minimal.gbk, v1_0_image.gbk
 //   ./a.out v1_0_kinds  one container per asset kind (frozen_kinds.h)
+//   ./a.out v1_0_glitter  the glitter container (frozen_kinds.h), added with the kind
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
@@ -55,6 +56,15 @@ int writeKinds() {
   return 0;
 }
 
+int writeGlitter() {
+  if (!writeKind("v1_0_glitter.gbk", AssetKind::kGlitter, "glitter", "ndfgen",
+                 {{kSectionGlitterInfo, 0, frozen::glitterRecord(), Codec::kRaw},
+                  {kSectionGlitterIntegrals, 0, frozen::glitterIntegrals(), Codec::kZstd}}))
+    return 1;
+  std::puts("wrote v1_0_glitter.gbk");
+  return 0;
+}
+
 int writeV1_0() {
   {
     Writer writer;
@@ -85,6 +95,7 @@ int writeV1_0() {
 int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0") == 0) return writeV1_0();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_kinds") == 0) return writeKinds();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_glitter") == 0) return writeGlitter();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter\n", stderr);
   return 2;
 }

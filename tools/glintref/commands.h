@@ -58,7 +58,22 @@ struct CompareOptions {
   double max_rel_mse = std::numeric_limits<double>::infinity();
 };
 
+struct GlitterOptions {
+  int64_t particles = 0;
+  double alpha = 0.0;
+  std::string distribution = "beckmann";
+  uint64_t seed = 1;
+  std::string at_text;  // --at U,V
+  double extent = 0.0;
+  std::string s_text;  // --s SX,SY
+  double gamma_deg = 1.0;
+  int max_depth = 20;
+  bool exact = false;
+  bool enumerate = false;
+};
+
 CLI::App* addNdfCommand(CLI::App& app, NdfOptions& options);
+CLI::App* addGlitterCommand(CLI::App& app, GlitterOptions& options);
 CLI::App* addImageCommand(CLI::App& app, ImageOptions& options);
 CLI::App* addSampleCommand(CLI::App& app, SampleOptions& options);
 CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options);
@@ -66,6 +81,7 @@ CLI::App* addCompareCommand(CLI::App& app, CompareOptions& options);
 
 // Each returns a documented exit code or throws cli::Error.
 int runNdf(cli::Tool& tool, NdfOptions& options);
+int runGlitter(cli::Tool& tool, GlitterOptions& options);
 int runImage(cli::Tool& tool, ImageOptions& options);
 int runSample(cli::Tool& tool, SampleOptions& options);
 int runRender(cli::Tool& tool, RenderOptions& options);

@@ -6,7 +6,8 @@
 int main(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("glintref",
-                 "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons");
+                 "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons; "
+                 "procedural glitter");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
   glintref::CompareOptions compare;
   CLI::App* render_cmd = glintref::addRenderCommand(app, render);
   CLI::App* compare_cmd = glintref::addCompareCommand(app, compare);
+  glintref::GlitterOptions glitter;
+  CLI::App* glitter_cmd = glintref::addGlitterCommand(app, glitter);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     if (ndf_cmd->parsed()) return glintref::runNdf(t, ndf);
@@ -29,6 +32,7 @@ int main(int argc, char** argv) {
     if (sample_cmd->parsed()) return glintref::runSample(t, sample);
     if (render_cmd->parsed()) return glintref::runRender(t, render);
     if (compare_cmd->parsed()) return glintref::runCompare(t, compare);
+    if (glitter_cmd->parsed()) return glintref::runGlitter(t, glitter);
     throw cli::Error(cli::kExitBadArguments, "no command given");
   });
 }

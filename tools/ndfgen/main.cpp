@@ -1,9 +1,13 @@
 // ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
-// ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md).
+// ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md). With
+// --procedural glitter the images come from a procedural glitter surface instead of a map
+// (libbake/glitter), and --glitter-asset writes the surface itself as a glitter asset.
+#include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
@@ -33,6 +37,78 @@ Json levelJson(const bake::ndf::PyramidLevelReport& l, int region_size) {
   return j;
 }
 
+// ndfgen --procedural glitter: the pyramid of a glitter surface (or, with --glitter-asset, the
+// surface itself).
+cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter, bool as_asset,
+                             const cli::PyramidCliOptions& pyramid, const std::string& output, int zstd_level,
+                             std::chrono::steady_clock::time_point t0) {
+  const bake::ndf::PyramidOptions& opt = pyramid.options;
+  const bake::glitter::GlitterParams gp = cli::resolveGlitterOptions(glitter, opt.splat.ndf_res);
+  const bake::glitter::GlitterModel model(gp);
+  Json params = cli::pyramidOptionsJson(pyramid);
+  params["zstd_level"] = zstd_level;
+  params["glitter"] = cli::glitterParamsJson(gp);
+  Json asset;
+  asset["glitter"] = cli::glitterParamsJson(gp);
+  asset["integral_entries"] = model.integrals().size();
+  bake::ndf::PyramidReport report;
+  uint64_t images = 0;
+  if (as_asset) {
+    cli::ContainerOutput out(t, output, format::AssetKind::kGlitter, zstd_level);
+    const format::GlitterTreeShape shape = bake::glitter::defaultGlitterShape(gp, opt.sigma0);
+    cli::check(bake::glitter::writeGlitterSections(out.writer(), model, shape));
+    asset["tree_shape"] = {{"area", shape.area}, {"cone", shape.cone}};
+    Json meta = out.makeMetadata(params);
+    meta["asset"] = asset;
+    out.finish(meta);
+    if (!t.common().json)
+      t.info("wrote " + output + ": glitter asset, " + std::to_string(out.bytesWritten()) + " bytes");
+  } else {
+    cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
+    const bake::glitter::GlitterImageSource source(model, opt.splat.ndf_res, opt.sigma0);
+    cli::LevelProgress progress(t);
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback());
+    progress.finish();
+    cli::check(built);
+    asset["ndf_res"] = opt.splat.ndf_res;
+    asset["map_size"] = {gp.map_width, gp.map_height};
+    asset["wrap"] = "repeat";
+    asset["centre_grid"] = "centre (i, j) of level l at ((i + 0.5) stride_x, (j + 0.5) stride_y) texels";
+    asset["levels"] = Json::array();
+    for (const auto& l : report.levels) {
+      asset["levels"].push_back(levelJson(l, opt.region_size));
+      images += l.images;
+    }
+    asset["stop_reason"] = report.stop_reason;
+    Json meta = out.makeMetadata(params);
+    meta["asset"] = asset;
+    out.finish(meta);
+    if (!t.common().json)
+      t.info("wrote " + output + ": glitter pyramid, " + std::to_string(report.levels.size()) + " levels, " +
+             std::to_string(images) + " images, " + std::to_string(out.bytesWritten()) + " bytes");
+  }
+  if (t.common().json) {
+    Json doc;
+    doc["tool"] = "ndfgen";
+    doc["procedural"] = "glitter";
+    doc["output"] = cli::baseName(output);
+    doc["kind"] = as_asset ? "glitter" : "ndf-pyramid";
+    doc["parameters"] = params;
+    doc["levels"] = Json::array();
+    for (const auto& l : report.levels) {
+      Json j = levelJson(l, opt.region_size);
+      j["images"] = l.images;
+      j["seconds"] = l.seconds;
+      doc["levels"].push_back(j);
+    }
+    doc["images"] = images;
+    doc["integral_entries"] = model.integrals().size();
+    doc["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    t.printJson(doc);
+  }
+  return cli::kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -43,16 +119,23 @@ int main(int argc, char** argv) {
   const bake::ndf::PyramidOptions& opt = pyramid.options;
   int zstd_level = 3;
   CLI::App& app = tool.app();
-  app.add_option("map", input, "Normal map (or height field with --height)")->required();
+  app.add_option("map", input, "Normal map (or height field with --height); none with --procedural");
   app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();
   cli::addPyramidOptions(app, pyramid, "Footprint centres per side of a streamed chunk (1..256)");
   app.add_option("--zstd-level", zstd_level, "zstd compression level of the chunks (1..19)")->capture_default_str();
   cli::addIngestOptions(app, ingest);
+  cli::GlitterCliOptions glitter;
+  bool glitter_asset = false;
+  cli::addGlitterOptions(app, glitter);
+  app.add_flag("--glitter-asset", glitter_asset, "With --procedural glitter: write the surface as a glitter asset");
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
     cli::resolvePyramidOptions(pyramid);
+    if (!glitter.procedural.empty()) return bakeProcedural(t, glitter, glitter_asset, pyramid, output, zstd_level, t0);
+    if (input.empty()) throw Error(cli::kExitBadArguments, "a normal map (or --procedural glitter) is required");
+    if (glitter_asset) throw Error(cli::kExitBadArguments, "--glitter-asset needs --procedural glitter");
 
     bake::IngestReport ingest_report;
     const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);

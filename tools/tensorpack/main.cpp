@@ -2,9 +2,11 @@
 // an ndf-pyramid container into a tensor-ndf asset: per region and level, the non-blank B x B
 // angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md
 // section 10.4).
+#include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
@@ -169,6 +171,7 @@ struct Options {
   std::string input, output, method_text = "compressed", precision_text = "float32";
   bake::IngestOptions ingest;
   cli::PyramidCliOptions pyramid;
+  cli::GlitterCliOptions glitter;
   tensor::TensorPackOptions pack;
   double error_target = -1.0, max_error = -1.0;
   double exact_mib = 4.0;
@@ -186,8 +189,10 @@ void addOptions(CLI::App& app, Options& o) {
   // clamp it, so pdf and value / mass disagree there).
   o.pack.cp.nonneg = true;
   tensor::TensorPackOptions& opt = o.pack;
-  app.add_option("input", o.input, "Normal map (or height field with --height), or an ndf-pyramid container (.gbk)")
-      ->required();
+  app.add_option("input", o.input,
+                 "Normal map (or height field with --height), or an ndf-pyramid container (.gbk); none with "
+                 "--procedural");
+  cli::addGlitterOptions(app, o.glitter);
   app.add_option("-o,--output", o.output, "Output tensor-ndf container (default: the input's name with .gbk)");
   app.add_option("--rank", opt.cp.rank, "CP rank per group (1..64); the largest rank with --error-target")
       ->capture_default_str();
@@ -264,6 +269,8 @@ Json parametersJson(const Options& o) {
 // The input: an ndf-pyramid container (open reader) or a loaded normal map.
 struct Input {
   bool from_container = false;
+  std::unique_ptr<bake::glitter::GlitterModel> glitter;  // --procedural glitter
+  std::unique_ptr<bake::glitter::GlitterImageSource> source;
   format::Reader reader;
   bake::NormalMap map;
   Json map_json = nullptr, source_asset = nullptr;
@@ -271,6 +278,25 @@ struct Input {
 
 // Stage 2: opens the container, or loads the normal map, and completes the parameters.
 void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
+  if (!o.glitter.procedural.empty()) {
+    if (!o.input.empty()) throw Error(cli::kExitBadArguments, "--procedural takes no input file");
+    if (o.output.empty()) throw Error(cli::kExitBadArguments, "--procedural needs -o/--output");
+    cli::resolvePyramidOptions(o.pyramid);
+    const int res = o.pyramid.options.splat.ndf_res;
+    if (res % o.pack.block != 0) {
+      throw Error(cli::kExitBadArguments,
+                  "--block " + std::to_string(o.pack.block) + " must divide --ndf-res " + std::to_string(res));
+    }
+    const bake::glitter::GlitterParams gp = cli::resolveGlitterOptions(o.glitter, res);
+    in.glitter = std::make_unique<bake::glitter::GlitterModel>(gp);
+    in.source = std::make_unique<bake::glitter::GlitterImageSource>(*in.glitter, res, o.pyramid.options.sigma0);
+    in.map_json = {{"width", gp.map_width}, {"height", gp.map_height}, {"wrap", "repeat"}};
+    params["pyramid"] = cli::pyramidOptionsJson(o.pyramid);
+    params["glitter"] = cli::glitterParamsJson(gp);
+    params["source"] = "glitter";
+    return;
+  }
+  if (o.input.empty()) throw Error(cli::kExitBadArguments, "an input (or --procedural glitter) is required");
   in.from_container = isContainer(o.input);
   if (o.output.empty()) o.output = defaultOutput(o.input, in.from_container);
   if (in.from_container) {
@@ -337,7 +363,12 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
                                    bake::ndf::FlakesHandover& handover, uint64_t* flake_bytes) {
   tensor::TensorPackReport report;
   bake::BakeStatus s = bake::okStatus();
-  if (in.from_container) {
+  if (in.source) {
+    cli::LevelProgress progress(t);
+    s = tensor::packTensorNdfFromSource(*in.source, o.pyramid.options, o.pack, out.writer(), &report,
+                                        progress.callback());
+    progress.finish();
+  } else if (in.from_container) {
     s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
   } else {
     cli::LevelProgress progress(t);
@@ -347,8 +378,8 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
   // The flakes for exact small footprints (formats/SPEC.md 10.5), written from the map or carried
   // over from the source container, with the hand-over this compression calls for: the pyramid
-  // answers only from the first level from which every level is faithful (kFaithfulLevelError),
-  // the clustered lobes below it.
+  // answers only from the first level from which every level is faithful (unfaithfulness), the
+  // clustered lobes below it.
   std::vector<double> sigmas, errors;
   std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
   for (size_t l = 0; l < report.levels.size(); ++l) {
@@ -358,7 +389,9 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   }
   const int lobes = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
   handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes, exact.get());
-  if (!in.from_container) {
+  if (in.source) {
+    *flake_bytes = 0;  // a procedural surface has no map to carry
+  } else if (!in.from_container) {
     *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
     std::vector<uint8_t> flakes;
@@ -433,9 +466,9 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
   }
   Json doc;
   doc["tool"] = "tensorpack";
-  doc["input"] = cli::baseName(o.input);
+  doc["input"] = in.source ? std::string("glitter") : cli::baseName(o.input);
   doc["output"] = cli::baseName(o.output);
-  doc["source"] = in.from_container ? "ndf-pyramid" : "normal-map";
+  doc["source"] = in.source ? "glitter" : in.from_container ? "ndf-pyramid" : "normal-map";
   doc["map"] = in.map_json;
   doc["parameters"] = params;
   doc["ndf_res"] = report.ndf_res;

@@ -1,6 +1,7 @@
 // Opening any NDF asset kind through the NdfSource interface, chosen by the container's kind; the
 // file is opened once and the chosen kind loads from the same reader.
 #include <glintbake/format/container.h>
+#include <glintbake/runtime/glitter_ndf.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/tensor_ndf.h>
@@ -28,6 +29,8 @@ RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>*
       return loadAs<NdfPyramid>(reader, out);
     case format::AssetKind::kTensorNdf:
       return loadAs<TensorNdf>(reader, out);
+    case format::AssetKind::kGlitter:
+      return loadAs<GlitterNdf>(reader, out);
     default:
       return RuntimeStatus::kWrongKind;
   }

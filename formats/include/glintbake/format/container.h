@@ -85,12 +85,15 @@ enum SectionType : uint32_t {
   kSectionLtcTable = 48,           // ltc-table sections (48-63)
   kSectionRoughness = 64,          // roughness mips (64-79)
   kSectionFlakes = 80,             // NDF assets: the source normal map for exact small footprints (key = 0)
+  kSectionGlitterInfo = 128,       // glitter: the surface record (key = 0)
+  kSectionGlitterIntegrals = 129,  // glitter: the cached triangle integrals of the smooth NDF (key = 0)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
   kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
-// "tensor-info", "tensor-group", "ltc-table", "roughness", "image"); "private" for types >= kSectionFirstPrivate,
+// "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "glitter-info", "glitter-integrals",
+// "image"); "private" for types >= kSectionFirstPrivate,
 // "unknown" otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);
 bool sectionTypeFromString(const std::string& name, uint32_t* type);

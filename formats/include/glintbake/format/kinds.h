@@ -49,7 +49,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kRoughness, "roughness", 64, 79, "ltcfit"},
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, ""},
     {AssetKind::kTinyExample, "tiny-example", 112, 127, ""},
-    {AssetKind::kGlitter, "glitter", 128, 143, ""},
+    {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
 
@@ -63,11 +63,18 @@ constexpr SectionRange kSectionRanges[] = {
 };
 
 constexpr SectionTypeInfo kSectionTypeRegistry[] = {
-    {kSectionMetadata, "metadata"},      {kSectionNdfLevel, "ndf-level"},
-    {kSectionNdfChunk, "ndf-chunk"},     {kSectionTensorIndex, "tensor-index"},
-    {kSectionTensorInfo, "tensor-info"}, {kSectionTensorGroup, "tensor-group"},
-    {kSectionLtcTable, "ltc-table"},     {kSectionRoughness, "roughness"},
-    {kSectionFlakes, "flakes"},          {kSectionImage, "image"},
+    {kSectionMetadata, "metadata"},
+    {kSectionNdfLevel, "ndf-level"},
+    {kSectionNdfChunk, "ndf-chunk"},
+    {kSectionTensorIndex, "tensor-index"},
+    {kSectionTensorInfo, "tensor-info"},
+    {kSectionTensorGroup, "tensor-group"},
+    {kSectionLtcTable, "ltc-table"},
+    {kSectionRoughness, "roughness"},
+    {kSectionFlakes, "flakes"},
+    {kSectionGlitterInfo, "glitter-info"},
+    {kSectionGlitterIntegrals, "glitter-integrals"},
+    {kSectionImage, "image"},
 };
 
 // True for the types readers and validators know: defined types, types of open blocks and

@@ -140,6 +140,18 @@ class WriterPyramidSink final : public PyramidSink {
   format::NdfLevelRecord below_;  // the last level added
 };
 
+// Where a pyramid's images come from when they are not a normal map's flakes (procedural surfaces:
+// libbake/glitter). image() writes the R x R NDF image (bin averages per unit s-plane area, row 0
+// at s_y = +1; formats/SPEC.md section 9) of the footprint N((x, y), sigma^2), all in texels of a
+// map of mapSize(). It is called concurrently from several threads and must give the same image
+// whatever the thread.
+class FootprintImageSource {
+ public:
+  virtual ~FootprintImageSource() = default;
+  virtual void mapSize(int* width, int* height) const = 0;
+  virtual void image(double x, double y, double sigma, float* out) const = 0;
+};
+
 // Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an
 // open writer (the caller adds metadata and calls finish()). Errors: kBadArgument (options),
 // kRuntime (cancelled, out of memory), kIo (writer failure).
@@ -151,6 +163,15 @@ BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, 
 // the sink sees identical data whatever the thread count). Errors: those above, plus whatever the
 // sink returns.
 BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, PyramidSink& sink,
+                           PyramidReport* report, const PyramidProgress& progress = {},
+                           const std::atomic<bool>* cancel = nullptr);
+
+// The same pyramid with every image from `source` (a repeating surface of source.mapSize()
+// texels); options.rate and the splat's sigma_r are recorded in the level records only.
+BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOptions& options, PyramidSink& sink,
+                           PyramidReport* report, const PyramidProgress& progress = {},
+                           const std::atomic<bool>* cancel = nullptr);
+BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOptions& options, format::Writer& writer,
                            PyramidReport* report, const PyramidProgress& progress = {},
                            const std::atomic<bool>* cancel = nullptr);
 

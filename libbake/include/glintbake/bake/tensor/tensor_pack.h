@@ -126,6 +126,12 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
                                 const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                 const ndf::PyramidProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
 
+// The same from a procedural source of NDF images (ndf::FootprintImageSource, e.g. glitter).
+BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
+                                   const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
+                                   const ndf::PyramidProgress& progress = {},
+                                   const std::atomic<bool>* cancel = nullptr);
+
 // From an ndf-pyramid container (reads one chunk at a time). The output is byte-identical to
 // packTensorNdfFromMap with the pyramid options that built the container. Errors: as above, plus
 // kInvalidInput for a container that is not a valid ndf-pyramid and kIo for read failures.
