@@ -2,6 +2,8 @@
 // map geometry, and the argument checks of every query (pyramid_ndf.h).
 #include <glintbake/runtime/pyramid_ndf.h>
 
+#include <glintbake/format/kinds/ndf_pyramid_blend.h>
+
 #include "format_status.h"
 #include "pyramid_blend.h"
 
@@ -63,9 +65,14 @@ FootprintRange PyramidNdf::footprintRange() const {
   FootprintRange range;
   const int count = levelCount();
   if (count == 0) return range;
-  range.pyramid_min_sigma = level(0)->sigma_texels;
+  const format::NdfPyramidBlend* b = blender();
+  range.pyramid_min_sigma = level(b ? b->firstLevel() : 0)->sigma_texels;
   range.pyramid_max_sigma = level(count - 1)->sigma_texels;
   return range;
+}
+
+void PyramidNdf::answerFromSigma(double sigma) {
+  if (format::NdfPyramidBlend* b = blender()) b->answerFromSigma(sigma);
 }
 
 MapSize PyramidNdf::mapSize() const {

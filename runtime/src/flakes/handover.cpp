@@ -11,6 +11,10 @@
 #include <new>
 
 namespace glintbake::runtime {
+namespace {
+// sqrt(2) and a little: a level of exactly lobes_up_to / sqrt(2) still answers despite rounding.
+constexpr double kHalfOctaveWithSlack = 1.4142135623730951 * (1.0 + 1e-9);
+}  // namespace
 RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resolution, FlakePaths* paths) {
   const format::SectionInfo& info = reader.sections()[size_t(section)];
   if (info.raw_size < sizeof(format::FlakesRecord)) return RuntimeStatus::kInvalidAsset;
@@ -56,6 +60,10 @@ HandoverNdf::HandoverNdf(FlakePaths paths, std::unique_ptr<NdfSource> pyramid)
     lobes_from_ = r.flakes_up_to * format::kLobesBand;
     lobes_up_to_ = std::max(lobes_from_, std::min(r.lobes_up_to, paths_.lobes->footprintRange().clustered_max_sigma));
     pyramid_from_ = std::max(pyramid_from_, lobes_up_to_);
+    // The levels the lobes stand in for never answer, not even through the pyramid's own blend
+    // (whose deconvolution would otherwise prefer the finest level): the pyramid answers from the
+    // first level of at least lobes_up_to / sqrt(2), the level the hand-over was placed above.
+    pyramid_->answerFromSigma(lobes_up_to_ / kHalfOctaveWithSlack);
   }
 }
 

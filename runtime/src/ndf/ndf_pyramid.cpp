@@ -165,6 +165,9 @@ const NdfLevelRecord* NdfPyramid::levelRecords(int* count) const {
   return impl_->records;
 }
 
+format::NdfPyramidBlend* NdfPyramid::blender() { return impl_ ? &impl_->blender : nullptr; }
+const format::NdfPyramidBlend* NdfPyramid::blender() const { return impl_ ? &impl_->blender : nullptr; }
+
 const float* NdfPyramid::centreImage(int l, int i, int j) const {
   const NdfLevelRecord* r = level(l);
   if (!r || i < 0 || j < 0 || uint32_t(i) >= r->grid_width || uint32_t(j) >= r->grid_height) return nullptr;

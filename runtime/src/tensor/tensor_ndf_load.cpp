@@ -190,6 +190,9 @@ const NdfLevelRecord* TensorNdf::levelRecords(int* count) const {
   return impl_->level_records;
 }
 
+format::NdfPyramidBlend* TensorNdf::blender() { return impl_ ? &impl_->blender : nullptr; }
+const format::NdfPyramidBlend* TensorNdf::blender() const { return impl_ ? &impl_->blender : nullptr; }
+
 const TensorInfoRecord* TensorNdf::info() const { return impl_ ? &impl_->info : nullptr; }
 int TensorNdf::groupCount() const { return impl_ ? int(impl_->group_count) : 0; }
 uint64_t TensorNdf::blocksKept() const { return impl_ ? impl_->blocks_kept : 0; }

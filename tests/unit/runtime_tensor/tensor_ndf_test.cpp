@@ -145,6 +145,26 @@ TEST(TensorNdf, ExactLevelsBlendLikeTheUncompressedPyramid) {
   for (int q = 0; q < 60; ++q) compare(recon, footprint(pos(rng), pos(rng), sig(rng)));
   std::uniform_real_distribution<double> above(1.25 * top, 80.0);
   for (int q = 0; q < 30; ++q) compare(plain, footprint(pos(rng), pos(rng), above(rng)));
+  // Answering from the first exact level only (what the loader does when the lobes stand in for
+  // the compressed level 0), the asset equals the uncompressed pyramid restricted alike at every
+  // footprint, and reports that level as where the pyramid starts.
+  TensorNdf restricted;
+  ASSERT_EQ(restricted.openMemory(assets().exact_bytes.data(), assets().exact_bytes.size()), RuntimeStatus::kOk);
+  const double level1 = restricted.level(1)->sigma_texels;
+  restricted.answerFromSigma(level1);
+  plain.answerFromSigma(level1);
+  EXPECT_EQ(restricted.footprintRange().pyramid_min_sigma, level1);
+  EXPECT_EQ(plain.footprintRange().pyramid_min_sigma, level1);
+  for (int q = 0; q < 60; ++q) {
+    const Footprint fp = footprint(pos(rng), pos(rng), sig(rng));
+    ASSERT_EQ(restricted.image(fp, img_t.data(), img_t.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(plain.image(fp, img_r.data(), img_r.size()), RuntimeStatus::kOk);
+    const float peak = *std::max_element(img_r.begin(), img_r.end());
+    for (size_t n = 0; n < img_t.size(); ++n) ASSERT_NEAR(img_t[n], img_r[n], 1e-5 * peak) << "sigma " << fp.sigma;
+  }
+  // Past the top level the restriction keeps the top level.
+  restricted.answerFromSigma(1e9);
+  EXPECT_EQ(restricted.footprintRange().pyramid_min_sigma, top);
   std::remove(recon_path.c_str());
   std::remove(plain_path.c_str());
 }

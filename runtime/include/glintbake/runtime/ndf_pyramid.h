@@ -58,6 +58,8 @@ class NdfPyramid : public PyramidNdf {
   void reset() override;
   bool loaded() const override { return impl_ != nullptr; }
   const NdfLevelRecord* levelRecords(int* count) const override;
+  format::NdfPyramidBlend* blender() override;
+  const format::NdfPyramidBlend* blender() const override;
 
   // eval: value of the blended P-NDF at s (density per unit s-plane area; 0 outside [-1,1]^2).
   // average: exact average of the blended P-NDF over the rectangle (its parts outside [-1,1]^2

@@ -78,6 +78,12 @@ class NdfSource {
   virtual RuntimeStatus mass(const Footprint& footprint, double* value) const = 0;
   // The R x R image of eval() (bin averages, row 0 at s_y = +1); out_count >= R * R.
   virtual RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const = 0;
+
+  // Pyramid-shaped sources: answer from the first level whose sigma is at least `sigma` (the top
+  // level when none is) and never consult finer ones; footprints below that level's sigma get its
+  // bilinear blend. The asset loader calls it before the source is shared, when the clustered
+  // lobes stand in for the finer levels (their compression is not faithful); others ignore it.
+  virtual void answerFromSigma(double sigma) { (void)sigma; }
 };
 
 // An NDF source whose image can be added, scaled, into a caller's buffer (the flakes and the

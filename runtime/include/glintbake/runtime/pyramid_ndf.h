@@ -16,6 +16,10 @@
 
 #include <cstddef>
 
+namespace glintbake::format {
+class NdfPyramidBlend;
+}
+
 namespace glintbake::runtime {
 
 // The level descriptor is the container's record (formats/SPEC.md 10.1, kinds/ndf_pyramid.h).
@@ -54,6 +58,10 @@ class PyramidNdf : public NdfSource {
   RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const final;
   RuntimeStatus mass(const Footprint& footprint, double* value) const final;
   RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const final;
+  // The blend uses the levels from the first whose sigma is at least `sigma` (NdfSource); the
+  // footprint range reports that level as pyramid_min_sigma. Not thread-safe: call it before the
+  // asset is shared. A later open() uses every level again.
+  void answerFromSigma(double sigma) final;
 
  protected:
   PyramidNdf() = default;
@@ -66,6 +74,9 @@ class PyramidNdf : public NdfSource {
   virtual bool loaded() const = 0;
   // The loaded level records, contiguous (count of them), or null when not loaded.
   virtual const NdfLevelRecord* levelRecords(int* count) const = 0;
+  // The footprint blend of the loaded levels, or null when not loaded.
+  virtual format::NdfPyramidBlend* blender() = 0;
+  virtual const format::NdfPyramidBlend* blender() const = 0;
 
   // Queries on checked arguments (the asset is loaded, pointers are valid, the footprint is valid).
   virtual RuntimeStatus evalChecked(const Footprint& footprint, const SPoint& s, double* value) const = 0;

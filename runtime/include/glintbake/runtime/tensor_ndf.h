@@ -81,6 +81,8 @@ class TensorNdf : public PyramidNdf {
   void reset() override;
   bool loaded() const override { return impl_ != nullptr; }
   const NdfLevelRecord* levelRecords(int* count) const override;
+  format::NdfPyramidBlend* blender() override;
+  const format::NdfPyramidBlend* blender() const override;
 
   RuntimeStatus evalChecked(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus averageChecked(const Footprint& footprint, const SRect& rect, double* value) const override;

@@ -161,6 +161,7 @@ class NdfPyramidBlend {
   // positive, sigmas increasing); 1 <= count <= kMaxNdfLevels.
   void init(const NdfLevelRecord* records, int count) {
     count_ = count;
+    first_ = 0;
     for (int l = 0; l < count; ++l) {
       const NdfLevelRecord& r = records[l];
       const bool repeat = r.wrap == 0;
@@ -180,12 +181,12 @@ class NdfPyramidBlend {
   // weights sum to 1 (up to the truncation, see above).
   template <typename Emit>
   void blend(double x, double y, double sigma, Emit&& emit) const {
-    if (!(sigma > level_[0].sigma)) {
-      blendLevel(0, 1.0, x, y, emit);
+    if (!(sigma > level_[first_].sigma)) {
+      blendLevel(first_, 1.0, x, y, emit);
       return;
     }
-    int l = 0;
-    double q = spread(0, sigma);
+    int l = first_;
+    double q = spread(first_, sigma);
     while (q > kMaxSpread && l + 1 < count_) q = spread(++l, sigma);
     double beta = 0.0;  // weight of level l + 1
     if (q > kBlendSpread && l + 1 < count_) {
@@ -195,6 +196,14 @@ class NdfPyramidBlend {
     gaussianLevel(l, 1.0 - beta, x, y, sigma, emit);
     if (beta > 0.0) gaussianLevel(l + 1, beta, x, y, sigma, emit);
   }
+
+  // blend() uses the levels from the first whose sigma is at least `sigma` (the top level when
+  // none is): footprints below it get its bilinear blend (NdfSource::answerFromSigma).
+  void answerFromSigma(double sigma) {
+    first_ = 0;
+    while (first_ + 1 < count_ && level_[first_].sigma < sigma) ++first_;
+  }
+  int firstLevel() const { return first_; }
 
   // Spread of level l for a footprint of std sigma: the larger of tau' / stride over both axes
   // (0 where the footprint is not wider than the level's own plus its tent).
@@ -251,6 +260,7 @@ class NdfPyramidBlend {
 
   Level level_[kMaxNdfLevels];
   int count_ = 0;
+  int first_ = 0;  // the finest level blend() uses
 };
 
 }  // namespace glintbake::format
