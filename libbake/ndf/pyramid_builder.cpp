@@ -118,7 +118,7 @@ BakeStatus validatePyramidOptions(const PyramidOptions& o) {
   if (o.levels < 0 || o.levels > kMaxPyramidLevels)
     return bad("--levels must be auto or in [1, " + std::to_string(kMaxPyramidLevels) + "]");
   if (!(o.converge_mse > 0.0)) return bad("--converge-mse must be positive");
-  if (o.converge_from_grid < 0) return bad("the convergence grid must be >= 0");
+  if (o.converge_from_grid < 0 || o.converge_from_level < 0) return bad("the convergence grid and level must be >= 0");
   if (o.region_size < 1 || o.region_size > 256) return bad("--region must be in [1, 256]");
   return okStatus();
 }
@@ -307,6 +307,7 @@ void PyramidBuild::computeImage(const Level& lv, int i, int j, float* out) {
 BakeStatus PyramidBuild::probe(Level& lv, bool* converged) {
   *converged = false;
   if (options_.levels != 0 || lv.samples.empty()) return okStatus();
+  if (lv.level - 1 < options_.converge_from_level) return okStatus();
   if (options_.converge_from_grid > 0 && lv.level > 0) {
     const LevelGeometry below = levelGeometry(map_.width, map_.height, options_, lv.level - 1);
     if (std::max(below.grid_width, below.grid_height) > options_.converge_from_grid) return okStatus();

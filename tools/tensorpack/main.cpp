@@ -174,7 +174,7 @@ struct Options {
   cli::GlitterCliOptions glitter;
   tensor::TensorPackOptions pack;
   double error_target = -1.0, max_error = -1.0;
-  double exact_mib = 4.0;
+  double exact_mib = 16.0;
   int zstd_level = 9;
 };
 
@@ -212,8 +212,8 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
   app.add_option("--exact-levels", o.exact_mib,
-                 "Store the levels whose NDF images take at most this many MiB (float32) exactly instead of "
-                 "compressed (0..1024; 0: compress every level)")
+                 "Store the levels above the finest whose NDF images take at most this many MiB "
+                 "(float32) exactly instead of compressed (0..1024; 0: compress every level)")
       ->capture_default_str();
   app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
   app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
@@ -242,6 +242,7 @@ void resolveOptions(const CLI::App& app, Options& o) {
   if (!(o.exact_mib >= 0.0 && o.exact_mib <= 1024.0))
     throw Error(cli::kExitBadArguments, "--exact-levels must be in [0, 1024] MiB");
   o.pack.exact_level_bytes = uint64_t(o.exact_mib * 1048576.0);
+  o.pack.exact_min_level = 1;  // level 0's footprints are the lobes' (from single flakes)
   if (bake::BakeStatus s = tensor::validateTensorPackOptions(o.pack); !s)
     throw Error(exitCodeOf(s.error()), s.error().message);
 }
@@ -330,6 +331,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   // (side^2 R^2 4 bytes within the budget), so that the top level is not a lossy one.
   const double exact_side = std::sqrt(double(o.pack.exact_level_bytes) / (4.0 * double(ndf_res) * double(ndf_res)));
   o.pyramid.options.converge_from_grid = int(std::min(exact_side, 65536.0));
+  o.pyramid.options.converge_from_level = o.pack.exact_level_bytes > 0 ? 1 : 0;
   if (ndf_res % o.pack.block != 0) {
     throw Error(cli::kExitBadArguments,
                 "--block " + std::to_string(o.pack.block) + " must divide --ndf-res " + std::to_string(ndf_res));

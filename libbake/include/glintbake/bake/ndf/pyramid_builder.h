@@ -60,6 +60,7 @@ struct PyramidOptions {
   // centres per side (0: above every level). tensorpack sets it so that the pyramid reaches the
   // small levels it stores exactly before it may stop.
   int converge_from_grid = 0;
+  int converge_from_level = 0;  // ... and only above this level
 };
 
 // Validates the options (kBadArgument with a message naming the option).

@@ -72,6 +72,9 @@ struct TensorPackOptions {
   // small and CP keeps little of their glints at rank 16 (README, "Figures"). 0: none; needs
   // B <= 64.
   uint64_t exact_level_bytes = 0;
+  // ... and whose index is at least this: finer levels stay compressed (tensorpack sets 1: the
+  // clustered lobes answer level 0's footprints from single flakes).
+  int exact_min_level = 0;
 };
 
 // Validates ranges (kBadArgument naming the option, as the tool spells it).
