@@ -9,6 +9,7 @@
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds/flakes.h>
 
 #include <algorithm>
@@ -236,7 +237,8 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
                                               format::assetKindString(in.reader.kind()) + ")");
     }
     std::string meta_text;
-    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk) {
+    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk &&
+        format::jsonNestingDepth(meta_text) <= size_t(format::kMaxJsonDepth)) {
       const Json source = Json::parse(meta_text, nullptr, false);
       if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
       if (source.is_object() && source.contains("asset")) in.source_asset = source["asset"];
