@@ -138,6 +138,20 @@ class KindLayouts(clitest.ToolTestCase):
         self.assert_refused_alike(self.write("headless.gbk", build_container(headless, kind=KIND_NDF_PYRAMID)))
 
 
+class MemoryBudget(clitest.ToolTestCase):
+    def test_bakers_refuse_up_front_when_the_estimate_exceeds_max_memory(self):
+        m = self.mapgen("beckmann", "m.png", "--size", "32", "--seed", "3")
+        pack = ["--rank", "4", "--block", "16"]
+        for tool, extra in (("ndfgen", []), ("tensorpack", pack)):
+            out = self.path(tool + ".gbk")
+            err = self.assert_fails(clitest.RUNTIME, tool, m, "-o", out, *NDF, *extra, "--max-memory", "64K",
+                                    outputs=[out])
+            self.assertIn("more than --max-memory 64K", err)
+            self.assert_fails(clitest.BAD_ARGS, tool, m, "-o", out, *NDF, *extra, "--max-memory", "lots",
+                              outputs=[out])
+            self.run_ok(tool, m, "-o", out, *NDF, *extra, "--max-memory", "1G")
+
+
 class TinyMaps(clitest.ToolTestCase):
     def test_one_texel_maps_are_refused_by_every_tool(self):
         one = self.path("one.pfm")

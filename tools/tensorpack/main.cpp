@@ -255,6 +255,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   bake::IngestReport ingest_report;
   in.map = cli::loadNormalMapForTool(t, o.input, o.ingest, &ingest_report);
   cli::requireBakeableMap(in.map, o.input);
+  cli::checkMemoryBudget(o.pyramid, in.map, t.threadCount(), /*tensor=*/true);
   in.map_json = {{"width", in.map.width}, {"height", in.map.height}, {"wrap", bake::wrapString(in.map.wrap)}};
   Json p = cli::pyramidOptionsJson(o.pyramid);
   p["ingest"] = cli::ingestOptionsJson(o.ingest);
