@@ -9,6 +9,7 @@ packages=(
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev libeigen3-dev libceres-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang  # libFuzzer targets (scripts/fuzz.sh)
 )
 if [[ "${1:-}" == "--browser" ]]; then
   packages+=(chromium)

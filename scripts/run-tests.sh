@@ -1,17 +1,42 @@
 #!/usr/bin/env bash
 # Builds everything and runs the whole test suite (CTest). Installs missing dependencies first.
-# First a runtime-only configuration (container library + runtime-lite, no OpenImageIO, Ceres,
-# TBB or Eigen) is built and tested, as a renderer would build it; then the full project.
+#  1. a runtime-only configuration (container library + runtime-lite, no OpenImageIO, Ceres, TBB
+#     or Eigen), built and tested as a renderer would build it;
+#  2. the full project, Release, with warnings as errors (GLINTBAKE_WERROR), every test;
+#  3. sanitizers (scripts/sanitize.sh): the unit tests under ASan+UBSan in a Debug build, the
+#     runtime's concurrency test under TSan;
+#  4. a short run of every libFuzzer target (scripts/fuzz.sh, clang), seeded from valid files of
+#     every kind.
+# Each stage's wall time is printed at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh --browser
 
-generator=()
-command -v ninja >/dev/null && generator=(-G Ninja)
-cmake -S . -B build-runtime-only "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DGLINTBAKE_RUNTIME_ONLY=ON \
-  -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build-runtime-only -j "$(nproc)" >/dev/null
-ctest --test-dir build-runtime-only --output-on-failure -j "$(nproc)"
+timings=()
+stage() {
+  local name=$1 start=$SECONDS
+  shift
+  echo "=== $name"
+  "$@"
+  timings+=("$name: $((SECONDS - start)) s")
+}
 
-scripts/build.sh
-ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 900
+runtime_only() {
+  local generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  cmake -S . -B build-runtime-only "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DGLINTBAKE_RUNTIME_ONLY=ON \
+    -DGLINTBAKE_BUILD_BENCH=OFF -DGLINTBAKE_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+  cmake --build build-runtime-only -j "$(nproc)" >/dev/null
+  ctest --test-dir build-runtime-only --output-on-failure -j "$(nproc)"
+}
+
+full() {
+  scripts/build.sh -DGLINTBAKE_WERROR=ON
+  ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 900
+}
+
+stage "runtime-only" runtime_only
+stage "full build and tests" full
+stage "sanitizers" scripts/sanitize.sh
+stage "fuzz" scripts/fuzz.sh "${GLINTBAKE_FUZZ_SECONDS:-20}"
+printf '%s\n' "${timings[@]}"

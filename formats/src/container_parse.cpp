@@ -3,6 +3,7 @@
 
 #include "layout.h"
 
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_frameHeaderSize (exported by libzstd 1.4+)
 #include <zstd.h>
 
 #include "hash_stream.h"
@@ -271,45 +272,110 @@ ContainerStatus parseContainer(const ByteSource& source, const ReaderOptions& op
   return check.status();
 }
 
-ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
-  if (dst_size != info.raw_size || (dst == nullptr && dst_size != 0)) return ContainerStatus::kInvalidArgument;
-  if (info.codec != uint32_t(Codec::kRaw) && info.codec != uint32_t(Codec::kZstd))
-    return ContainerStatus::kDecompressFailed;
-  if (info.codec == uint32_t(Codec::kRaw)) {
-    if (info.stored_size != info.raw_size) return ContainerStatus::kCorruptIndex;
-    if (!source.readAt(info.offset, dst, dst_size)) return ContainerStatus::kTruncated;
-    if (hash64(dst, dst_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
-    return ContainerStatus::kOk;
-  }
+namespace {
 
-  // zstd: stored bytes come straight from memory sources, or through a buffer bounded by the file.
-  std::vector<uint8_t> buffer;
+// The most bytes a zstd frame's blocks can produce, from its block headers alone (RFC 8878 3.1.1.2):
+// raw and RLE blocks their stated size, a compressed block at most 128 KiB. The frame header's
+// content size is a claim; this bound is what a hostile frame can really make a decoder write.
+// UINT64_MAX when the block headers are malformed.
+uint64_t zstdBlockBound(const uint8_t* frame, size_t size) {
+  const size_t header = ZSTD_frameHeaderSize(frame, size);
+  if (ZSTD_isError(header) || header > size) return UINT64_MAX;
+  constexpr uint64_t kMaxBlock = uint64_t(128) << 10;
+  uint64_t bound = 0;
+  for (size_t at = header;;) {
+    if (size - at < 3) return UINT64_MAX;
+    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
+    at += 3;
+    const uint32_t type = (block >> 1) & 3, block_size = block >> 3;
+    const uint64_t consumed = type == 1 ? 1 : block_size;  // RLE: one byte repeated
+    if (type == 3 || block_size > kMaxBlock || consumed > size - at) return UINT64_MAX;
+    at += size_t(consumed);
+    bound += type == 2 ? kMaxBlock : block_size;
+    if (block & 1) return bound;
+  }
+}
+
+// The stored bytes of a zstd section, checksum-verified and proven to decode to exactly raw_size:
+// one frame, exactly the stored bytes, recording raw_size as its content size, whose blocks can
+// produce that many bytes. Memory sources are used in place; file sources go through `buffer`
+// (bounded by the file's size). Nothing of raw_size is allocated here.
+ContainerStatus loadZstdFrame(const ByteSource& source, const SectionInfo& info, std::vector<uint8_t>* buffer,
+                              const uint8_t** stored_out) {
   const uint8_t* stored = source.data() ? source.data() + info.offset : nullptr;
   if (!stored) {
     if (info.stored_size > source.size()) return ContainerStatus::kTruncated;
-    buffer.resize(size_t(info.stored_size));
-    if (!source.readAt(info.offset, buffer.data(), buffer.size())) return ContainerStatus::kTruncated;
-    stored = buffer.data();
+    buffer->resize(size_t(info.stored_size));
+    if (!source.readAt(info.offset, buffer->data(), buffer->size())) return ContainerStatus::kTruncated;
+    stored = buffer->data();
   } else if (info.offset > source.size() || info.stored_size > source.size() - info.offset) {
     return ContainerStatus::kTruncated;
   }
   const size_t stored_size = size_t(info.stored_size);
   if (hash64(stored, stored_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
-
-  // One frame, exactly the stored bytes, announcing exactly raw_size: checked before decoding so
-  // a hostile frame can neither overrun dst nor make the decoder produce more than asked.
   const size_t frame_size = ZSTD_findFrameCompressedSize(stored, stored_size);
   if (ZSTD_isError(frame_size) || frame_size != stored_size) return ContainerStatus::kDecompressFailed;
   const unsigned long long content = ZSTD_getFrameContentSize(stored, stored_size);
   if (content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR || content != info.raw_size) {
     return ContainerStatus::kDecompressFailed;
   }
+  // The frame header may lie; the block headers bound what the frame can really produce.
+  const uint64_t bound = zstdBlockBound(stored, stored_size);
+  if (bound == UINT64_MAX || bound < info.raw_size) return ContainerStatus::kDecompressFailed;
+  *stored_out = stored;
+  return ContainerStatus::kOk;
+}
+
+ContainerStatus decodeZstd(const uint8_t* stored, size_t stored_size, void* dst, size_t dst_size) {
   ZSTD_DCtx* dctx = ZSTD_createDCtx();
   if (!dctx) return ContainerStatus::kDecompressFailed;
   const size_t got = ZSTD_decompressDCtx(dctx, dst, dst_size, stored, stored_size);
   ZSTD_freeDCtx(dctx);
   if (ZSTD_isError(got) || got != dst_size) return ContainerStatus::kDecompressFailed;
   return ContainerStatus::kOk;
+}
+
+ContainerStatus readRaw(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
+  if (info.stored_size != info.raw_size) return ContainerStatus::kCorruptIndex;
+  if (!source.readAt(info.offset, dst, dst_size)) return ContainerStatus::kTruncated;
+  if (hash64(dst, dst_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
+  return ContainerStatus::kOk;
+}
+
+bool knownCodec(uint32_t codec) { return codec == uint32_t(Codec::kRaw) || codec == uint32_t(Codec::kZstd); }
+
+}  // namespace
+
+ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size) {
+  if (dst_size != info.raw_size || (dst == nullptr && dst_size != 0)) return ContainerStatus::kInvalidArgument;
+  if (!knownCodec(info.codec)) return ContainerStatus::kDecompressFailed;
+  if (info.codec == uint32_t(Codec::kRaw)) return readRaw(source, info, dst, dst_size);
+  std::vector<uint8_t> buffer;
+  const uint8_t* stored = nullptr;
+  const ContainerStatus status = loadZstdFrame(source, info, &buffer, &stored);
+  if (status != ContainerStatus::kOk) return status;
+  return decodeZstd(stored, size_t(info.stored_size), dst, dst_size);
+}
+
+ContainerStatus readSectionAlloc(const ByteSource& source, const SectionInfo& info, std::vector<uint8_t>* out) {
+  out->clear();
+  if (!knownCodec(info.codec)) return ContainerStatus::kDecompressFailed;
+  if (info.codec == uint32_t(Codec::kRaw)) {
+    // stored_size = raw_size and the stored bytes lie inside the file (parseContainer).
+    if (info.stored_size != info.raw_size || info.raw_size > source.size()) return ContainerStatus::kCorruptIndex;
+    out->resize(size_t(info.raw_size));
+    const ContainerStatus status = readRaw(source, info, out->data(), out->size());
+    if (status != ContainerStatus::kOk) out->clear();
+    return status;
+  }
+  std::vector<uint8_t> buffer;
+  const uint8_t* stored = nullptr;
+  ContainerStatus status = loadZstdFrame(source, info, &buffer, &stored);
+  if (status != ContainerStatus::kOk) return status;
+  out->resize(size_t(info.raw_size));
+  status = decodeZstd(stored, size_t(info.stored_size), out->data(), out->size());
+  if (status != ContainerStatus::kOk) std::vector<uint8_t>().swap(*out);
+  return status;
 }
 
 ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected) {

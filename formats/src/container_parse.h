@@ -41,6 +41,10 @@ ContainerStatus parseContainer(const ByteSource& source, const ReaderOptions& op
 // before decoding. `info` must come from parseContainer on the same source. Thread-safe.
 ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& info, void* dst, size_t dst_size);
 
+// Same, into out (resized to raw_size only after the stored bytes have proven, checksum and zstd
+// frame and block headers, that they decode to raw_size bytes). out is empty on failure.
+ContainerStatus readSectionAlloc(const ByteSource& source, const SectionInfo& info, std::vector<uint8_t>* out);
+
 // Hashes bytes [kHeaderSize, size) of the source (streamed in fixed-size chunks) and compares
 // with `expected`.
 ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected);

@@ -91,12 +91,9 @@ int Reader::find(uint32_t type, uint64_t key) const {
 ContainerStatus Reader::readSection(size_t i, std::vector<uint8_t>* out) const {
   if (!impl_->source || out == nullptr) return ContainerStatus::kInvalidArgument;
   if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;
-  const SectionInfo& info = impl_->parsed.sections[i];
-  // raw_size was checked against ReaderOptions::max_raw_section_size by open().
-  out->resize(size_t(info.raw_size));
-  const ContainerStatus status = detail::readSectionFrom(*impl_->source, info, out->data(), out->size());
-  if (status != ContainerStatus::kOk) out->clear();
-  return status;
+  // raw_size was checked against ReaderOptions::max_raw_section_size by open(); the frame is checked
+  // against it before out grows.
+  return detail::readSectionAlloc(*impl_->source, impl_->parsed.sections[i], out);
 }
 
 ContainerStatus Reader::readSectionInto(size_t i, void* dst, size_t dst_size) const {
@@ -121,6 +118,7 @@ ContainerStatus Reader::readMetadata(std::string* json_utf8) const {
   if (json_utf8 == nullptr) return ContainerStatus::kInvalidArgument;
   const int i = find(kSectionMetadata);
   if (i < 0) return ContainerStatus::kNotFound;
+  if (impl_->parsed.sections[size_t(i)].raw_size > kMaxMetadataSize) return ContainerStatus::kTooLarge;
   std::vector<uint8_t> bytes;
   const ContainerStatus status = readSection(size_t(i), &bytes);
   if (status != ContainerStatus::kOk) return status;

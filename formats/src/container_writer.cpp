@@ -1,4 +1,5 @@
 // Writer: streams sections into a temporary file, then writes index and header and renames.
+#include <glintbake/format/atomic_file.h>
 #include <glintbake/format/container.h>
 
 #include "hash_stream.h"
@@ -23,8 +24,8 @@ using namespace layout;
 
 struct Writer::Impl {
   std::string final_path;
-  std::string tmp_path;
-  int fd = -1;
+  AtomicFile file;
+  bool open = false;
   bool failed = false;
   bool finished = false;
   AssetKind kind = AssetKind::kUnknown;
@@ -43,15 +44,7 @@ struct Writer::Impl {
 
   // Writes all of data at the current position (sequential, after the header).
   bool append(const void* data, size_t size) {
-    const auto* p = static_cast<const uint8_t*>(data);
-    size_t left = size;
-    while (left > 0) {
-      const ssize_t n = ::write(fd, p, left);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return false;
-      p += n;
-      left -= size_t(n);
-    }
+    if (file.write(data, size) != ContainerStatus::kOk) return false;
     file_hash.update(data, size);
     position += size;
     return true;
@@ -76,21 +69,14 @@ Writer::~Writer() {
 }
 
 ContainerStatus Writer::open(const std::string& path, AssetKind kind, int zstd_level) {
-  if (impl_->fd >= 0 || impl_->finished) return ContainerStatus::kInvalidArgument;
+  if (impl_->open || impl_->finished) return ContainerStatus::kInvalidArgument;
   if (path.empty() || zstd_level < 1 || zstd_level > 19) return ContainerStatus::kInvalidArgument;
   Impl& w = *impl_;
   w.final_path = path;
   w.kind = kind;
   w.zstd_level = zstd_level;
-  std::string pattern = path + ".tmp-XXXXXX";
-  std::vector<char> buffer(pattern.begin(), pattern.end());
-  buffer.push_back('\0');
-  const int fd = ::mkstemp(buffer.data());
-  if (fd < 0) return ContainerStatus::kIoError;
-  w.fd = fd;
-  w.tmp_path = buffer.data();
-  // mkstemp creates 0600; assets are ordinary shareable files.
-  ::fchmod(fd, 0644);
+  if (w.file.open(path) != ContainerStatus::kOk) return ContainerStatus::kIoError;
+  w.open = true;
   w.cctx = ZSTD_createCCtx();
   if (!w.cctx || !w.file_hash.ok()) return w.fail(ContainerStatus::kIoError);
   // Deterministic frames: fixed level, content size recorded, no checksum (the index has one),
@@ -101,20 +87,14 @@ ContainerStatus Writer::open(const std::string& path, AssetKind kind, int zstd_l
   ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_dictIDFlag, 0);
   // The header is written last; reserve its bytes now (they are not part of the file hash).
   static const uint8_t kZeroHeader[kHeaderSize] = {};
-  size_t left = kHeaderSize;
-  while (left > 0) {
-    const ssize_t n = ::write(fd, kZeroHeader + (kHeaderSize - left), left);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return w.fail(ContainerStatus::kIoError);
-    left -= size_t(n);
-  }
+  if (w.file.write(kZeroHeader, kHeaderSize) != ContainerStatus::kOk) return w.fail(ContainerStatus::kIoError);
   w.position = kHeaderSize;
   return ContainerStatus::kOk;
 }
 
 ContainerStatus Writer::addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec) {
   Impl& w = *impl_;
-  if (w.fd < 0 || w.failed || w.finished) return ContainerStatus::kInvalidArgument;
+  if (!w.open || w.failed || w.finished) return ContainerStatus::kInvalidArgument;
   if (data == nullptr && size != 0) return ContainerStatus::kInvalidArgument;
   if (codec != Codec::kRaw && codec != Codec::kZstd) return ContainerStatus::kInvalidArgument;
   if (w.sections.size() >= kMaxSectionCount) return ContainerStatus::kTooLarge;
@@ -157,7 +137,7 @@ ContainerStatus Writer::addMetadata(const std::string& json_utf8) {
 
 ContainerStatus Writer::finish() {
   Impl& w = *impl_;
-  if (w.fd < 0 || w.finished) return ContainerStatus::kInvalidArgument;
+  if (!w.open || w.finished) return ContainerStatus::kInvalidArgument;
   if (w.failed) {
     abort();
     return ContainerStatus::kInvalidArgument;
@@ -203,41 +183,30 @@ ContainerStatus Writer::finish() {
   store64(h + kOffIndexChecksum, hash64(index.data(), index.size()));
   store64(h + kOffHeaderChecksum, hash64(h, kHeaderSize));  // computed with the field still zero
 
-  bool ok = ::pwrite(w.fd, h, kHeaderSize, 0) == ssize_t(kHeaderSize);
-  ok = ok && ::fsync(w.fd) == 0;
-  ok = (::close(w.fd) == 0) && ok;
-  w.fd = -1;
-  if (!ok || std::rename(w.tmp_path.c_str(), w.final_path.c_str()) != 0) {
+  if (w.file.writeAt(h, kHeaderSize, 0) != ContainerStatus::kOk || w.file.commit() != ContainerStatus::kOk) {
     abort();
     return ContainerStatus::kIoError;
   }
+  w.open = false;
   w.finished = true;
-  w.tmp_path.clear();
-  // Make the rename durable too: sync the destination directory (best effort).
-  const size_t slash = w.final_path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : w.final_path.substr(0, slash));
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
   return ContainerStatus::kOk;
 }
 
 void Writer::abort() {
   Impl& w = *impl_;
-  if (w.fd >= 0) {
-    ::close(w.fd);
-    w.fd = -1;
-  }
-  if (!w.tmp_path.empty()) {
-    ::unlink(w.tmp_path.c_str());
-    w.tmp_path.clear();
-  }
+  w.file.abort();
+  w.open = false;
   w.failed = true;
 }
 
-const std::string& Writer::temporaryPath() const { return impl_->tmp_path; }
+const std::string& Writer::temporaryPath() const { return impl_->file.temporaryPath(); }
+
+int Writer::errorNumber() const { return impl_->file.errorNumber(); }
+
+std::string Writer::errorString(ContainerStatus status) const {
+  const int error_number = errorNumber();
+  return error_number ? std::string(std::strerror(error_number)) : std::string(statusString(status));
+}
 
 uint64_t Writer::bytesWritten() const { return impl_->position; }
 

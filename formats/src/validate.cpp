@@ -1,5 +1,6 @@
 // validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
 // its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
+#include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/format/validate.h>
@@ -21,8 +22,8 @@
 namespace glintbake::format {
 namespace {
 
-constexpr size_t kMaxMetadataBytes = size_t(16) << 20;
-constexpr int kMaxMetadataDepth = 64;
+constexpr size_t kMaxMetadataBytes = size_t(kMaxMetadataSize);
+constexpr int kMaxMetadataDepth = kMaxJsonDepth;
 constexpr const char* kMetadataSchemaId = "glintbake.container-metadata/1";
 
 class Collector final : public detail::Diagnostics {
@@ -110,30 +111,6 @@ void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uin
   }
 }
 
-// Nesting depth of a JSON text, counted without parsing (strings skipped), so that deeply nested
-// hostile input is refused before any recursive processing.
-int jsonDepth(const std::string& text) {
-  int depth = 0, max_depth = 0;
-  bool in_string = false, escaped = false;
-  for (char c : text) {
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '{' || c == '[') {
-      max_depth = std::max(max_depth, ++depth);
-    } else if (c == '}' || c == ']') {
-      --depth;
-    }
-  }
-  return max_depth;
-}
-
 bool looksLikeAbsolutePath(const std::string& s) {
   if (s.size() >= 2 && s[0] == '/' && s[1] != ' ') return true;    // POSIX
   if (s.size() >= 2 && s[0] == '\\' && s[1] == '\\') return true;  // UNC
@@ -193,7 +170,7 @@ void validateMetadata(const std::string& text, AssetKind kind, std::vector<Valid
     addError(messages, 5016, "metadata is " + std::to_string(text.size()) + " bytes, more than the 16 MiB limit");
     return;
   }
-  if (jsonDepth(text) > kMaxMetadataDepth) {
+  if (jsonNestingDepth(text) > size_t(kMaxMetadataDepth)) {
     addError(messages, 5003, "metadata JSON is nested deeper than " + std::to_string(kMaxMetadataDepth) + " levels");
     return;
   }
@@ -311,6 +288,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     }
   }
   std::vector<uint8_t> raw;
+  std::string metadata_text;
   std::vector<bool> readable(sections.size(), false);
   for (size_t i = 0; i < sections.size(); ++i) {
     const SectionInfo& s = sections[i];
@@ -318,9 +296,16 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       addWarning(&report.messages, 3011, describe(i, s) + ": unknown section type, skipped by readers");
     }
     const bool known_codec = s.codec == uint32_t(Codec::kRaw) || s.codec == uint32_t(Codec::kZstd);
-    if (!index_sound || !known_codec || !options.check_payloads) continue;
-    raw.resize(size_t(s.raw_size));
-    const ContainerStatus status = detail::readSectionFrom(source, s, raw.data(), raw.size());
+    if (!index_sound || !known_codec) continue;
+    if (s.type == kSectionMetadata && s.raw_size > kMaxMetadataBytes) {
+      // Refused from its declared size, before a byte of it is decoded.
+      addError(&report.messages, 5016,
+               describe(i, s) + ": metadata is " + std::to_string(s.raw_size) + " bytes, more than the 16 MiB limit");
+      continue;
+    }
+    if (!options.check_payloads && s.type != kSectionMetadata) continue;
+    // The frame is checked against raw_size (content size, block bound) before raw grows.
+    const ContainerStatus status = detail::readSectionAlloc(source, s, &raw);
     if (status == ContainerStatus::kChecksumMismatch) {
       addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
     } else if (status == ContainerStatus::kDecompressFailed) {
@@ -333,6 +318,10 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       continue;
     }
     readable[i] = true;
+    if (s.type == kSectionMetadata) {
+      if (metadata_text.empty()) metadata_text.assign(raw.begin(), raw.end());
+      continue;
+    }
     if (s.type == kSectionFlakes) {
       checkFlakesPayload(i, s, raw, &report.messages);
     } else if (s.type != kSectionMetadata) {
@@ -359,9 +348,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   }
   for (size_t i = 0; i < sections.size(); ++i) {
     if (sections[i].type != kSectionMetadata || !readable[i]) continue;
-    std::vector<uint8_t> bytes(size_t(sections[i].raw_size));
-    if (detail::readSectionFrom(source, sections[i], bytes.data(), bytes.size()) != ContainerStatus::kOk) break;
-    validateMetadata(std::string(bytes.begin(), bytes.end()), kind, &report.messages);
+    validateMetadata(metadata_text, kind, &report.messages);
     break;
   }
 

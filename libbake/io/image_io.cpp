@@ -1,20 +1,18 @@
 // Image output through OpenImageIO: atomic (temporary file + rename) and byte-reproducible.
 #include <glintbake/bake/io/image_io.h>
 
+#include <glintbake/format/atomic_file.h>
+
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#ifndef _WIN32
-#include <unistd.h>
-#endif
 
 namespace glintbake::bake {
 namespace {
@@ -30,16 +28,6 @@ std::string oneLine(std::string text) {
 // Formats whose OIIO writers only take 8-bit integers.
 bool eightBitOnly(const std::string& ext) {
   return ext == "jpg" || ext == "jpeg" || ext == "webp" || ext == "bmp" || ext == "gif" || ext == "tga";
-}
-
-std::string temporaryPath(const std::string& path) {
-  static std::atomic<uint64_t> counter{0};
-#ifndef _WIN32
-  const long pid = long(::getpid());
-#else
-  const long pid = 0;
-#endif
-  return path + ".tmp-" + std::to_string(pid) + "-" + std::to_string(counter.fetch_add(1));
 }
 
 // Quantises [0, 1] values to unsigned integers of `bits` bits, round to nearest, NaN -> 0.
@@ -120,25 +108,29 @@ BakeStatus writeImage(const std::string& path, int width, int height, int channe
     }
   }
 
-  const std::string tmp = options.temporary_path.empty() ? temporaryPath(path) : options.temporary_path;
-  if (!output->open(tmp, spec)) {
-    std::string reason = oneLine(output->geterror());
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, path + ": cannot create file (" + reason + ")");
+  // OIIO encodes into memory; the bytes then reach the disk through one checked write path
+  // (format::AtomicFile), so a full disk or a file-size limit can never leave a truncated image
+  // that looks complete: OIIO's own file writers do not report every failed write.
+  if (!output->supports("ioproxy")) {
+    return makeError(ErrorCode::kUnsupported, path + ": this image format cannot be written atomically");
+  }
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput proxy(encoded);
+  if (!output->set_ioproxy(&proxy)) {
+    return makeError(ErrorCode::kUnsupported, path + ": this image format cannot be written atomically");
+  }
+  if (!output->open(path, spec)) {
+    return makeError(ErrorCode::kIo, path + ": cannot encode the image (" + oneLine(output->geterror()) + ")");
   }
   const bool written = output->write_image(data_type, data);
   std::string reason = written ? std::string() : oneLine(output->geterror());
   const bool closed = output->close();
   if (written && !closed) reason = oneLine(output->geterror());
   output.reset();
-  if (!written || !closed) {
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, path + ": write failed (" + reason + ")");
-  }
-  if (!options.rename) return okStatus();
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, path + ": cannot rename the temporary file into place");
+  if (!written || !closed) return makeError(ErrorCode::kIo, path + ": write failed (" + reason + ")");
+  std::string message;
+  if (format::writeFileAtomically(path, encoded.data(), encoded.size(), &message) != format::ContainerStatus::kOk) {
+    return makeError(ErrorCode::kIo, "cannot write " + message);
   }
   return okStatus();
 }

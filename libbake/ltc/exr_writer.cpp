@@ -1,32 +1,29 @@
 // Deterministic EXR output through the OpenEXR library.
 #include "ltc/exr_writer.h"
 
+#include <glintbake/format/atomic_file.h>
+
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 
-#include <unistd.h>
-#include <atomic>
-#include <cstdio>
 #include <exception>
+#include <string>
 
 namespace glintbake::bake::ltc {
 
 namespace {
 
-std::string temporaryName(const std::string& path) {
-  static std::atomic<unsigned> counter{0};
-  char suffix[64];
-  std::snprintf(suffix, sizeof(suffix), ".tmp-%ld-%u", long(getpid()), counter.fetch_add(1));
-  return path + suffix;
-}
-
-BakeStatus commit(const std::string& tmp, const std::string& path) {
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return makeError(ErrorCode::kIo, "cannot write " + path + ": rename failed");
+// The EXR is encoded in memory and reaches the disk through format::AtomicFile, whose every write
+// is checked: OpenEXR's file streams can lose a failed write (full disk, file-size limit).
+BakeStatus commit(const Imf::StdOSStream& encoded, const std::string& path) {
+  const std::string bytes = encoded.str();
+  std::string message;
+  if (format::writeFileAtomically(path, bytes.data(), bytes.size(), &message) != format::ContainerStatus::kOk) {
+    return makeError(ErrorCode::kIo, "cannot write " + message);
   }
   return okStatus();
 }
@@ -34,7 +31,7 @@ BakeStatus commit(const std::string& tmp, const std::string& path) {
 }  // namespace
 
 BakeStatus writeExr(const std::string& path, const std::vector<std::string>& channel_names, const ExrLevel& image) {
-  const std::string tmp = temporaryName(path);
+  Imf::StdOSStream stream;
   const size_t channels = channel_names.size();
   try {
     Imf::Header header(image.width, image.height);
@@ -45,26 +42,25 @@ BakeStatus writeExr(const std::string& path, const std::vector<std::string>& cha
       frame.insert(channel_names[c], Imf::Slice(Imf::FLOAT, (char*)(image.pixels + c), sizeof(float) * channels,
                                                 sizeof(float) * channels * size_t(image.width)));
     }
-    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::OutputFile file(stream, header);
     file.setFrameBuffer(frame);
     file.writePixels(image.height);
   } catch (const std::exception& e) {
-    std::remove(tmp.c_str());
     return makeError(ErrorCode::kIo, "cannot write " + path + ": " + e.what());
   }
-  return commit(tmp, path);
+  return commit(stream, path);
 }
 
 BakeStatus writeMipmappedExr(const std::string& path, const std::string& channel_name,
                              const std::vector<ExrLevel>& levels) {
   if (levels.empty()) return makeError(ErrorCode::kBadArgument, "no image levels to write");
-  const std::string tmp = temporaryName(path);
+  Imf::StdOSStream stream;
   try {
     Imf::Header header(levels[0].width, levels[0].height);
     header.compression() = Imf::ZIP_COMPRESSION;
     header.channels().insert(channel_name, Imf::Channel(Imf::FLOAT));
     header.setTileDescription(Imf::TileDescription(32, 32, Imf::MIPMAP_LEVELS, Imf::ROUND_UP));
-    Imf::TiledOutputFile file(tmp.c_str(), header);
+    Imf::TiledOutputFile file(stream, header);
     if (file.numLevels() != int(levels.size())) throw std::runtime_error("mip chain length mismatch");
     for (int l = 0; l < file.numLevels(); ++l) {
       const ExrLevel& level = levels[size_t(l)];
@@ -77,10 +73,9 @@ BakeStatus writeMipmappedExr(const std::string& path, const std::string& channel
       file.writeTiles(0, file.numXTiles(l) - 1, 0, file.numYTiles(l) - 1, l);
     }
   } catch (const std::exception& e) {
-    std::remove(tmp.c_str());
     return makeError(ErrorCode::kIo, "cannot write " + path + ": " + e.what());
   }
-  return commit(tmp, path);
+  return commit(stream, path);
 }
 
 }  // namespace glintbake::bake::ltc

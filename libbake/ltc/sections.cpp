@@ -26,7 +26,7 @@ BakeStatus addImage(format::Writer& writer, uint32_t type, uint64_t key, int wid
   if (format::ContainerStatus st = writer.addSection(type, key, bytes.data(), bytes.size());
       st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write section ") + format::sectionTypeString(type) + " " +
-                                         std::to_string(key) + ": " + format::statusString(st));
+                                         std::to_string(key) + ": " + writer.errorString(st));
   }
   return okStatus();
 }

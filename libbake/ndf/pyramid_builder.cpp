@@ -145,7 +145,7 @@ BakeStatus WriterPyramidSink::addLevel(const format::NdfLevelRecord& record) {
   if (format::ContainerStatus st =
           writer_.addSection(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record));
       st != format::ContainerStatus::kOk) {
-    return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + format::statusString(st));
+    return makeError(ErrorCode::kIo, std::string("cannot write level descriptor: ") + writer_.errorString(st));
   }
   return okStatus();
 }
@@ -155,7 +155,7 @@ BakeStatus WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
   if (format::ContainerStatus st =
           writer_.addSection(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
       st != format::ContainerStatus::kOk) {
-    return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + format::statusString(st));
+    return makeError(ErrorCode::kIo, std::string("cannot write NDF chunk: ") + writer_.errorString(st));
   }
   return okStatus();
 }

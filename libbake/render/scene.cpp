@@ -1,6 +1,8 @@
 // Scene JSON parsing and validation (schemas/scene.schema.json).
 #include <glintbake/bake/render/scene.h>
 
+#include <glintbake/format/json_depth.h>
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -265,6 +267,10 @@ Light parseLight(const Json& j, size_t index) {
 }  // namespace
 
 Result<Scene> parseScene(const std::string& json_text, const std::string& base_dir) {
+  if (format::jsonNestingDepth(json_text) > size_t(format::kMaxJsonDepth)) {
+    return makeError(ErrorCode::kInvalidInput,
+                     "scene is nested deeper than " + std::to_string(format::kMaxJsonDepth) + " levels");
+  }
   Json doc;
   try {
     doc = Json::parse(json_text);

@@ -120,6 +120,13 @@ void CpEngine::contractW(const MatF& c) {
   }
 }
 
+// GCC 12 reports -Wuse-after-free inside Eigen's aligned_free when it inlines the resize of `tmp`
+// (already of the right size, so never reallocated) into this loop: a known false positive of
+// GCC 12's new warning. Silenced for this one function only.
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
 void CpEngine::contractModeA(const MatF& b, MatD& out) const {
   out.resize(bins_, rank_);
   Eigen::VectorXf tmp(bins_);
@@ -129,6 +136,9 @@ void CpEngine::contractModeA(const MatF& b, MatD& out) const {
     out.col(r) = tmp.cast<double>();
   }
 }
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic pop
+#endif
 
 void CpEngine::contractModeB(const MatF& a, MatD& out) const {
   out.resize(bins_, rank_);

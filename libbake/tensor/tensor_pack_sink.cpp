@@ -52,7 +52,7 @@ BakeStatus TensorPackSink::writeSection(uint32_t type, uint64_t key, const void*
   ScopedTimer timer(report_.write_seconds);
   if (format::ContainerStatus st = writer_.addSection(type, key, data, size); st != format::ContainerStatus::kOk) {
     return makeError(ErrorCode::kIo, std::string("cannot write ") + format::sectionTypeString(type) +
-                                         " section: " + format::statusString(st));
+                                         " section: " + writer_.errorString(st));
   }
   return okStatus();
 }

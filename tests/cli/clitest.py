@@ -22,13 +22,23 @@ def tool_path(name):
     return os.path.join(BIN_DIR, name)
 
 
-def run(tool, *args, stdin=None, timeout=600, env=None):
-    """Runs a tool; returns (exit code, stdout, stderr) as text."""
+def run(tool, *args, stdin=None, timeout=600, env=None, limits=None):
+    """Runs a tool; returns (exit code, stdout, stderr) as text. limits: {resource.RLIMIT_*: bytes}
+    applied to the tool alone (e.g. RLIMIT_FSIZE as `ulimit -f` sets it, RLIMIT_AS for memory)."""
     full_env = dict(os.environ)
     if env:
         full_env.update(env)
+
+    def apply_limits():
+        import resource
+        for which, value in (limits or {}).items():
+            resource.setrlimit(which, (value, value))
+
     proc = subprocess.run([tool_path(tool)] + [str(a) for a in args], input=stdin, capture_output=True,
-                          text=True, timeout=timeout, env=full_env)
+                          text=isinstance(stdin, str) or stdin is None, timeout=timeout, env=full_env,
+                          preexec_fn=apply_limits if limits else None)
+    if not isinstance(proc.stdout, str):
+        return proc.returncode, proc.stdout.decode("utf-8", "replace"), proc.stderr.decode("utf-8", "replace")
     return proc.returncode, proc.stdout, proc.stderr
 
 
@@ -75,6 +85,13 @@ class ToolTestCase(unittest.TestCase):
 
     def path(self, name):
         return os.path.join(self.tmp, name)
+
+    def write(self, name, data):
+        """Writes bytes to a file of the test directory; returns its path."""
+        path = self.path(name)
+        with open(path, "wb") as f:
+            f.write(data)
+        return path
 
     def run_ok(self, tool, *args, **kw):
         code, out, err = run(tool, *args, **kw)

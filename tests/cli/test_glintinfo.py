@@ -2,93 +2,18 @@
 formats/SPEC.md (a second, independent writer: if these files validate, the spec is complete),
 on the frozen 1.0 files, and on damaged copies."""
 
-import ctypes
-import ctypes.util
 import json
 import os
 import shutil
-import struct
 
 import clitest
 from clitest import BAD_ARGS, DIFFERENCES, INVALID, IO, OK, UNSUPPORTED
+from containers import SECTION_IMAGE, SECTION_METADATA, SECTION_PRIVATE, build_container, image_payload, metadata
 
 FROZEN_DIR = os.path.join(clitest.SOURCE_DIR, "tests", "format")
 
 
-def _load_xxhash():
-    for name in (ctypes.util.find_library("xxhash"), "libxxhash.so.0", "libxxhash.so"):
-        if not name:
-            continue
-        try:
-            lib = ctypes.CDLL(name)
-        except OSError:
-            continue
-        lib.XXH3_64bits.restype = ctypes.c_uint64
-        lib.XXH3_64bits.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
-        return lib
-    raise RuntimeError("libxxhash not found")
-
-
-_XXH = _load_xxhash()
-
-
-def xxh3_64(data):
-    return _XXH.XXH3_64bits(bytes(data), len(data))
-
-
-MAGIC = bytes([0xAB, ord("G"), ord("B"), ord("K"), 0x0D, 0x0A, 0x1A, 0x0A])
-KIND_TEST = 0x7FFF
-SECTION_METADATA, SECTION_IMAGE, SECTION_PRIVATE = 1, 0x100, 0x10000
-
-
-def metadata(tool="pytest", version="1.0", **extra):
-    doc = {"schema": "glintbake.container-metadata/1", "asset_kind": "test",
-           "generator": {"tool": tool, "version": version}, "parameters": {"n": 1},
-           "inputs": [{"name": "input.png", "hash": "xxh3-128:" + "0f" * 16}]}
-    doc.update(extra)
-    return json.dumps(doc).encode()
-
-
-def image_payload(width, height, channels, layers, values):
-    header = struct.pack("<6IQ", 0x474D4947, width, height, channels, layers, 0, 0)
-    assert len(values) == width * height * channels * layers
-    return header + struct.pack("<%df" % len(values), *values)
-
-
-def build_container(sections, kind=KIND_TEST, major=1, minor=0):
-    """sections: list of (type, key, raw bytes); every section stored raw (codec 0).
-    Layout per SPEC.md: 128-byte header, 64-aligned sections, 64-byte index entries, header last."""
-    body = bytearray()
-    entries = []
-    offset = 128
-    for stype, key, data in sections:
-        pad = (-offset) % 64
-        body += b"\0" * pad
-        offset += pad
-        entries.append(struct.pack("<IIQQQQQII8x", stype, 0, key, offset, len(data), len(data), xxh3_64(data), 0, 0))
-        body += data
-        offset += len(data)
-    pad = (-offset) % 64
-    body += b"\0" * pad
-    offset += pad
-    index = b"".join(entries)
-    index_offset = offset
-    body += index
-    file_size = index_offset + len(index)
-    header = bytearray(struct.pack("<8sHHIIIIIQQQQQQ", MAGIC, major, minor, kind, 128, 0, len(sections), 0,
-                                   index_offset, len(index), file_size, xxh3_64(body), xxh3_64(index), 0))
-    header += b"\0" * (128 - len(header))
-    struct.pack_into("<Q", header, 72, xxh3_64(header))
-    return bytes(header) + bytes(body)
-
-
 class GlintinfoTest(clitest.ToolTestCase):
-
-    def write(self, name, data):
-        path = self.path(name)
-        with open(path, "wb") as f:
-            f.write(data)
-        return path
 
     @staticmethod
     def image(offset=0.0):

@@ -4,6 +4,8 @@
 #include <glintbake/format/container.h>
 #include <glintbake/format/validate.h>
 
+#include "reseal.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -12,31 +14,7 @@
 namespace {
 
 using namespace glintbake::format;
-
-uint64_t load64(const uint8_t* p) {
-  uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-void store64(uint8_t* p, uint64_t v) {
-  for (int i = 0; i < 8; ++i) p[i] = uint8_t(v >> (8 * i));
-}
-
-// Recomputes the index, file and header checksums (SPEC.md 2.1) so that mutations reach the
-// checks behind them instead of stopping at a checksum mismatch.
-std::vector<uint8_t> reseal(const uint8_t* data, size_t size) {
-  std::vector<uint8_t> bytes(data, data + size);
-  if (size < kHeaderSize) return bytes;
-  uint8_t* h = bytes.data();
-  const uint64_t index_offset = load64(h + 32), index_size = load64(h + 40);
-  if (index_offset <= size && index_size <= size - index_offset) {
-    store64(h + 64, hash64(h + index_offset, size_t(index_size)));
-  }
-  store64(h + 56, hash64(h + kHeaderSize, size - kHeaderSize));
-  store64(h + 72, 0);
-  store64(h + 72, hash64(h, kHeaderSize));
-  return bytes;
-}
+using glintbake::fuzz::reseal;
 
 void check(const uint8_t* data, size_t size) {
   // A small cap keeps each run fast; the checks are the same as with the default.

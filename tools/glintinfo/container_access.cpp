@@ -1,6 +1,7 @@
 #include "container_access.h"
 #include <glintbake/cli/exit_codes.h>
 
+#include <glintbake/format/json_depth.h>
 #include <glintbake/format/validate.h>
 
 #include <cerrno>
@@ -38,6 +39,27 @@ std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std:
                      path + ": section " + std::to_string(i) + ": " + format::statusString(status));
   }
   return bytes;
+}
+
+std::string readMetadataOrThrow(const format::Reader& reader, const std::string& path) {
+  std::string text;
+  const format::ContainerStatus status = reader.readMetadata(&text);
+  if (status == format::ContainerStatus::kNotFound) return std::string();
+  if (status == format::ContainerStatus::kTooLarge) {
+    const auto& s = reader.sections()[size_t(reader.find(format::kSectionMetadata))];
+    throw cli::Error(cli::kExitInvalidInput, path + ": error-5016: metadata is " + std::to_string(s.raw_size) +
+                                                 " bytes, more than the 16 MiB limit");
+  }
+  if (status != format::ContainerStatus::kOk) {
+    throw cli::Error(cli::exitCodeOf(status), path + ": metadata section: " + format::statusString(status));
+  }
+  return text;
+}
+
+cli::Json parseMetadata(const std::string& text) {
+  if (text.empty() || format::jsonNestingDepth(text) > size_t(format::kMaxJsonDepth)) return nullptr;
+  cli::Json doc = cli::Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  return doc.is_discarded() ? cli::Json(nullptr) : doc;
 }
 
 std::string typeLabel(uint32_t type) {

@@ -21,6 +21,14 @@ std::unique_ptr<format::Reader> openContainer(const std::string& path);
 // Reads section i; throws cli::Error (exit 3 for damaged data) naming the file and section.
 std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i);
 
+// The metadata text (empty when the file has none); throws cli::Error (exit 3) when it is larger
+// than format::kMaxMetadataSize (refused before it is decoded) or cannot be read.
+std::string readMetadataOrThrow(const format::Reader& reader, const std::string& path);
+
+// The metadata parsed, when it is JSON nested at most format::kMaxJsonDepth levels; otherwise
+// nullptr (see validate for the reason). Linear in the text's size.
+cli::Json parseMetadata(const std::string& text);
+
 // "ndf-chunk" or the decimal type number when it has no registered name.
 std::string typeLabel(uint32_t type);
 

@@ -50,10 +50,15 @@ ImageMetrics compareImages(const std::vector<uint8_t>& a, const std::vector<uint
   return m;
 }
 
-// Metadata as JSON with the generator version removed; a text that is not JSON stays a string.
-cli::Json comparableMetadata(const std::vector<uint8_t>& bytes) {
-  cli::Json doc = cli::Json::parse(bytes.begin(), bytes.end(), nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) return cli::Json(std::string(bytes.begin(), bytes.end()));
+// Metadata as JSON with the generator version removed. Metadata that is not JSON within the
+// nesting limit is invalid input, never "the same" as another such file.
+cli::Json comparableMetadata(const format::Reader& reader, const std::string& path) {
+  const std::string text = readMetadataOrThrow(reader, path);
+  cli::Json doc = parseMetadata(text);
+  if (doc.is_null()) {
+    throw cli::Error(cli::kExitInvalidInput, path + ": error-5003: metadata is not UTF-8 JSON nested at most " +
+                                                 std::to_string(format::kMaxJsonDepth) + " levels");
+  }
   if (doc.is_object() && doc.contains("generator") && doc["generator"].is_object()) doc["generator"].erase("version");
   return doc;
 }
@@ -112,16 +117,20 @@ int runDiff(cli::Tool& tool, const DiffOptions& options) {
       rows.push_back(row);
       continue;
     }
-    const auto da = readSectionOrThrow(*a, options.file_a, size_t(ia));
-    const auto db = readSectionOrThrow(*b, options.file_b, size_t(ib));
     bool equal = true;
-    format::ImageSectionHeader ha, hb;
     if (s.type == format::kSectionMetadata) {
       row["comparison"] = "metadata";
-      equal = comparableMetadata(da) == comparableMetadata(db);
+      equal = comparableMetadata(*a, options.file_a) == comparableMetadata(*b, options.file_b);
       if (!equal) lines.push_back(label + ": metadata differs (generator version ignored)");
-    } else if (format::parseImageSection(da.data(), da.size(), &ha) &&
-               format::parseImageSection(db.data(), db.size(), &hb)) {
+      row["status"] = equal ? "same" : "different";
+      same = same && equal;
+      rows.push_back(row);
+      continue;
+    }
+    const auto da = readSectionOrThrow(*a, options.file_a, size_t(ia));
+    const auto db = readSectionOrThrow(*b, options.file_b, size_t(ib));
+    format::ImageSectionHeader ha, hb;
+    if (format::parseImageSection(da.data(), da.size(), &ha) && format::parseImageSection(db.data(), db.size(), &hb)) {
       row["comparison"] = "image";
       if (ha.width != hb.width || ha.height != hb.height || ha.channels != hb.channels || ha.layers != hb.layers) {
         equal = false;

@@ -89,16 +89,11 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
   const format::HeaderInfo& header = reader->header();
   const auto& sections = reader->sections();
 
-  // The metadata is shown parsed when it is JSON, as text otherwise (validate reports why).
-  cli::Json metadata = nullptr;
-  std::string metadata_text;
-  const int meta_index = reader->find(format::kSectionMetadata);
-  if (meta_index >= 0) {
-    const auto bytes = readSectionOrThrow(*reader, options.file, size_t(meta_index));
-    metadata_text.assign(bytes.begin(), bytes.end());
-    metadata = cli::Json::parse(metadata_text, nullptr, /*allow_exceptions=*/false);
-    if (metadata.is_discarded()) metadata = metadata_text;
-  }
+  // The metadata is shown parsed when it is JSON within the nesting limit, as text otherwise
+  // (validate reports why); more than 16 MiB of it is refused before it is decoded.
+  const std::string metadata_text = readMetadataOrThrow(*reader, options.file);
+  cli::Json metadata = parseMetadata(metadata_text);
+  if (metadata.is_null() && !metadata_text.empty()) metadata = metadata_text;
 
   if (tool.common().json) {
     cli::Json doc;
@@ -178,7 +173,7 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
   std::printf("%5s  %-12s  %-24s  %-5s  %12" PRIu64 "  %12" PRIu64 "  %6.2fx\n", "", "total", "", "", total_stored,
               total_raw, total_stored ? double(total_raw) / double(total_stored) : 1.0);
   std::printf("\nmetadata:\n");
-  if (meta_index < 0) {
+  if (reader->find(format::kSectionMetadata) < 0) {
     std::printf("  (none)\n");
   } else if (metadata.is_string()) {
     std::printf("%s\n", metadata_text.c_str());

@@ -3,10 +3,42 @@
 #include "container_access.h"
 
 #include <glintbake/format/validate.h>
+#include <glintbake/runtime/ltc.h>
+#include <glintbake/runtime/ndf_source.h>
 
 #include <cstdio>
+#include <memory>
 
 namespace glintbake::glintinfo {
+namespace {
+
+// 6004/6005 (formats/SPEC.md section 8): a structurally sound container of a kind the runtime
+// loads must also pass the runtime's own layout and record checks, by the runtime's own loader
+// (one implementation), so that validate passes exactly the files a renderer can open.
+void checkWithRuntime(const std::string& path, format::ValidationReport* report) {
+  if (report->status != format::ContainerStatus::kOk) return;
+  format::Reader reader;
+  if (reader.open(path) != format::ContainerStatus::kOk) return;
+  const format::AssetKind kind = reader.kind();
+  reader.close();
+  runtime::RuntimeStatus status = runtime::RuntimeStatus::kOk;
+  int id = 0;
+  if (kind == format::AssetKind::kNdfPyramid || kind == format::AssetKind::kTensorNdf) {
+    std::unique_ptr<runtime::NdfSource> ndf;
+    status = runtime::openNdfAsset(path.c_str(), &ndf);
+    id = 6004;
+  } else if (kind == format::AssetKind::kLtcTable) {
+    runtime::LtcTable table;
+    status = table.open(path.c_str());
+    id = 6005;
+  }
+  if (status == runtime::RuntimeStatus::kOk || status == runtime::RuntimeStatus::kOutOfMemory) return;
+  report->messages.push_back({id, format::Severity::kError,
+                              std::string("the runtime refuses this ") + format::assetKindString(kind) +
+                                  " asset: " + runtime::statusString(status)});
+}
+
+}  // namespace
 
 CLI::App* addValidateCommand(CLI::App& app, ValidateOptions& options) {
   CLI::App* cmd = app.add_subcommand(
@@ -17,10 +49,11 @@ CLI::App* addValidateCommand(CLI::App& app, ValidateOptions& options) {
 }
 
 int runValidate(cli::Tool& tool, const ValidateOptions& options) {
-  const format::ValidationReport report = format::validateFile(options.file);
+  format::ValidationReport report = format::validateFile(options.file);
   if (report.status == format::ContainerStatus::kIoError && !report.messages.empty() && report.messages[0].id == 1001) {
     throw cli::Error(cli::kExitIo, "cannot read " + options.file);
   }
+  checkWithRuntime(options.file, &report);
 
   if (tool.common().json) {
     cli::Json messages = cli::Json::array();

@@ -2,6 +2,8 @@
 // (schemas/glintquery-batch.schema.json).
 #include "commands.h"
 
+#include <glintbake/format/json_depth.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <iostream>
@@ -105,35 +107,6 @@ Json answer(const rt::NdfSource& ndf, const Json& q) {
   return out;
 }
 
-// Deepest nesting of arrays and objects in a JSON text, outside strings, found by one scan (no
-// recursion, so any line is safe to measure before it is parsed).
-size_t nestingDepth(const std::string& text) {
-  size_t depth = 0, deepest = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return deepest;
-}
-
-// A query line nested deeper than this is refused (its parse, echo and destruction would recurse
-// that deep).
-constexpr size_t kMaxQueryDepth = 64;
-
 }  // namespace
 
 CLI::App* addBatchCommand(CLI::App& app, BatchOptions& options) {
@@ -156,8 +129,13 @@ int runBatch(cli::Tool& tool, const BatchOptions& options) {
     ++count;
     Json out;
     try {
-      if (nestingDepth(line) > kMaxQueryDepth)
-        throw std::invalid_argument("the line is nested deeper than " + std::to_string(kMaxQueryDepth) + " levels");
+      // nlohmann-json stops at a NUL byte as at the end of the text: refuse it rather than answer
+      // the query before it and drop the rest.
+      if (const size_t nul = line.find('\0'); nul != std::string::npos)
+        throw std::invalid_argument("the line holds a NUL byte at column " + std::to_string(nul + 1));
+      if (format::jsonNestingDepth(line) > size_t(format::kMaxJsonDepth))
+        throw std::invalid_argument("the line is nested deeper than " + std::to_string(format::kMaxJsonDepth) +
+                                    " levels");
       out = answer(*ndf.source, Json::parse(line));
     } catch (const std::exception& e) {
       ++failed;

@@ -57,15 +57,11 @@ int runCompare(cli::Tool& tool, CompareOptions& options) {
 
   if (!options.heatmap.empty()) {
     const std::vector<float> heat = bake::render::errorHeatMap(a.value(), b.value(), options.heatmap_scale);
-    cli::AtomicOutput out(options.heatmap);
     bake::ImageWriteOptions wo;
     wo.png_bits = 8;
-    wo.temporary_path = out.temporaryPath();
-    wo.rename = false;
     const bake::BakeStatus st =
         bake::writeImage(options.heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
     if (!st) throw cli::Error(int(st.error().code), st.error().message);
-    out.commit();
     tool.addOutput(options.heatmap);
   }
 

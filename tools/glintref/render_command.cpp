@@ -145,13 +145,9 @@ void loadRenderSources(cli::Tool& tool, const RenderOptions& options, bake::rend
 
 // One image file, written atomically.
 void writeRenderImage(cli::Tool& tool, const std::string& path, int width, int height, const float* rgb, int png_bits) {
-  cli::AtomicOutput out(path);
   bake::ImageWriteOptions wo;
   if (png_bits > 0) wo.png_bits = png_bits;
-  wo.temporary_path = out.temporaryPath();
-  wo.rename = false;
   cli::check(bake::writeImage(path, width, height, 3, rgb, wo));
-  out.commit();
   tool.addOutput(path);
 }
 

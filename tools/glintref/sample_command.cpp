@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -36,7 +37,8 @@ CLI::App* addSampleCommand(CLI::App& app, SampleOptions& options) {
   addQueryOptions(*cmd, options.query);
   cmd->add_option("--count", options.count, "Number of samples (1..1e8)")->required();
   cmd->add_option("--seed", options.seed, "Seed of the random sequence (equal seeds give equal samples)");
-  cmd->add_option("-o,--output", options.output, "CSV file of the samples (default: stdout, or in the --json document)");
+  cmd->add_option("-o,--output", options.output,
+                  "CSV file of the samples (default: stdout, or in the --json document)");
   return cmd;
 }
 
@@ -55,14 +57,17 @@ int runSample(cli::Tool& tool, SampleOptions& options) {
   cli::Json samples = cli::Json::array();
 
   if (!options.output.empty()) {
-    cli::AtomicOutput output(options.output);
-    std::FILE* file = std::fopen(output.temporaryPath().c_str(), "wb");
-    if (file == nullptr) {
-      throw cli::Error(cli::kExitIo, "cannot write " + options.output + ": " + std::strerror(errno));
-    }
+    // The CSV is formatted in memory, then written through one checked atomic write.
+    char* buffer = nullptr;
+    size_t size = 0;
+    std::FILE* file = open_memstream(&buffer, &size);
+    if (file == nullptr) throw cli::Error(cli::kExitRuntime, "out of memory");
     const bool ok = writeCsv(file, sampler, options.count, mean);
-    if (std::fclose(file) != 0 || !ok) throw cli::Error(cli::kExitIo, "cannot write " + options.output);
-    output.commit();
+    const bool closed = std::fclose(file) == 0;
+    const std::string text = buffer ? std::string(buffer, size) : std::string();
+    std::free(buffer);
+    if (!ok || !closed) throw cli::Error(cli::kExitRuntime, "cannot format " + options.output);
+    cli::writeOutputFile(options.output, text);
     tool.addOutput(options.output);
   } else if (json) {
     double sum[2] = {0.0, 0.0};

@@ -32,17 +32,8 @@ int runMultiscale(cli::Tool& tool, const MultiscaleArgs& args) {
                      {"error", errorsJson(fit.combine_error)},
                      {"paper_form", "alpha = 0.07 a_mi^2 + 0.94 a_mi + a_me - 0.83 a_mi a_me (Tao et al. 2021, eq. 7)"},
                      {"paper_error", errorsJson(fit.combine_paper_error)}}}};
-  {
-    cli::AtomicOutput out(args.output);
-    {
-      std::ofstream file(out.temporaryPath(), std::ios::binary);
-      file << doc.dump(2) << "\n";
-      file.flush();
-      if (!file) throw cli::Error(cli::kExitIo, "cannot write " + args.output);
-    }
-    out.commit();
-    tool.addOutput(args.output);
-  }
+  cli::writeOutputFile(args.output, doc.dump(2) + "\n");
+  tool.addOutput(args.output);
   if (tool.common().json) tool.printJson(doc);
   return cli::kExitOk;
 }

@@ -14,14 +14,7 @@ namespace glintbake::ltcfit {
 namespace {
 
 void writeTextAtomically(cli::Tool& tool, const std::string& path, const std::string& text) {
-  cli::AtomicOutput out(path);
-  {
-    std::ofstream file(out.temporaryPath(), std::ios::binary);
-    file << text;
-    file.flush();
-    if (!file) throw cli::Error(cli::kExitIo, "cannot write " + path);
-  }
-  out.commit();
+  cli::writeOutputFile(path, text);
   tool.addOutput(path);
 }
 

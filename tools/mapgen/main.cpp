@@ -112,16 +112,10 @@ int main(int argc, char** argv) {
     const bake::NormalMap map = bake::generateMap(kind, params);
     const bake::MapStatistics stats = bake::measureMap(map);
 
-    // The temporary file is registered for removal on SIGINT/SIGTERM until it is committed.
-    cli::AtomicOutput atomic(output);
     bake::ImageWriteOptions write_options;
     write_options.png_bits = png_bits;
     write_options.half_float = half;
-    write_options.temporary_path = atomic.temporaryPath();
-    write_options.rename = false;
-    const bake::BakeStatus written = bake::writeNormalMap(output, map, write_options);
-    cli::check(written);
-    atomic.commit();
+    cli::check(bake::writeNormalMap(output, map, write_options));
     t.addOutput(output);
 
     if (t.common().json) {

@@ -140,6 +140,7 @@ int main(int argc, char** argv) {
     bake::IngestReport ingest_report;
     const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
     cli::requireBakeableMap(map, input);
+    cli::checkMemoryBudget(pyramid, map, t.threadCount(), /*tensor=*/false);
 
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
 

@@ -11,6 +11,7 @@
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds/flakes.h>
 
 #include <algorithm>
@@ -317,7 +318,8 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
                                               format::assetKindString(in.reader.kind()) + ")");
     }
     std::string meta_text;
-    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk) {
+    if (in.reader.readMetadata(&meta_text) == format::ContainerStatus::kOk &&
+        format::jsonNestingDepth(meta_text) <= size_t(format::kMaxJsonDepth)) {
       const Json source = Json::parse(meta_text, nullptr, false);
       if (source.is_object() && source.contains("parameters")) params["pyramid"] = source["parameters"];
       if (source.is_object() && source.contains("asset")) in.source_asset = source["asset"];
@@ -339,6 +341,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   bake::IngestReport ingest_report;
   in.map = cli::loadNormalMapForTool(t, o.input, o.ingest, &ingest_report);
   cli::requireBakeableMap(in.map, o.input);
+  cli::checkMemoryBudget(o.pyramid, in.map, t.threadCount(), /*tensor=*/true);
   in.map_json = {{"width", in.map.width}, {"height", in.map.height}, {"wrap", bake::wrapString(in.map.wrap)}};
   Json p = cli::pyramidOptionsJson(o.pyramid);
   p["ingest"] = cli::ingestOptionsJson(o.ingest);

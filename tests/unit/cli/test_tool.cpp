@@ -1,6 +1,8 @@
 // Tests of the shared command scaffolding: exit codes, atomic outputs, depfiles, metadata.
 #include <glintbake/cli/tool.h>
 
+#include "../file_size_limit.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -63,21 +65,17 @@ TEST(Tool, ThreadsOptionIsApplied) {
   EXPECT_GE(seen, 1);
 }
 
-TEST(AtomicOutput, RemovesTemporaryUnlessCommitted) {
+TEST(AtomicOutput, LeavesNothingUnlessCommitted) {
   const fs::path dir = scratchDir("atomic");
   const fs::path target = dir / "out.bin";
-  std::string tmp;
   {
     AtomicOutput out(target.string());
-    tmp = out.temporaryPath();
-    std::ofstream(tmp) << "partial";
-    EXPECT_TRUE(fs::exists(tmp));
+    out.write("partial");
   }
-  EXPECT_FALSE(fs::exists(tmp));
-  EXPECT_FALSE(fs::exists(target));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 0);
   {
     AtomicOutput out(target.string());
-    std::ofstream(out.temporaryPath()) << "complete";
+    out.write("complete");
     out.commit();
   }
   EXPECT_EQ(readText(target), "complete");
@@ -85,14 +83,29 @@ TEST(AtomicOutput, RemovesTemporaryUnlessCommitted) {
   fs::remove_all(dir);
 }
 
-TEST(AtomicOutput, CommitIntoMissingDirectoryFailsWithIoCode) {
-  AtomicOutput out("/nonexistent-dir-for-glintbake/out.bin");
+TEST(AtomicOutput, MissingDirectoryFailsWithIoCode) {
   try {
+    AtomicOutput out("/nonexistent-dir-for-glintbake/out.bin");
     out.commit();
-    FAIL() << "commit should fail";
+    FAIL() << "opening should fail";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), kExitIo);
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos) << e.what();
   }
+}
+
+TEST(AtomicOutput, FileSizeLimitFailsWithIoCode) {
+  const fs::path dir = scratchDir("atomic-limit");
+  try {
+    glintbake::test::FileSizeLimit limit(1024);
+    writeOutputFile((dir / "big.bin").string(), std::string(64 * 1024, 'x'));
+    FAIL() << "the write should fail";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), kExitIo);
+    EXPECT_NE(std::string(e.what()).find("File too large"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 0);
+  fs::remove_all(dir);
 }
 
 TEST(Depfile, MakeSyntaxWithEscapes) {

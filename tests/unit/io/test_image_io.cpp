@@ -2,6 +2,7 @@
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/io/normal_map.h>
 
+#include "../file_size_limit.h"
 #include "test_support.h"
 
 #include <chrono>
@@ -138,16 +139,28 @@ TEST(ImageIo, OverwritesAtomicallyAndLeavesNoTemporary) {
   EXPECT_NEAR(back[0], 0.25f, 1e-4);
 }
 
-TEST(ImageIo, CallerChosenTemporaryWithoutRename) {
+TEST(ImageIo, FileSizeLimitIsAnIoErrorAndKeepsThePreviousFile) {
+  // OIIO's own EXR writer does not notice a failed write; the encoded bytes go through one checked
+  // write path instead, so a truncated image never replaces the previous one.
   ScratchDir dir;
-  std::vector<float> px = ramp(4, 4, 3);
-  ImageWriteOptions options;
-  options.temporary_path = dir.file("staging.tmp-1");
-  options.rename = false;
-  ASSERT_TRUE(writeImage(dir.file("final.exr"), 4, 4, 3, px.data(), options).ok());
-  // The format follows the final name even though the bytes went to the staging name.
-  EXPECT_EQ(dir.entries(), std::vector<std::string>{"staging.tmp-1"});
-  EXPECT_EQ(test::readBytes(dir.file("staging.tmp-1")).substr(0, 4), std::string("\x76\x2f\x31\x01"));
+  for (const char* name : {"out.exr", "out.png", "out.tif"}) {
+    const std::string path = dir.file(name);
+    std::vector<float> small = ramp(2, 2, 3);
+    ASSERT_TRUE(writeImage(path, 2, 2, 3, small.data()).ok());
+    const std::string before = test::readBytes(path);
+    std::vector<float> big(256 * 256 * 3);
+    for (size_t i = 0; i < big.size(); ++i) big[i] = float((i * 2654435761u) % 1000) / 999.0f;
+    BakeStatus status = okStatus();
+    {
+      test::FileSizeLimit limit(4096);
+      status = writeImage(path, 256, 256, 3, big.data());
+    }
+    ASSERT_FALSE(status.ok()) << name;
+    EXPECT_EQ(status.error().code, ErrorCode::kIo);
+    EXPECT_NE(status.error().message.find("File too large"), std::string::npos) << status.error().message;
+    EXPECT_EQ(test::readBytes(path), before) << name;
+  }
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"out.exr", "out.png", "out.tif"}));
 }
 
 TEST(ImageIo, FailuresLeaveNothing) {

@@ -14,6 +14,7 @@
 #include <iterator>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 #include "../temp_dir.h"
 
@@ -291,6 +292,41 @@ TEST_F(NdfPyramidTest, SamplePdfEqualsPdfAndEval) {
   NdfSample smp;
   EXPECT_EQ(pyr_.sample(f, 1.0, 0.5, &smp), RuntimeStatus::kInvalidArgument);
   EXPECT_EQ(pyr_.sample(f, std::nan(""), 0.5, &smp), RuntimeStatus::kInvalidArgument);
+}
+
+// Queries are const and thread-safe: several threads hammering eval, average, sample, pdf and mass
+// on one shared asset get exactly the answers of one thread (run under TSan in CI).
+TEST_F(NdfPyramidTest, ConcurrentQueriesOnOneSharedAssetMatchSerial) {
+  constexpr int kThreads = 4, kQueries = 300;
+  const auto run = [this](int seed, std::vector<double>* out) {
+    std::mt19937_64 rng{uint64_t(seed)};
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < kQueries; ++k) {
+      const Footprint f = fp(kMap * u(rng), kMap * u(rng), 1.0 + 10.0 * u(rng));
+      double e = 0.0, a = 0.0, p = 0.0, m = 0.0;
+      SRect r;
+      r.x0 = -0.5 + 0.4 * u(rng);
+      r.x1 = r.x0 + 0.5;
+      r.y0 = -0.5 + 0.4 * u(rng);
+      r.y1 = r.y0 + 0.5;
+      NdfSample smp;
+      SPoint s;
+      s.x = 0.6 * u(rng) - 0.3;
+      s.y = 0.6 * u(rng) - 0.3;
+      out->push_back(double(pyr_.eval(f, s, &e)) + e);
+      out->push_back(double(pyr_.average(f, r, &a)) + a);
+      out->push_back(double(pyr_.mass(f, &m)) + m);
+      const RuntimeStatus st = pyr_.sample(f, u(rng), u(rng), &smp);
+      out->push_back(double(st) + (st == RuntimeStatus::kOk ? smp.s.x + smp.s.y + smp.pdf : 0.0));
+      if (st == RuntimeStatus::kOk) out->push_back(double(pyr_.pdf(f, smp.s, &p)) + p);
+    }
+  };
+  std::vector<std::vector<double>> serial(kThreads), threaded(kThreads);
+  for (int t = 0; t < kThreads; ++t) run(t, &serial[size_t(t)]);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) threads.emplace_back(run, t, &threaded[size_t(t)]);
+  for (auto& thread : threads) thread.join();
+  for (int t = 0; t < kThreads; ++t) EXPECT_EQ(serial[size_t(t)], threaded[size_t(t)]) << "thread " << t;
 }
 
 TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {

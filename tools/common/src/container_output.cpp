@@ -9,22 +9,26 @@ ContainerOutput::ContainerOutput(Tool& tool, const std::string& path, format::As
     : tool_(tool), kind_(kind), path_(path) {
   const format::ContainerStatus status = writer_.open(path, kind, zstd_level);
   if (status != format::ContainerStatus::kOk) {
-    throw Error(kExitIo, "cannot create " + path + ": " + format::statusString(status));
+    throw Error(kExitIo, "cannot create " + path + ": " + reason(status));
   }
   temporary_ = writer_.temporaryPath();
-  registerTemporary(temporary_);
+  if (!temporary_.empty()) registerTemporary(temporary_);
   tool.addOutput(path);
+}
+
+std::string ContainerOutput::reason(format::ContainerStatus status) const {
+  const int error_number = writer_.errorNumber();
+  return error_number ? std::string(std::strerror(error_number)) : std::string(format::statusString(status));
 }
 
 ContainerOutput::~ContainerOutput() {
   if (!finished_) writer_.abort();
-  unregisterTemporary(temporary_);
+  if (!temporary_.empty()) unregisterTemporary(temporary_);
 }
 
 void ContainerOutput::addSection(uint32_t type, uint64_t key, const void* data, size_t size) {
   const format::ContainerStatus status = writer_.addSection(type, key, data, size);
-  if (status != format::ContainerStatus::kOk)
-    throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+  if (status != format::ContainerStatus::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + reason(status));
 }
 
 void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, int height, int channels,
@@ -44,8 +48,7 @@ void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, in
 void ContainerOutput::finish(const Json& metadata) {
   format::ContainerStatus status = writer_.addMetadata(metadata.dump());
   if (status == format::ContainerStatus::kOk) status = writer_.finish();
-  if (status != format::ContainerStatus::kOk)
-    throw Error(kExitIo, "cannot write " + path_ + ": " + format::statusString(status));
+  if (status != format::ContainerStatus::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + reason(status));
   finished_ = true;
 }
 

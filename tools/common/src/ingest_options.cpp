@@ -2,6 +2,7 @@
 // form, and the loader that maps library errors to exit codes.
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
+#include <glintbake/cli/pyramid_options.h>
 
 #include <map>
 #include <string>
@@ -75,6 +76,8 @@ bake::NormalMap loadNormalMapForTool(Tool& tool, const std::string& path, const 
   tool.addInput(path);
   bake::Result<bake::NormalMap> loaded = bake::loadNormalMap(path, options, r);
   if (!loaded) throw Error(exitCodeOf(loaded.error()), loaded.error().message);
+  // Every tool needs neighbours to differentiate or filter: a 1x1 map is refused everywhere.
+  requireBakeableMap(loaded.value(), path);
 
   const std::string name = baseName(path);
   if (r->nonfinite > 0) {

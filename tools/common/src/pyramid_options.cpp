@@ -3,7 +3,10 @@
 
 #include <glintbake/bake/ndf/flakes_section.h>
 
+#include <cctype>
+#include <cstdint>
 #include <stdexcept>
+#include <string>
 
 namespace glintbake::cli {
 
@@ -32,6 +35,53 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& r
                      "flakes hand over to the pyramid at max(4, sigma0))")
           ->capture_default_str(),
   };
+  // Not among `flags`: it applies to every input, a container as well as a map.
+  app.add_option("--max-memory", p.max_memory_text,
+                 "Refuse the bake up front when its estimated peak memory exceeds this many bytes (suffix K, M, "
+                 "G or T: powers of 1024)");
+}
+
+uint64_t estimateBakeBytes(const PyramidCliOptions& p, const bake::NormalMap& map, int threads, bool tensor) {
+  const bake::ndf::PyramidOptions& o = p.options;
+  const double texels = double(map.width) * double(map.height);
+  const double rate2 = double(o.rate) * double(o.rate);
+  const double r2 = double(o.splat.ndf_res) * double(o.splat.ndf_res);
+  const double region2 = double(o.region_size) * double(o.region_size);
+  double bytes = texels * 3 * 4                                   // the map's normals
+                 + texels * rate2 * 24                            // its flakes
+                 + 2 * region2 * r2 * 4                           // two chunks
+                 + (double(threads) + 16) * r2 * 8;               // scratch, and split footprints
+  if (tensor) bytes += (double(threads) + 1) * region2 * r2 * 4;  // group tensors in flight
+  return bytes >= 1.8e19 ? UINT64_MAX : uint64_t(bytes);
+}
+
+void checkMemoryBudget(const PyramidCliOptions& p, const bake::NormalMap& map, int threads, bool tensor) {
+  if (p.max_memory_text.empty()) return;
+  uint64_t limit = 0;
+  try {
+    size_t used = 0;
+    const double value = std::stod(p.max_memory_text, &used);
+    const std::string suffix = p.max_memory_text.substr(used);
+    static const std::string kSuffixes = "KMGT";
+    double scale = 1.0;
+    if (suffix.size() == 1 &&
+        kSuffixes.find(char(std::toupper(static_cast<unsigned char>(suffix[0])))) != std::string::npos) {
+      const size_t power = kSuffixes.find(char(std::toupper(static_cast<unsigned char>(suffix[0])))) + 1;
+      for (size_t k = 0; k < power; ++k) scale *= 1024.0;
+    } else if (!suffix.empty()) {
+      throw std::invalid_argument("suffix");
+    }
+    if (!(value > 0) || value * scale >= 1.8e19) throw std::invalid_argument("range");
+    limit = uint64_t(value * scale);
+  } catch (const std::exception&) {
+    throw Error(kExitBadArguments, "--max-memory must be a positive number of bytes, optionally with K, M, G or T");
+  }
+  const uint64_t estimate = estimateBakeBytes(p, map, threads, tensor);
+  if (estimate > limit) {
+    throw Error(kExitRuntime, "the bake needs about " + std::to_string((estimate + (1u << 20) - 1) >> 20) +
+                                  " MiB (map " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+                                  "), more than --max-memory " + p.max_memory_text);
+  }
 }
 
 void resolvePyramidOptions(PyramidCliOptions& p) {

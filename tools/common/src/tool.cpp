@@ -17,7 +17,6 @@
 #include <iostream>
 #include <mutex>
 #include <new>
-#include <random>
 
 namespace glintbake::cli {
 
@@ -48,6 +47,9 @@ void installSignalHandlers() {
   std::signal(SIGINT, removeTemporariesAndExit);
   std::signal(SIGTERM, removeTemporariesAndExit);
   std::signal(SIGHUP, removeTemporariesAndExit);
+  // A file-size limit (ulimit -f) must fail the write with EFBIG, reported as an I/O error, rather
+  // than kill the process with no message.
+  std::signal(SIGXFSZ, SIG_IGN);
 }
 
 }  // namespace
@@ -77,26 +79,31 @@ void unregisterTemporary(const std::string& path) {
 
 // ---------------------------------------------------------------------------------------------
 AtomicOutput::AtomicOutput(const std::string& final_path) : final_(final_path) {
-  // A unique name in the destination directory, so rename() stays on one file system.
-  std::random_device rd;
-  char suffix[16];
-  std::snprintf(suffix, sizeof(suffix), "%08x", unsigned(rd()));
-  tmp_ = final_path + ".tmp-" + suffix;
-  registerTemporary(tmp_);
+  if (file_.open(final_path) != format::ContainerStatus::kOk)
+    throw Error(kExitIo, "cannot create " + file_.errorMessage());
+  // A named temporary file (no anonymous files on this file system) is removed on signals.
+  registered_ = file_.temporaryPath();
+  if (!registered_.empty()) registerTemporary(registered_);
 }
 
 AtomicOutput::~AtomicOutput() {
-  if (!committed_) std::remove(tmp_.c_str());
-  unregisterTemporary(tmp_);
+  file_.abort();
+  if (!registered_.empty()) unregisterTemporary(registered_);
+}
+
+void AtomicOutput::write(const void* data, size_t size) {
+  if (file_.write(data, size) != format::ContainerStatus::kOk)
+    throw Error(kExitIo, "cannot write " + file_.errorMessage());
 }
 
 void AtomicOutput::commit() {
-  if (std::rename(tmp_.c_str(), final_.c_str()) != 0) {
-    std::string reason = std::strerror(errno);
-    std::remove(tmp_.c_str());
-    throw Error(kExitIo, "cannot write " + final_ + ": " + reason);
-  }
-  committed_ = true;
+  if (file_.commit() != format::ContainerStatus::kOk) throw Error(kExitIo, "cannot write " + file_.errorMessage());
+}
+
+void writeOutputFile(const std::string& path, const std::string& bytes) {
+  AtomicOutput out(path);
+  out.write(bytes);
+  out.commit();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -121,13 +128,7 @@ void writeDepfile(const std::string& depfile, const std::vector<std::string>& ta
   text += ":";
   for (const auto& d : dependencies) text += " \\\n  " + escapeMake(d);
   text += "\n";
-  AtomicOutput out(depfile);
-  FILE* f = std::fopen(out.temporaryPath().c_str(), "wb");
-  if (!f) throw Error(kExitIo, "cannot write depfile " + depfile + ": " + std::strerror(errno));
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) throw Error(kExitIo, "cannot write depfile " + depfile);
-  out.commit();
+  writeOutputFile(depfile, text);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -287,7 +288,13 @@ void Tool::finishDepfile() const {
   if (outputs_.empty()) {
     warning("--depfile ignored: this command writes no output file");
   } else {
-    writeDepfile(common_.depfile, outputs_, inputs_);
+    try {
+      writeDepfile(common_.depfile, outputs_, inputs_);
+    } catch (const Error&) {
+      // Make must not see a fresh output without its dependencies: it would never rebuild it.
+      for (const auto& output : outputs_) std::remove(output.c_str());
+      throw;
+    }
   }
   depfile_written_ = true;
 }

@@ -25,6 +25,8 @@ constexpr size_t kIndexEntrySize = 64;                             // bytes of o
 constexpr size_t kSectionAlignment = 64;                           // every section and the index start at a multiple
 constexpr uint64_t kDefaultMaxRawSectionSize = uint64_t(1) << 32;  // 4 GiB: readers' default cap
 constexpr uint32_t kMaxSectionCount = 1u << 24;                    // readers refuse more
+constexpr uint64_t kMaxMetadataSize = uint64_t(16) << 20;          // 16 MiB: metadata text limit
+constexpr int kMaxJsonDepth = 64;                                  // nesting limit of every JSON input
 
 enum class ContainerStatus : int32_t {
   kOk = 0,
@@ -132,8 +134,9 @@ ContainerStatus hashFile128Hex(const std::string& path, std::string* hex_out);
 
 // Writes a container. Sections are compressed and appended as they are added, so a producer
 // never holds more than one section in memory; the index and header are written by finish().
-// Output goes to "<path>.tmp-<random>" in the same directory and is renamed to <path> by
-// finish(); if finish() is not reached (error, destruction, abort()), the temporary file is removed.
+// Output goes to an anonymous file in the same directory (format::AtomicFile; "<path>.tmp-<random>"
+// where the file system has no anonymous files) that finish() puts in place at <path>; if finish()
+// is not reached (error, destruction, abort()), nothing is left behind.
 // Not thread-safe: one thread adds sections (compress in parallel upstream and add in a fixed order
 // for deterministic bytes).
 class Writer {
@@ -153,8 +156,14 @@ class Writer {
   ContainerStatus finish();
   // Drops the temporary file. Called by the destructor if finish() did not succeed.
   void abort();
-  // Path of the temporary file while open (for signal handlers that must unlink it).
+  // Path of the temporary file while open (for signal handlers that must unlink it); empty when
+  // the temporary file is anonymous.
   const std::string& temporaryPath() const;
+  // errno of the first failed write, sync or rename (EFBIG, ENOSPC, ...), 0 when none.
+  int errorNumber() const;
+  // The reason of a failure for messages: strerror(errorNumber()) when a write failed ("File too
+  // large", "No space left on device"), else statusString(status).
+  std::string errorString(ContainerStatus status) const;
   uint64_t bytesWritten() const;
 
  private:
@@ -193,7 +202,10 @@ class Reader {
   int find(uint32_t type) const;
   int find(uint32_t type, uint64_t key) const;
 
-  // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size.
+  // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size. For
+  // zstd, the frame's recorded content size must equal raw_size and its blocks must be able to
+  // produce that many bytes (from its block headers) BEFORE out is resized, so a small file declaring
+  // a huge section costs at most its stored bytes (kDecompressFailed).
   ContainerStatus readSection(size_t i, std::vector<uint8_t>* out) const;
   // Same, into a caller buffer of exactly raw_size bytes (kInvalidArgument otherwise). Raw sections
   // are read straight into dst; zstd sections of a file reader go through a temporary buffer of
@@ -201,7 +213,8 @@ class Reader {
   ContainerStatus readSectionInto(size_t i, void* dst, size_t dst_size) const;
   // Reads the stored (possibly compressed) bytes of section i without decoding.
   ContainerStatus readStored(size_t i, std::vector<uint8_t>* out) const;
-  // The metadata JSON text (the single kSectionMetadata section).
+  // The metadata JSON text (the single kSectionMetadata section). kTooLarge, before anything is
+  // read, when its raw_size exceeds kMaxMetadataSize.
   ContainerStatus readMetadata(std::string* json_utf8) const;
   // Hashes every byte after the header and compares with the header's file checksum.
   ContainerStatus verifyFileChecksum() const;

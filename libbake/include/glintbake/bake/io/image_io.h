@@ -1,4 +1,4 @@
-// Image output through OpenImageIO, atomically (temporary file + rename).
+// Image output through OpenImageIO, atomically (format::AtomicFile).
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
@@ -13,13 +13,6 @@ struct ImageWriteOptions {
   // formats (EXR) always store float32 (or half if half_float).
   int png_bits = 16;
   bool half_float = false;
-  // Where the bytes are written before they become `path`. Empty: "<path>.tmp-<pid>-<n>" in the
-  // same directory. Tools pass a name they registered for removal on SIGINT/SIGTERM
-  // (cli::AtomicOutput), usually together with rename = false.
-  std::string temporary_path;
-  // true: rename the temporary file to `path` when complete. false: leave the complete file at
-  // temporary_path for the caller to move into place (it is still removed on failure).
-  bool rename = true;
   // When non-empty, stored as the file attribute kNormalEncodingAttribute ("snorm" or "unorm"), so
   // that --encoding auto reads the map back as written even when no value is negative (a flat
   // signed map would otherwise look encoded).
@@ -35,8 +28,9 @@ constexpr const char* kNormalEncodingAttribute = "glintbake:normal_encoding";
 // Float formats (.exr, .hdr, .pfm) store the values as given (float32, or half when half_float).
 // Every other format stores unsigned integers of png_bits bits (8 for formats that only hold 8,
 // e.g. JPEG): each value is clamped to [0, 1] (NaN becomes 0) and rounded to the nearest level.
-// The pixels go to "<path>.tmp-<pid>-<n>" in the same directory, renamed to path when complete;
-// on failure nothing is left behind. Bytes depend only on the arguments: no timestamps, host or
+// The image is encoded in memory and written through format::AtomicFile: it appears at path only
+// when every byte reached the file, and on failure (full disk, file-size limit) nothing is left
+// behind and an existing file at path is kept. Bytes depend only on the arguments: no timestamps, host or
 // software names are written. Thread-safe (distinct paths). Errors: kBadArgument (bad sizes,
 // channels not in 1..4, png_bits not 8 or 16), kUnsupported (unknown extension), kIo.
 BakeStatus writeImage(const std::string& path, int width, int height, int channels, const float* pixels,

@@ -34,6 +34,9 @@ class ContainerOutput {
   uint64_t bytesWritten() const { return writer_.bytesWritten(); }
 
  private:
+  // The OS reason of a failed write ("File too large"), else the status name.
+  std::string reason(format::ContainerStatus status) const;
+
   Tool& tool_;
   format::AssetKind kind_;
   format::Writer writer_;

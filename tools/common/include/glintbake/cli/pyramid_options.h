@@ -20,7 +20,8 @@ struct PyramidCliOptions {
   std::string levels_text = "auto";  // "auto" or a positive integer; resolvePyramidOptions fills options.levels
   bool flakes = true;                // write the flakes section (formats/SPEC.md 10.5); --no-flakes
   int lobes = bake::ndf::kDefaultLobesPerTile;  // lobes per tile of the clustered path; --lobes
-  std::vector<CLI::Option*> flags;   // the registered options (to reject them where they do not apply)
+  std::vector<CLI::Option*> flags;              // the registered options (to reject them where they do not apply)
+  std::string max_memory_text;  // --max-memory: bytes, with an optional K, M, G or T suffix (powers of 1024)
 };
 
 // Registers the options; region_help describes --region for this tool.
@@ -28,6 +29,15 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& pyramid, const std::str
 
 // Parses --levels and validates every option (Error with exit 1 naming the option).
 void resolvePyramidOptions(PyramidCliOptions& pyramid);
+
+// The estimated peak memory, in bytes, of baking `map` with these options on `threads` threads
+// (pyramid_builder.h and tensor_pack.h list the terms): the map, its flakes (24 bytes each), two
+// chunks, per-thread scratch, and for tensorpack (tensor = true) the group tensors in flight.
+uint64_t estimateBakeBytes(const PyramidCliOptions& pyramid, const bake::NormalMap& map, int threads, bool tensor);
+
+// Refuses the bake up front (Error exit 4 naming both figures) when --max-memory is given and the
+// estimate exceeds it; exit 1 when the value does not parse.
+void checkMemoryBudget(const PyramidCliOptions& pyramid, const bake::NormalMap& map, int threads, bool tensor);
 
 // Canonical JSON form of the options (for provenance metadata and --json reports).
 Json pyramidOptionsJson(const PyramidCliOptions& pyramid);

@@ -11,6 +11,7 @@
 // "<tool>: error: <message>" as one line on stderr and returns the code.
 #pragma once
 
+#include <glintbake/format/atomic_file.h>
 #include <glintbake/format/container.h>
 
 #include <CLI/CLI.hpp>
@@ -70,22 +71,28 @@ class Progress {
   std::unique_ptr<Impl> impl_;
 };
 
-// An output file written atomically: write to temporaryPath(), then commit() renames it to the
-// final path. The temporary file is removed if commit() is not reached, including on SIGINT/SIGTERM.
+// An output file written atomically (format::AtomicFile): write() the bytes, then commit() puts
+// the file in place. Nothing is left behind if commit() is not reached, on a failed write (full
+// disk, file-size limit) or on SIGINT/SIGTERM/SIGHUP. Failures throw Error(kExitIo) naming the
+// path and the reason ("File too large").
 class AtomicOutput {
  public:
-  explicit AtomicOutput(const std::string& final_path);
+  explicit AtomicOutput(const std::string& final_path);  // throws Error(kExitIo)
   ~AtomicOutput();
   AtomicOutput(const AtomicOutput&) = delete;
   AtomicOutput& operator=(const AtomicOutput&) = delete;
-  const std::string& temporaryPath() const { return tmp_; }
   const std::string& finalPath() const { return final_; }
+  void write(const void* data, size_t size);  // throws Error(kExitIo)
+  void write(const std::string& bytes) { write(bytes.data(), bytes.size()); }
   void commit();  // throws Error(kExitIo) on failure
 
  private:
-  std::string final_, tmp_;
-  bool committed_ = false;
+  std::string final_, registered_;
+  format::AtomicFile file_;
 };
+
+// Writes bytes to path through an AtomicOutput (throws Error(kExitIo) on failure).
+void writeOutputFile(const std::string& path, const std::string& bytes);
 
 // Registers a path to unlink if the process receives SIGINT/SIGTERM (used by AtomicOutput and by
 // format::Writer users through Tool::guardTemporary). Async-signal-safe removal.

@@ -1,0 +1,107 @@
+"""Containers written directly from formats/SPEC.md by a second, independent writer (if these
+files validate, the spec is complete), including hostile ones: any codec, any declared raw size,
+and zstd frames built by hand from RLE blocks (RFC 8878) that record any content size. XXH3-64
+comes from the system libxxhash through ctypes."""
+
+import ctypes
+import ctypes.util
+import json
+import struct
+
+
+def _load_xxhash():
+    for name in (ctypes.util.find_library("xxhash"), "libxxhash.so.0", "libxxhash.so"):
+        if not name:
+            continue
+        try:
+            lib = ctypes.CDLL(name)
+        except OSError:
+            continue
+        lib.XXH3_64bits.restype = ctypes.c_uint64
+        lib.XXH3_64bits.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
+        return lib
+    raise RuntimeError("libxxhash not found")
+
+
+_XXH = _load_xxhash()
+
+
+def xxh3_64(data):
+    return _XXH.XXH3_64bits(bytes(data), len(data))
+
+
+MAGIC = bytes([0xAB, ord("G"), ord("B"), ord("K"), 0x0D, 0x0A, 0x1A, 0x0A])
+KIND_TEST = 0x7FFF
+SECTION_METADATA, SECTION_IMAGE, SECTION_PRIVATE = 1, 0x100, 0x10000
+CODEC_RAW, CODEC_ZSTD = 0, 1
+
+
+def metadata(tool="pytest", version="1.0", **extra):
+    doc = {"schema": "glintbake.container-metadata/1", "asset_kind": "test",
+           "generator": {"tool": tool, "version": version}, "parameters": {"n": 1},
+           "inputs": [{"name": "input.png", "hash": "xxh3-128:" + "0f" * 16}]}
+    doc.update(extra)
+    return json.dumps(doc).encode()
+
+
+def image_payload(width, height, channels, layers, values):
+    header = struct.pack("<6IQ", 0x474D4947, width, height, channels, layers, 0, 0)
+    assert len(values) == width * height * channels * layers
+    return header + struct.pack("<%df" % len(values), *values)
+
+
+def build_container(sections, kind=KIND_TEST, major=1, minor=0):
+    """sections: list of (type, key, raw bytes), stored raw (codec 0), or of (type, key, stored
+    bytes, codec, raw_size) for any codec and any declared size.
+    Layout per SPEC.md: 128-byte header, 64-aligned sections, 64-byte index entries, header last."""
+    body = bytearray()
+    entries = []
+    offset = 128
+    for section in sections:
+        stype, key, data = section[:3]
+        codec, raw_size = section[3:] if len(section) > 3 else (CODEC_RAW, len(data))
+        pad = (-offset) % 64
+        body += b"\0" * pad
+        offset += pad
+        entries.append(struct.pack("<IIQQQQQII8x", stype, codec, key, offset, len(data), raw_size, xxh3_64(data), 0, 0))
+        body += data
+        offset += len(data)
+    pad = (-offset) % 64
+    body += b"\0" * pad
+    offset += pad
+    index = b"".join(entries)
+    index_offset = offset
+    body += index
+    file_size = index_offset + len(index)
+    header = bytearray(struct.pack("<8sHHIIIIIQQQQQQ", MAGIC, major, minor, kind, 128, 0, len(sections), 0,
+                                   index_offset, len(index), file_size, xxh3_64(body), xxh3_64(index), 0))
+    header += b"\0" * (128 - len(header))
+    struct.pack_into("<Q", header, 72, xxh3_64(header))
+    return bytes(header) + bytes(body)
+
+
+
+
+def zstd_rle_frame(content_size, produced=None, byte=b"\0"):
+    """One zstd frame whose header records content_size and whose RLE blocks really produce
+    `produced` bytes (default content_size) of `byte`: about 4 bytes per 128 KiB."""
+    produced = content_size if produced is None else produced
+    frame = struct.pack("<IBQ", 0xFD2FB528, 0xE0, content_size)  # single segment, 8-byte content size
+    left = produced
+    while True:
+        n = min(128 * 1024, left)
+        left -= n
+        frame += struct.pack("<I", (1 if left == 0 else 0) | (1 << 1) | (n << 3))[:3] + byte
+        if left == 0:
+            return frame
+
+
+def read_sections(data):
+    """The sections of a container's bytes as build_container takes them: (type, key, stored bytes,
+    codec, raw_size), in index order, so a test can rebuild a real file with one section changed."""
+    index_offset, index_size = struct.unpack_from("<QQ", data, 32)
+    sections = []
+    for at in range(index_offset, index_offset + index_size, 64):
+        stype, codec, key, offset, stored, raw = struct.unpack_from("<IIQQQQ", data, at)
+        sections.append((stype, key, data[offset:offset + stored], codec, raw))
+    return sections
