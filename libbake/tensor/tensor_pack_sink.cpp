@@ -92,6 +92,7 @@ BakeStatus TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   level_images_ = 0;
   const uint64_t level_bytes = uint64_t(grid_width_) * uint64_t(grid_height_) * uint64_t(res) * uint64_t(res) * 4u;
   exact_level_ = options_.exact_level_bytes > 0 && level_bytes <= options_.exact_level_bytes &&
+                 uint64_t(grid_width_) * uint64_t(grid_height_) <= kMaxExactCentres &&
                  int(record.level) >= options_.exact_min_level && options_.block <= int(format::kTensorMaxRank);
   TensorPackLevelReport lrep;
   lrep.level = level_;

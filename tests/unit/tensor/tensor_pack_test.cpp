@@ -5,6 +5,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/format/container.h>
+#include <glintbake/runtime/cp_block.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf_layout.h>
 
@@ -377,6 +378,30 @@ TEST(TensorPack, ExactLevelsDecodeToThePyramidImages) {
   EXPECT_EQ(rep.max_rank, 16);
   EXPECT_GT(rep.rank_histogram[16], 0u);
   EXPECT_GT(rep.rank_histogram[8], 0u);
+}
+
+// Levels of more than kMaxExactCentres centres stay compressed whatever the budget: a footprint
+// blending two exact levels must stay within the runtime's groups per block mix.
+TEST(TensorPack, ExactLevelsHaveAtMost64Centres) {
+  MapParams mp;
+  mp.size = 128;
+  mp.seed = 3;
+  const NormalMap map = generateMap(MapKind::kBeckmann, mp);
+  ndf::PyramidOptions pyr;
+  pyr.splat.ndf_res = 16;
+  pyr.stride0 = 8;  // level 0: 16 x 16 centres, level 1: 8 x 8
+  pyr.sigma0 = 4;
+  pyr.levels = 2;
+  TensorPackOptions o = packOptions(4);
+  o.block = 8;
+  o.exact_level_bytes = uint64_t(1) << 30;
+  TensorPackReport rep;
+  ASSERT_TRUE(packFromMap(map, o, tempPath("exact_cap.gbk"), &rep, pyr).ok());
+  ASSERT_EQ(rep.levels.size(), 2u);
+  EXPECT_FALSE(rep.levels[0].exact);
+  EXPECT_TRUE(rep.levels[1].exact);
+  EXPECT_LE(runtime::kCpMaxGroups, 1 << 16);
+  EXPECT_GE(uint64_t(runtime::kCpMaxGroups), kMaxExactCentres + kMaxExactCentres / 4);
 }
 
 TEST(TensorPack, IndexBlankBlocksAndPrefixSumsAreConsistent) {

@@ -58,6 +58,8 @@ namespace glintbake::bake::tensor {
 
 constexpr double kDefaultBlankThreshold = 1e-5;
 
+constexpr uint64_t kMaxExactCentres = 64;
+
 struct TensorPackOptions {
   CpOptions cp;    // rank (default 16) is the rank, or the largest rank of error-target mode
   int block = 32;  // B: bins per block side, divides the NDF resolution, [1, kMaxBlockBins]
@@ -71,6 +73,8 @@ struct TensorPackOptions {
   // A (4 B^2 + 12 B values a block on load, about four times the images). The coarse levels are
   // small and CP keeps little of their glints at rank 16 (README, "Figures"). 0: none; needs
   // B <= 64.
+  // At most kMaxExactCentres centres per exact level, so that a footprint blending two exact
+  // levels mixes at most 80 groups per block (the runtime's CpMix keeps 128).
   uint64_t exact_level_bytes = 0;
   // ... and whose index is at least this: finer levels stay compressed (tensorpack sets 1: the
   // clustered lobes answer level 0's footprints from single flakes).
