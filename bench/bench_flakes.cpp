@@ -101,50 +101,32 @@ std::vector<Query> queries(const Subject& subject, double sigma) {
   return q;
 }
 
-void evalBench(benchmark::State& state, size_t subject, double sigma) {
+// Point eval and sample of one of a subject's evaluators (the exact flakes or the clustered lobes).
+const rt::NdfSource& evaluator(const Subject& s, bool lobes) {
+  return lobes ? static_cast<const rt::NdfSource&>(s.lobes) : s.ndf;
+}
+
+void evalBench(benchmark::State& state, size_t subject, double sigma, bool lobes) {
   const Subject& s = *subjects()[subject];
+  const rt::NdfSource& src = evaluator(s, lobes);
   const std::vector<Query> q = queries(s, sigma);
   size_t i = 0;
   for (auto _ : state) {
     double v;
-    s.ndf.eval(q[i].fp, q[i].s, &v);
+    src.eval(q[i].fp, q[i].s, &v);
     benchmark::DoNotOptimize(v);
     i = (i + 1) & 1023;
   }
 }
 
-void sampleBench(benchmark::State& state, size_t subject, double sigma) {
+void sampleBench(benchmark::State& state, size_t subject, double sigma, bool lobes) {
   const Subject& s = *subjects()[subject];
+  const rt::NdfSource& src = evaluator(s, lobes);
   const std::vector<Query> q = queries(s, sigma);
   size_t i = 0;
   for (auto _ : state) {
     rt::NdfSample smp;
-    s.ndf.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
-    benchmark::DoNotOptimize(smp);
-    i = (i + 1) & 1023;
-  }
-}
-
-// The clustered lobes (lobe_ndf.h) at the defaults (16 lobes per tile), at the same queries.
-void lobeEvalBench(benchmark::State& state, size_t subject, double sigma) {
-  const Subject& s = *subjects()[subject];
-  const std::vector<Query> q = queries(s, sigma);
-  size_t i = 0;
-  for (auto _ : state) {
-    double v;
-    s.lobes.eval(q[i].fp, q[i].s, &v);
-    benchmark::DoNotOptimize(v);
-    i = (i + 1) & 1023;
-  }
-}
-
-void lobeSampleBench(benchmark::State& state, size_t subject, double sigma) {
-  const Subject& s = *subjects()[subject];
-  const std::vector<Query> q = queries(s, sigma);
-  size_t i = 0;
-  for (auto _ : state) {
-    rt::NdfSample smp;
-    s.lobes.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
+    src.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
     benchmark::DoNotOptimize(smp);
     i = (i + 1) & 1023;
   }
@@ -167,14 +149,14 @@ const int registered = [] {
     const std::string name = subjects()[k]->name;
     for (double sigma : {0.0, 1.0, 4.0, 8.0, 16.0}) {
       const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
-      benchmark::RegisterBenchmark(("flake_eval/" + tag).c_str(), evalBench, k, sigma);
-      benchmark::RegisterBenchmark(("flake_sample/" + tag).c_str(), sampleBench, k, sigma);
+      benchmark::RegisterBenchmark(("flake_eval/" + tag).c_str(), evalBench, k, sigma, false);
+      benchmark::RegisterBenchmark(("flake_sample/" + tag).c_str(), sampleBench, k, sigma, false);
     }
     for (double sigma : {6.0, 12.0, 24.0, 48.0}) {
       const std::string tag = name + "/sigma:" + std::to_string(int(sigma));
-      benchmark::RegisterBenchmark(("lobe_eval/" + tag).c_str(), lobeEvalBench, k, sigma)
+      benchmark::RegisterBenchmark(("lobe_eval/" + tag).c_str(), evalBench, k, sigma, true)
           ->Unit(benchmark::kMicrosecond);
-      benchmark::RegisterBenchmark(("lobe_sample/" + tag).c_str(), lobeSampleBench, k, sigma)
+      benchmark::RegisterBenchmark(("lobe_sample/" + tag).c_str(), sampleBench, k, sigma, true)
           ->Unit(benchmark::kMicrosecond);
     }
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
