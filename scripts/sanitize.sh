@@ -28,7 +28,11 @@ if [[ ! -f build-asan/CMakeCache.txt ]]; then
   cmake -S . -B build-asan "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug \
     -DGLINTBAKE_SANITIZE=address,undefined -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 fi
-cmake --build build-asan -j "$jobs" >/dev/null
+if [[ "${1:-}" == "--cli" ]]; then
+  cmake --build build-asan -j "$jobs" >/dev/null
+else
+  cmake --build build-asan -j "$jobs" --target glintbake_unit_tests >/dev/null  # no tools, no benchmarks
+fi
 if [[ "${1:-}" == "--cli" ]]; then
   ctest --test-dir build-asan --output-on-failure -j "$jobs" -E '^install[.]' --timeout 1800
 else

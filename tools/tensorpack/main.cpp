@@ -175,7 +175,7 @@ struct Options {
   cli::GlitterCliOptions glitter;
   tensor::TensorPackOptions pack;
   double error_target = -1.0, max_error = -1.0;
-  double exact_mib = 4.0;
+  double exact_mib = 16.0;
   int zstd_level = 9;
 };
 
@@ -213,7 +213,7 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
   app.add_option("--exact-levels", o.exact_mib,
-                 "Store the levels above the finest whose NDF images take at most this many MiB (and 64 centres) "
+                 "Store the levels above the finest whose NDF images take at most this many MiB (and 16 x 16 centres) "
                  "(float32) exactly instead of compressed (0..1024; 0: compress every level)")
       ->capture_default_str();
   app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
@@ -332,7 +332,7 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   // The automatic level count may stop only once the pyramid has reached the levels stored exactly
   // (side^2 R^2 4 bytes within the budget), so that the top level is not a lossy one.
   const double exact_side = std::sqrt(double(o.pack.exact_level_bytes) / (4.0 * double(ndf_res) * double(ndf_res)));
-  o.pyramid.options.converge_from_grid = int(std::min(exact_side, 8.0));  // kMaxExactCentres = 8 x 8
+  o.pyramid.options.converge_from_grid = int(std::min(exact_side, 16.0));  // kMaxExactCentres = 16 x 16
   o.pyramid.options.converge_from_level = o.pack.exact_level_bytes > 0 ? 1 : 0;
   if (ndf_res % o.pack.block != 0) {
     throw Error(cli::kExitBadArguments,

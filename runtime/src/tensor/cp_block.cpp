@@ -12,11 +12,13 @@ RuntimeStatus validateCpGroupView(const CpGroupView& v) {
   if (v.bins < 1 || v.bins > kCpMaxBins || v.rank < 1 || v.rank > kCpMaxRank || v.blocks < 1)
     return RuntimeStatus::kInvalidArgument;
   if (!v.a || !v.b || !v.c || !v.a_prefix || !v.b_prefix) return RuntimeStatus::kInvalidArgument;
+  if (v.identity_a && v.rank != v.bins) return RuntimeStatus::kInvalidArgument;
   return RuntimeStatus::kOk;
 }
 
 RuntimeStatus CpMix::init(const CpBlendTerm* terms, int32_t count) {
   group_count_ = 0;
+  exact_count_ = 0;
   bins_ = 0;
   if (count < 0 || count > kCpMaxBlend || (count > 0 && !terms)) return RuntimeStatus::kInvalidArgument;
   for (int32_t t = 0; t < count; ++t) {
@@ -24,11 +26,22 @@ RuntimeStatus CpMix::init(const CpBlendTerm* terms, int32_t count) {
     if (!term.group || validateCpGroupView(*term.group) != RuntimeStatus::kOk || term.block < 0 ||
         term.block >= term.group->blocks || !std::isfinite(term.weight) || (bins_ != 0 && term.group->bins != bins_)) {
       group_count_ = 0;
+      exact_count_ = 0;
       bins_ = 0;
       return RuntimeStatus::kInvalidArgument;
     }
     if (term.weight == 0.0f) continue;
     bins_ = term.group->bins;
+    if (term.group->identity_a) {
+      const int32_t t_exact = exact_count_++;
+      exact_[t_exact] = term.group;
+      exact_c_[t_exact] = term.group->c + static_cast<size_t>(term.block) * term.group->rank;
+      exact_w_[t_exact] = term.weight;
+      const double m = term.mass >= 0.0f ? double(term.weight) * term.mass
+                                         : double(exactRangeSum(t_exact, 0, bins_, 0, bins_));
+      exact_m_[t_exact] = m > 0.0 ? m : 0.0;
+      continue;
+    }
     int32_t g = 0;
     while (g < group_count_ && groups_[g] != term.group) ++g;
     const int32_t rank = term.group->rank;
@@ -41,12 +54,38 @@ RuntimeStatus CpMix::init(const CpBlendTerm* terms, int32_t count) {
     const float* c = term.group->c + static_cast<size_t>(term.block) * rank;
     for (int32_t r = 0; r < rank; ++r) coef_[g][r] += term.weight * c[r];
   }
+  group_mass_ = mix_mass_ = 0.0;
+  if (exact_count_ > 0) {
+    if (group_count_ > 0) {
+      const float m = groupRangeSum(0, bins_, 0, bins_);
+      group_mass_ = m > 0.0f ? double(m) : 0.0;
+    }
+    mix_mass_ = group_mass_;
+    for (int32_t t = 0; t < exact_count_; ++t) mix_mass_ += exact_m_[t];
+  }
   return RuntimeStatus::kOk;
+}
+
+float CpMix::exactValue(int32_t t, int32_t i, int32_t j) const {
+  const CpGroupView& v = *exact_[t];
+  return exact_w_[t] * exact_c_[t][i] * v.b[static_cast<size_t>(j) * v.rank + i];
+}
+
+float CpMix::exactRangeSum(int32_t t, int32_t i0, int32_t i1, int32_t j0, int32_t j1) const {
+  // Column i of an exact block is C(k, i) times column i of B; B's prefix sums run down the rows.
+  const CpGroupView& v = *exact_[t];
+  const float* p0 = v.b_prefix + static_cast<size_t>(j0) * v.rank;
+  const float* p1 = v.b_prefix + static_cast<size_t>(j1) * v.rank;
+  const float* c = exact_c_[t];
+  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  laneAccumulate<float>(i1 - i0, [&](int32_t r) { return c[i0 + r] * (p1[i0 + r] - p0[i0 + r]); }, exact_w_[t], lanes);
+  return laneTotal(lanes);
 }
 
 float CpMix::rawValue(int32_t i, int32_t j) const {
   if (i < 0 || j < 0 || i >= bins_ || j >= bins_) return 0.0f;
   float sum = 0.0f;
+  for (int32_t t = 0; t < exact_count_; ++t) sum += exactValue(t, i, j);
   for (int32_t g = 0; g < group_count_; ++g) {
     const CpGroupView& v = *groups_[g];
     const int32_t rank = v.rank;
@@ -64,6 +103,12 @@ float CpMix::value(int32_t i, int32_t j) const {
 
 float CpMix::rawRangeSum(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const {
   if (i0 < 0 || j0 < 0 || i1 > bins_ || j1 > bins_ || i0 >= i1 || j0 >= j1) return 0.0f;
+  float sum = groupRangeSum(i0, i1, j0, j1);
+  for (int32_t t = 0; t < exact_count_; ++t) sum += exactRangeSum(t, i0, i1, j0, j1);
+  return sum;
+}
+
+float CpMix::groupRangeSum(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const {
   float sum = 0.0f;
   for (int32_t g = 0; g < group_count_; ++g) {
     const CpGroupView& v = *groups_[g];
@@ -95,13 +140,22 @@ float CpMix::rangeAverage(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const 
 }
 
 float CpMix::blockMass() const {
+  if (exact_count_ > 0) return float(mix_mass_);  // the components' clamped masses (sample's mixture)
   const float sum = rawRangeSum(0, bins_, 0, bins_);
   return sum > 0.0f ? sum : 0.0f;
 }
 
-void CpMix::childWeights(int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t ym, int32_t y1, float w[4]) const {
+void CpMix::childWeights(int32_t component, int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t ym, int32_t y1,
+                         float w[4]) const {
   float s00 = 0.0f, s10 = 0.0f, s01 = 0.0f, s11 = 0.0f;
-  for (int32_t g = 0; g < group_count_; ++g) {
+  if (component >= 0) {
+    // An empty side (width 0) sums to exactly zero.
+    s00 = x0 < xm && y0 < ym ? exactRangeSum(component, x0, xm, y0, ym) : 0.0f;
+    s10 = xm < x1 && y0 < ym ? exactRangeSum(component, xm, x1, y0, ym) : 0.0f;
+    s01 = x0 < xm && ym < y1 ? exactRangeSum(component, x0, xm, ym, y1) : 0.0f;
+    s11 = xm < x1 && ym < y1 ? exactRangeSum(component, xm, x1, ym, y1) : 0.0f;
+  }
+  for (int32_t g = 0; component < 0 && g < group_count_; ++g) {
     const CpGroupView& v = *groups_[g];
     const int32_t rank = v.rank;
     const float* pax0 = v.a_prefix + static_cast<size_t>(x0) * rank;
@@ -174,13 +228,12 @@ constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
 
 }  // namespace
 
-bool CpMix::sample(double u1, double u2, CpBlockSample* out) const {
-  if (!out || !(blockMass() > 0.0f)) return false;
+bool CpMix::descend(int32_t component, double u1, double u2, CpBlockSample* out) const {
   Node n{0, bins_, 0, bins_};
   double p = 1.0;
   while (!n.leaf()) {
     float w[4];
-    childWeights(n.x0, n.xm(), n.x1, n.y0, n.ym(), n.y1, w);
+    childWeights(component, n.x0, n.xm(), n.x1, n.y0, n.ym(), n.y1, w);
     double q[4];
     childProbabilities(n, w, q);
     // Column first (u1), then the row within the column (u2); each uniform is rescaled into the
@@ -218,13 +271,12 @@ bool CpMix::sample(double u1, double u2, CpBlockSample* out) const {
   return true;
 }
 
-double CpMix::pdf(int32_t i, int32_t j) const {
-  if (i < 0 || j < 0 || i >= bins_ || j >= bins_ || !(blockMass() > 0.0f)) return 0.0;
+double CpMix::descentPdf(int32_t component, int32_t i, int32_t j) const {
   Node n{0, bins_, 0, bins_};
   double p = 1.0;
   while (!n.leaf()) {
     float w[4];
-    childWeights(n.x0, n.xm(), n.x1, n.y0, n.ym(), n.y1, w);
+    childWeights(component, n.x0, n.xm(), n.x1, n.y0, n.ym(), n.y1, w);
     double q[4];
     childProbabilities(n, w, q);
     const int child = (i >= n.xm() ? 1 : 0) + (j >= n.ym() ? 2 : 0);
@@ -233,6 +285,44 @@ double CpMix::pdf(int32_t i, int32_t j) const {
     descendInto(n, child);
   }
   return p;
+}
+
+double CpMix::mixturePdf(int32_t i, int32_t j) const {
+  if (!(mix_mass_ > 0.0)) return 0.0;
+  double density = group_mass_ > 0.0 ? group_mass_ * descentPdf(-1, i, j) : 0.0;
+  for (int32_t t = 0; t < exact_count_; ++t) {
+    const float v = exactValue(t, i, j);
+    if (v > 0.0f) density += double(v);
+  }
+  return density / mix_mass_;
+}
+
+bool CpMix::sample(double u1, double u2, CpBlockSample* out) const {
+  if (!out || !(blockMass() > 0.0f)) return false;
+  if (exact_count_ == 0) return descend(-1, u1, u2, out);
+  // A mixture: the component by its clamped mass (u1 rescaled into it), then the quadtree within.
+  const double target = u1 * mix_mass_;
+  double before = 0.0, chosen_mass = 0.0;
+  int32_t chosen = -2;
+  for (int32_t c = group_count_ > 0 ? -1 : 0; c < exact_count_; ++c) {
+    const double m = componentMass(c);
+    if (!(m > 0.0)) continue;
+    chosen = c;
+    chosen_mass = m;
+    if (target < before + m) break;
+    before += m;  // rounding may run past the last component with mass: it is kept
+  }
+  if (chosen == -2) return false;
+  u1 = (target - before) / chosen_mass;
+  u1 = u1 < kOneMinusEpsilon ? (u1 > 0.0 ? u1 : 0.0) : kOneMinusEpsilon;
+  if (!descend(chosen, u1, u2, out)) return false;
+  out->pdf = mixturePdf(out->i, out->j);
+  return true;
+}
+
+double CpMix::pdf(int32_t i, int32_t j) const {
+  if (i < 0 || j < 0 || i >= bins_ || j >= bins_ || !(blockMass() > 0.0f)) return 0.0;
+  return exact_count_ == 0 ? descentPdf(-1, i, j) : mixturePdf(i, j);
 }
 
 double CpMix::pdfAt(float x, float y) const {

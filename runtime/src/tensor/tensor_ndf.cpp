@@ -1,5 +1,5 @@
 // Queries of tensor-ndf assets: the NdfPyramid blend over centres and levels, reduced per block to
-// a CpMix (cp_block.h) of at most 8 (group, row, weight) terms.
+// a CpMix (cp_block.h) of its (group, row, weight) terms.
 #include "tensor_ndf_impl.h"
 
 #include "../pyramid_blend.h"
@@ -73,7 +73,9 @@ void TensorNdf::Impl::mixBlock(const Blend& b, uint64_t block, CpMix* mix) const
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup) continue;
-    terms[n++] = CpBlendTerm{&groups.data[e.group].view, int32_t(e.row), float(b.weight[t])};
+    // The loader's raw masses are in s-plane units (bin area times the bins' sum).
+    terms[n++] = CpBlendTerm{&groups.data[e.group].view, int32_t(e.row), float(b.weight[t]),
+                             float(b.mass[t][block] * inv_bin_area)};
   }
   // Entries were validated at load: init cannot fail.
   mix->init(terms, n);
@@ -153,6 +155,10 @@ RuntimeStatus TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s
     if (e.group == kTensorBlankGroup) continue;
     const CpGroupView& v = m.groups.data[e.group].view;
     const size_t rank = size_t(v.rank);
+    if (v.identity_a) {  // an exact block: one stored value
+      lanes[0] += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
+      continue;
+    }
     laneAccumulateDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
                        float(b.weight[t]), lanes);
   }

@@ -38,6 +38,7 @@ struct TensorNdf::Impl {
   uint64_t nb2 = 0;
   bool nonneg = false;
   double bin = 0.0, bin_area = 0.0;  // 2 / R, (2 / R)^2
+  double inv_bin_area = 0.0;         // (R / 2)^2
   double inv_bin = 0.0;              // R / 2
   int level_count = 0;
   TLevel levels[kMaxNdfLevels];

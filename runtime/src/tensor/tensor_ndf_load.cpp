@@ -76,6 +76,16 @@ RuntimeStatus TensorNdf::Impl::loadGroup(const format::Reader& reader, uint32_t 
   for (uint64_t r = 0; r < rank; ++r) {
     if (view.a_prefix[r] != 0.0f || view.b_prefix[r] != 0.0f) return RuntimeStatus::kInvalidAsset;
   }
+  // Exact groups (tensorpack's exact levels) have A = identity: queries read their blocks directly.
+  view.identity_a = rank == b;
+  for (uint64_t i = 0; view.identity_a && i < b; ++i) {
+    for (uint64_t r = 0; r < rank; ++r) {
+      if (view.a[i * rank + r] != (i == r ? 1.0f : 0.0f)) {
+        view.identity_a = false;
+        break;
+      }
+    }
+  }
   if (validateCpGroupView(view) != RuntimeStatus::kOk) return RuntimeStatus::kInvalidAsset;
   memory_bytes += (factor_values + prefix_values) * 4;
   return RuntimeStatus::kOk;
@@ -143,6 +153,7 @@ RuntimeStatus TensorNdf::Impl::load(const format::Reader& reader) {
   bin = 2.0 / res;
   inv_bin = res / 2.0;
   bin_area = bin * bin;
+  inv_bin_area = 1.0 / bin_area;
 
   for (int l = 0; l < int(info.level_count); ++l) {
     const int idx = reader.find(format::kSectionNdfLevel, uint64_t(l));

@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <random>
+#include <vector>
 
 namespace glintbake::runtime {
 namespace {
@@ -135,6 +138,106 @@ TEST(CpBlock, MeasuresSignedModelDepartures) {
       EXPECT_LT(gap, 1e-4);
     }
   }
+}
+
+// Exact blocks (A = identity, tensorpack's exact levels) beside a compressed group: a footprint
+// over a wide exact level blends hundreds of them, more than a mix has group slots. Every term
+// counts, and sample() follows pdf(), which sums to 1 and equals value / mass.
+struct ExactBlock {
+  std::vector<float> a, b, c, a_prefix, b_prefix;
+  CpGroupView view;
+};
+
+std::unique_ptr<ExactBlock> makeExactBlock(uint64_t seed) {
+  constexpr int kBins = 32;
+  auto e = std::make_unique<ExactBlock>();
+  e->a.assign(kBins * kBins, 0.0f);
+  for (int i = 0; i < kBins; ++i) e->a[i * kBins + i] = 1.0f;
+  // A few narrow peaks on a faint floor, like a glinty NDF block; some blocks all zero.
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  e->b.assign(kBins * kBins, seed % 7 == 0 ? 0.0f : 1e-3f);
+  for (int p = 0; p < int(seed % 4); ++p) {
+    const int i = int(u(rng) * kBins), j = int(u(rng) * kBins);
+    e->b[j * kBins + i] += 5.0f * u(rng);
+  }
+  e->c.assign(kBins, 1.0f);
+  e->a_prefix = bake::tensor::buildPrefixSums(e->a, kBins, kBins);
+  e->b_prefix = bake::tensor::buildPrefixSums(e->b, kBins, kBins);
+  e->view = CpGroupView{kBins, kBins, 1, e->a.data(), e->b.data(), e->c.data(), e->a_prefix.data(), e->b_prefix.data(),
+                        true};
+  return e;
+}
+
+TEST(CpBlock, ExactBlocksBeyondTheGroupSlotsAllCount) {
+  constexpr int kExact = 3 * kCpMaxGroups;
+  std::vector<std::unique_ptr<ExactBlock>> blocks;
+  for (int t = 0; t < kExact; ++t) blocks.push_back(makeExactBlock(uint64_t(t)));
+  auto cp = makeGroup(21, true);
+  std::vector<CpBlendTerm> terms;
+  Uniforms u(22);
+  terms.push_back({&cp->view, 4, 0.05f});
+  terms.push_back({&cp->view, 9, 0.03f});
+  for (int t = 0; t < kExact; ++t) terms.push_back({&blocks[size_t(t)]->view, 0, float(0.5 + u.next()) / kExact});
+  CpMix mix;
+  ASSERT_EQ(mix.init(terms.data(), int32_t(terms.size())), RuntimeStatus::kOk);
+  double peak = 0.0, direct_mass = 0.0;
+  for (int j = 0; j < 32; ++j) {
+    for (int i = 0; i < 32; ++i) {
+      const double expected = directValue(terms.data(), int(terms.size()), i, j);
+      ASSERT_NEAR(mix.rawValue(i, j), expected, 1e-5 * (1.0 + std::abs(expected))) << i << "," << j;
+      peak = std::max(peak, expected);
+      direct_mass += expected;
+    }
+  }
+  EXPECT_NEAR(mix.blockMass(), direct_mass, 1e-5 * direct_mass);
+  EXPECT_NEAR(mix.rawRangeSum(3, 20, 5, 9), [&] {
+    double s = 0.0;
+    for (int j = 5; j < 9; ++j) {
+      for (int i = 3; i < 20; ++i) s += mix.rawValue(i, j);
+    }
+    return s;
+  }(), 1e-4 * direct_mass);
+  const double mass = mix.blockMass();
+  double total = 0.0, worst = 0.0;
+  std::vector<double> pdf(32 * 32);
+  for (int j = 0; j < 32; ++j) {
+    for (int i = 0; i < 32; ++i) {
+      pdf[size_t(j * 32 + i)] = mix.pdf(i, j);
+      total += pdf[size_t(j * 32 + i)];
+      worst = std::max(worst, std::abs(pdf[size_t(j * 32 + i)] * mass - mix.value(i, j)) / peak);
+    }
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+  EXPECT_LT(worst, 1e-5);
+  // Samples land where pdf() says: the sample's pdf is pdf() bit for bit, and a chi-square test
+  // of the bin counts against it (bins expecting at least 5 samples) passes.
+  constexpr int kSamples = 100000;
+  std::vector<double> count(32 * 32, 0.0);
+  for (int n = 0; n < kSamples; ++n) {
+    CpBlockSample s;
+    ASSERT_TRUE(mix.sample(u.next(), u.next(), &s));
+    ASSERT_EQ(s.pdf, mix.pdf(s.i, s.j));
+    ASSERT_GE(s.x, s.i);
+    ASSERT_LT(s.x, s.i + 1);
+    count[size_t(s.j * 32 + s.i)] += 1.0;
+  }
+  double chi2 = 0.0, rest_expected = 0.0, rest_seen = 0.0;
+  int dof = 0;
+  for (size_t k = 0; k < count.size(); ++k) {
+    const double expected = pdf[k] * kSamples;
+    if (expected >= 5.0) {
+      chi2 += (count[k] - expected) * (count[k] - expected) / expected;
+      ++dof;
+    } else {
+      rest_expected += expected;
+      rest_seen += count[k];
+    }
+  }
+  if (rest_expected > 0.0) chi2 += (rest_seen - rest_expected) * (rest_seen - rest_expected) / rest_expected;
+  ASSERT_GT(dof, 100);
+  // Mean dof, standard deviation sqrt(2 dof): 5 standard deviations.
+  EXPECT_LT(chi2, dof + 5.0 * std::sqrt(2.0 * dof)) << "dof " << dof;
 }
 
 TEST(CpBlock, RejectsInvalidBlends) {

@@ -7,10 +7,12 @@
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/cp_block.h>
 #include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/runtime/tensor_ndf.h>
 #include <glintbake/runtime/tensor_ndf_layout.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 #include "../temp_dir.h"
@@ -380,28 +383,80 @@ TEST(TensorPack, ExactLevelsDecodeToThePyramidImages) {
   EXPECT_GT(rep.rank_histogram[8], 0u);
 }
 
-// Levels of more than kMaxExactCentres centres stay compressed whatever the budget: a footprint
-// blending two exact levels must stay within the runtime's groups per block mix.
-TEST(TensorPack, ExactLevelsHaveAtMost64Centres) {
+// Levels of more than kMaxExactCentres (16 x 16) centres stay compressed whatever the budget. A
+// 16 x 16 exact level answers wide footprints from hundreds of exact blocks per block mix (more
+// than a mix has group slots for compressed groups): the asset still equals the uncompressed
+// pyramid there, in images, point values and mass, and its sampler's pdf integrates to 1.
+TEST(TensorPack, ExactLevelsOfUpTo256CentresAnswerLikeThePyramid) {
   MapParams mp;
-  mp.size = 128;
+  mp.size = 256;
   mp.seed = 3;
   const NormalMap map = generateMap(MapKind::kBeckmann, mp);
   ndf::PyramidOptions pyr;
   pyr.splat.ndf_res = 16;
-  pyr.stride0 = 8;  // level 0: 16 x 16 centres, level 1: 8 x 8
+  pyr.stride0 = 8;  // level 0: 32 x 32 centres, level 1: 16 x 16
   pyr.sigma0 = 4;
   pyr.levels = 2;
   TensorPackOptions o = packOptions(4);
   o.block = 8;
   o.exact_level_bytes = uint64_t(1) << 30;
   TensorPackReport rep;
-  ASSERT_TRUE(packFromMap(map, o, tempPath("exact_cap.gbk"), &rep, pyr).ok());
+  const std::string packed = tempPath("exact_cap.gbk");
+  ASSERT_TRUE(packFromMap(map, o, packed, &rep, pyr).ok());
   ASSERT_EQ(rep.levels.size(), 2u);
   EXPECT_FALSE(rep.levels[0].exact);
   EXPECT_TRUE(rep.levels[1].exact);
-  EXPECT_LE(runtime::kCpMaxGroups, 1 << 16);
-  EXPECT_GE(uint64_t(runtime::kCpMaxGroups), kMaxExactCentres + kMaxExactCentres / 4);
+
+  const std::string plain_path = tempPath("exact_cap.pyramid.gbk");
+  {
+    format::Writer w;
+    ASSERT_EQ(w.open(plain_path, format::AssetKind::kNdfPyramid, 1), format::ContainerStatus::kOk);
+    ASSERT_TRUE(ndf::buildNdfPyramid(map, pyr, w, nullptr).ok());
+    ASSERT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    ASSERT_EQ(w.finish(), format::ContainerStatus::kOk);
+  }
+  runtime::TensorNdf t;
+  runtime::NdfPyramid plain;
+  ASSERT_EQ(t.open(packed.c_str()), runtime::RuntimeStatus::kOk);
+  ASSERT_EQ(plain.open(plain_path.c_str()), runtime::RuntimeStatus::kOk);
+  const double level1 = t.level(1)->sigma_texels;
+  t.answerFromSigma(level1);
+  plain.answerFromSigma(level1);
+  const int res = t.resolution();
+  std::vector<float> img_t(size_t(res) * res), img_p(size_t(res) * res);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> pos(0.0, 256.0), lsig(std::log(level1), std::log(400.0)), sp(-1.0, 1.0);
+  for (int q = 0; q < 12; ++q) {
+    const runtime::Footprint fp{pos(rng), pos(rng), std::exp(lsig(rng))};
+    ASSERT_EQ(t.image(fp, img_t.data(), img_t.size()), runtime::RuntimeStatus::kOk);
+    ASSERT_EQ(plain.image(fp, img_p.data(), img_p.size()), runtime::RuntimeStatus::kOk);
+    const float peak = *std::max_element(img_p.begin(), img_p.end());
+    for (size_t n = 0; n < img_t.size(); ++n) ASSERT_NEAR(img_t[n], img_p[n], 1e-5 * peak) << "sigma " << fp.sigma;
+    for (int k = 0; k < 8; ++k) {
+      const runtime::SPoint s{sp(rng), sp(rng)};
+      double a = -1.0, b = -1.0;
+      ASSERT_EQ(t.eval(fp, s, &a), runtime::RuntimeStatus::kOk);
+      ASSERT_EQ(plain.eval(fp, s, &b), runtime::RuntimeStatus::kOk);
+      ASSERT_NEAR(a, b, 1e-5 * peak);
+    }
+    double ma = 0.0, mb = 0.0;
+    ASSERT_EQ(t.mass(fp, &ma), runtime::RuntimeStatus::kOk);
+    ASSERT_EQ(plain.mass(fp, &mb), runtime::RuntimeStatus::kOk);
+    EXPECT_NEAR(ma, mb, 1e-5 * mb);
+    // The sampler's density over the bins sums to 1 (bin area (2 / R)^2).
+    double total = 0.0;
+    for (int j = 0; j < res; ++j) {
+      for (int i = 0; i < res; ++i) {
+        double p = 0.0;
+        const runtime::SPoint s{-1.0 + (i + 0.5) * 2.0 / res, 1.0 - (j + 0.5) * 2.0 / res};
+        ASSERT_EQ(t.pdf(fp, s, &p), runtime::RuntimeStatus::kOk);
+        total += p * (2.0 / res) * (2.0 / res);
+      }
+    }
+    EXPECT_NEAR(total, 1.0, 1e-5) << "sigma " << fp.sigma;
+  }
+  std::remove(packed.c_str());
+  std::remove(plain_path.c_str());
 }
 
 TEST(TensorPack, IndexBlankBlocksAndPrefixSumsAreConsistent) {

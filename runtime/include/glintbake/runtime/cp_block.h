@@ -27,7 +27,16 @@
 // [i, i + 1) x [j, j + 1). pdf is a density per unit bin area relative to the block's clamped
 // mass (it integrates to 1 over the block); the asset converts it to s-plane units.
 // Cost: init O(count * R); value O(groups * R); rangeSum O(groups * R); sample and pdf
-// O(ceil(log2 B) * groups * R). No allocation; CpMix lives on the stack (about 2 KiB).
+// O(ceil(log2 B) * groups * R). No allocation; CpMix lives on the stack (about 40 KiB).
+//
+// Exact blocks. A group whose A factor is the B x B identity (rank B) stores each of its blocks
+// exactly: value(k, i, j) = C(k, i) B(j, i) (tensorpack's exact levels, formats/SPEC.md 10.4). Its
+// terms do not take a group slot of the mix (a footprint may blend hundreds of them): value is
+// one product per term, a range sum O(width) per term, and sample / pdf treat the block as a
+// mixture of its components, the compressed part (clamped, sampled by the quadtree above) and
+// each exact term (non-negative, sampled by a quadtree over that block alone), chosen by mass:
+//   pdf(i, j) = (m_cp pdf_cp(i, j) + sum_t max(0, value_t(i, j))) / (m_cp + sum_t m_t).
+// sample() returns exactly that number for the bin it lands in.
 // Thread safety: views and mixes are immutable after init; all queries are const and reentrant.
 // Untrusted input: validateCpGroupView() checks a view's sizes; the data it points to must hold
 // finite values (the asset reader validates sections). Query arguments are range-checked: out-of-
@@ -59,6 +68,7 @@ struct CpGroupView {
   const float* c = nullptr;
   const float* a_prefix = nullptr;
   const float* b_prefix = nullptr;
+  bool identity_a = false;  // A is the B x B identity (rank == bins): the blocks are stored exactly
 };
 
 // kOk, or kInvalidArgument for null pointers or sizes out of range.
@@ -69,6 +79,9 @@ struct CpBlendTerm {
   const CpGroupView* group = nullptr;
   int32_t block = 0;
   float weight = 0.0f;
+  // Exact blocks only (identity_a): the block's sum over its bins when the caller has it
+  // precomputed (the asset's loader does), else negative and init() forms it (O(B)).
+  float mass = -1.0f;
 };
 
 // A sampled bin and point. pdf: see the header comment.
@@ -81,14 +94,14 @@ struct CpBlockSample {
 class CpMix {
  public:
   // Builds the blend of `count` terms (count in [0, kCpMaxBlend]). Terms with weight 0 are
-  // skipped, and so are terms of groups beyond the first kCpMaxGroups distinct ones (only assets
+  // skipped, and so are terms of compressed groups beyond the first kCpMaxGroups distinct ones (only assets
   // baked with spatial regions of fewer than 4 centres per side reach that); all groups must share B and hold valid
   // views (validateCpGroupView) and the block index must be in [0, K). Returns kInvalidArgument otherwise (the mix is
   // then empty: every query returns 0). Zero terms give an empty mix.
   RuntimeStatus init(const CpBlendTerm* terms, int32_t count);
 
   int32_t bins() const { return bins_; }
-  bool empty() const { return group_count_ == 0; }
+  bool empty() const { return group_count_ == 0 && exact_count_ == 0; }
 
   // Unclamped model value of bin (i, j) (may be negative for signed models).
   float rawValue(int32_t i, int32_t j) const;
@@ -116,13 +129,34 @@ class CpMix {
 
  private:
   // Clamped weights of the four children of [x0, x1) x [y0, y1) split at (xm, ym), in the order
-  // (left-top, right-top, left-bottom, right-bottom).
-  void childWeights(int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t ym, int32_t y1, float w[4]) const;
+  // (left-top, right-top, left-bottom, right-bottom), of one component: the compressed groups
+  // (component -1) or exact term `component`.
+  void childWeights(int32_t component, int32_t x0, int32_t xm, int32_t x1, int32_t y0, int32_t ym, int32_t y1,
+                    float w[4]) const;
+  // The compressed groups' unclamped range sum, and exact term t's.
+  float groupRangeSum(int32_t i0, int32_t i1, int32_t j0, int32_t j1) const;
+  float exactRangeSum(int32_t t, int32_t i0, int32_t i1, int32_t j0, int32_t j1) const;
+  float exactValue(int32_t t, int32_t i, int32_t j) const;
+  // Quadtree descent within one component, and the probability it gives bin (i, j).
+  bool descend(int32_t component, double u1, double u2, CpBlockSample* out) const;
+  double descentPdf(int32_t component, int32_t i, int32_t j) const;
+  // The clamped mass of a component (the compressed part -1, or an exact term), formed by init();
+  // the mixture density of bin (i, j).
+  double componentMass(int32_t component) const { return component < 0 ? group_mass_ : exact_m_[component]; }
+  double mixturePdf(int32_t i, int32_t j) const;
 
   int32_t bins_ = 0;
   int32_t group_count_ = 0;
-  const CpGroupView* groups_[kCpMaxGroups] = {};
-  float coef_[kCpMaxGroups][kCpMaxRank] = {};
+  int32_t exact_count_ = 0;
+  // Written by init() before any read (left uninitialised: a mix is built per query).
+  const CpGroupView* groups_[kCpMaxGroups];
+  float coef_[kCpMaxGroups][kCpMaxRank];
+  const CpGroupView* exact_[kCpMaxBlend];
+  const float* exact_c_[kCpMaxBlend];  // the term's C row
+  float exact_w_[kCpMaxBlend];
+  double exact_m_[kCpMaxBlend];  // weighted, clamped mass of each exact term
+  double group_mass_ = 0.0;      // clamped mass of the compressed groups (when exact terms are present)
+  double mix_mass_ = 0.0;        // group_mass_ + sum of exact_m_
 };
 
 }  // namespace glintbake::runtime

@@ -58,7 +58,7 @@ namespace glintbake::bake::tensor {
 
 constexpr double kDefaultBlankThreshold = 1e-5;
 
-constexpr uint64_t kMaxExactCentres = 64;
+constexpr uint64_t kMaxExactCentres = 256;
 
 struct TensorPackOptions {
   CpOptions cp;    // rank (default 16) is the rank, or the largest rank of error-target mode
@@ -70,11 +70,11 @@ struct TensorPackOptions {
   int threads = 0;             // TBB workers, 0 = all cores (the tool's -j)
   // Levels whose NDF images take at most this many bytes (float32, R^2 * 4 per centre) are stored
   // exactly instead of compressed: every kept block its own group of rank B with the identity as
-  // A (4 B^2 + 12 B values a block on load, about four times the images). The coarse levels are
+  // A (4 B^2 + 4 B values a block on load, about four times the images). The coarse levels are
   // small and CP keeps little of their glints at rank 16 (README, "Figures"). 0: none; needs
   // B <= 64.
-  // At most kMaxExactCentres centres per exact level, so that a footprint blending two exact
-  // levels mixes at most 80 groups per block (the runtime's CpMix keeps 128).
+  // At most kMaxExactCentres (16 x 16) centres per exact level: the runtime reads exact blocks
+  // directly (cp_block.h), and a footprint blends at most kMaxBlendCentres of them.
   uint64_t exact_level_bytes = 0;
   // ... and whose index is at least this: finer levels stay compressed (tensorpack sets 1: the
   // clustered lobes answer level 0's footprints from single flakes).
