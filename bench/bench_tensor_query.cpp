@@ -27,9 +27,10 @@ namespace fmt = glintbake::format;
 
 struct Assets {
   rt::NdfPyramid pyramid;
-  rt::TensorNdf tensor;     // plain (signed) CP: tensorpack --no-nonneg
-  rt::TensorNdf tensor_nn;  // non-negative CP, every level compressed (--exact-levels 0)
-  rt::TensorNdf tensor_ex;  // non-negative CP with the small levels exact (the tensorpack default)
+  rt::TensorNdf tensor;            // plain (signed) CP: tensorpack --no-nonneg
+  rt::TensorNdf tensor_nn;         // non-negative CP, every level compressed (--exact-levels 0)
+  rt::TensorNdf tensor_ex;         // non-negative CP with the 8 x 8 and 4 x 4 levels exact
+  rt::TensorNdf tensor_all_exact;  // every level exact, level 0 of 16 x 16 centres too
 };
 
 [[noreturn]] void fail(const char* what) {
@@ -78,8 +79,11 @@ const Assets& assets() {
     if (x->pyramid.open(path.c_str()) != rt::RuntimeStatus::kOk) fail("open the pyramid");
     pack(path, false, "bench_tensor_query_cp.gbk", &x->tensor);
     pack(path, true, "bench_tensor_query_nn.gbk", &x->tensor_nn);
-    // tensorpack's default budget (4 MiB): the 8 x 8 and 4 x 4 levels exact, level 0 compressed.
+    // A 4 MiB budget: the 8 x 8 and 4 x 4 levels exact, level 0 compressed; 16 MiB (tensorpack's
+    // default, without its rule that level 0 stays compressed): every level exact, so that wide
+    // footprints blend up to a few hundred exact blocks.
     pack(path, true, "bench_tensor_query_ex.gbk", &x->tensor_ex, uint64_t(4) << 20);
+    pack(path, true, "bench_tensor_query_allex.gbk", &x->tensor_all_exact, uint64_t(16) << 20);
     std::remove(path.c_str());
     return x;
   }();
@@ -120,11 +124,12 @@ const rt::NdfSource& source(int which) {
   if (which == 0) return a.tensor;
   if (which == 1) return a.tensor_nn;
   if (which == 3) return a.tensor_ex;
+  if (which == 4) return a.tensor_all_exact;
   return a.pyramid;
 }
 
 void label(benchmark::State& state) {
-  static const char* names[] = {"tensor-cp", "tensor-nonneg", "pyramid", "tensor-exact-levels"};
+  static const char* names[] = {"tensor-cp", "tensor-nonneg", "pyramid", "tensor-exact-levels", "tensor-all-exact"};
   state.SetLabel(names[state.range(0)]);
 }
 
@@ -140,7 +145,7 @@ void BM_Eval(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Eval)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_Eval)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4);
 
 void BM_Range(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -154,7 +159,7 @@ void BM_Range(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Range)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_Range)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4);
 
 void BM_Sample(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -168,7 +173,7 @@ void BM_Sample(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Sample)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_Sample)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4);
 
 void BM_Pdf(benchmark::State& state) {
   const rt::NdfSource& src = source(int(state.range(0)));
@@ -182,7 +187,7 @@ void BM_Pdf(benchmark::State& state) {
   }
   label(state);
 }
-BENCHMARK(BM_Pdf)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_Pdf)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4);
 
 }  // namespace
 

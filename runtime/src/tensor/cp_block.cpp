@@ -37,8 +37,8 @@ RuntimeStatus CpMix::init(const CpBlendTerm* terms, int32_t count) {
       exact_[t_exact] = term.group;
       exact_c_[t_exact] = term.group->c + static_cast<size_t>(term.block) * term.group->rank;
       exact_w_[t_exact] = term.weight;
-      const double m = term.mass >= 0.0f ? double(term.weight) * term.mass
-                                         : double(exactRangeSum(t_exact, 0, bins_, 0, bins_));
+      const double m =
+          term.mass >= 0.0f ? double(term.weight) * term.mass : double(exactRangeSum(t_exact, 0, bins_, 0, bins_));
       exact_m_[t_exact] = m > 0.0 ? m : 0.0;
       continue;
     }
@@ -78,7 +78,8 @@ float CpMix::exactRangeSum(int32_t t, int32_t i0, int32_t i1, int32_t j0, int32_
   const float* p1 = v.b_prefix + static_cast<size_t>(j1) * v.rank;
   const float* c = exact_c_[t];
   float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  laneAccumulate<float>(i1 - i0, [&](int32_t r) { return c[i0 + r] * (p1[i0 + r] - p0[i0 + r]); }, exact_w_[t], lanes);
+  laneAccumulate<float>(
+      i1 - i0, [&](int32_t r) { return c[i0 + r] * (p1[i0 + r] - p0[i0 + r]); }, exact_w_[t], lanes);
   return laneTotal(lanes);
 }
 

@@ -34,6 +34,15 @@ struct Span {
     f1 = float(x1 - k1);
     single = k0 == k1;
   }
+  // The integral of column r alone.
+  float column(const float* factor, const float* prefix, int32_t rank, int32_t r) const {
+    const float a0 = factor[size_t(k0) * size_t(rank) + size_t(r)];
+    if (single) return (f1 - f0) * a0;
+    const float a1 = factor[size_t(k1) * size_t(rank) + size_t(r)];
+    const float p0 = prefix[size_t(k0) * size_t(rank) + size_t(r)];
+    const float p1 = prefix[size_t(k1) * size_t(rank) + size_t(r)];
+    return ((p1 - p0) + f1 * a1) - f0 * a0;
+  }
   // The integrals of all `rank` columns, into out[0, rank).
   void extents(const float* factor, const float* prefix, int32_t rank, float* out) const {
     const float* a0 = factor + size_t(k0) * size_t(rank);
@@ -95,6 +104,19 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
     if (e.group == kTensorBlankGroup || b.weight[t] == 0.0) continue;
     const CpGroupView* v = &groups.data[e.group].view;
     const int32_t rank = v->rank;
+    if (v->identity_a) {
+      // An exact block: column r of A is the indicator of bin r, so only the columns the range
+      // covers contribute, each its partial width times its integral down the rows.
+      const float* crow = v->c + size_t(e.row) * size_t(rank);
+      float sum = 0.0f;
+      for (int32_t r = sx.k0; r <= sx.k1; ++r) {
+        const float wx = sx.single ? sx.f1 - sx.f0 : (r == sx.k0 ? 1.0f - sx.f0 : (r == sx.k1 ? sx.f1 : 1.0f));
+        if (!(wx > 0.0f)) continue;
+        sum += wx * crow[r] * sy.column(v->b, v->b_prefix, rank, r);
+      }
+      lanes[0] += float(b.weight[t]) * sum;
+      continue;
+    }
     if (v != current) {
       sx.extents(v->a, v->a_prefix, rank, ex);
       sy.extents(v->b, v->b_prefix, rank, ey);

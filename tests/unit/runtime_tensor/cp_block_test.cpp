@@ -164,8 +164,8 @@ std::unique_ptr<ExactBlock> makeExactBlock(uint64_t seed) {
   e->c.assign(kBins, 1.0f);
   e->a_prefix = bake::tensor::buildPrefixSums(e->a, kBins, kBins);
   e->b_prefix = bake::tensor::buildPrefixSums(e->b, kBins, kBins);
-  e->view = CpGroupView{kBins, kBins, 1, e->a.data(), e->b.data(), e->c.data(), e->a_prefix.data(), e->b_prefix.data(),
-                        true};
+  e->view =
+      CpGroupView{kBins, kBins, 1, e->a.data(), e->b.data(), e->c.data(), e->a_prefix.data(), e->b_prefix.data(), true};
   return e;
 }
 
@@ -191,13 +191,16 @@ TEST(CpBlock, ExactBlocksBeyondTheGroupSlotsAllCount) {
     }
   }
   EXPECT_NEAR(mix.blockMass(), direct_mass, 1e-5 * direct_mass);
-  EXPECT_NEAR(mix.rawRangeSum(3, 20, 5, 9), [&] {
-    double s = 0.0;
-    for (int j = 5; j < 9; ++j) {
-      for (int i = 3; i < 20; ++i) s += mix.rawValue(i, j);
-    }
-    return s;
-  }(), 1e-4 * direct_mass);
+  EXPECT_NEAR(
+      mix.rawRangeSum(3, 20, 5, 9),
+      [&] {
+        double s = 0.0;
+        for (int j = 5; j < 9; ++j) {
+          for (int i = 3; i < 20; ++i) s += mix.rawValue(i, j);
+        }
+        return s;
+      }(),
+      1e-4 * direct_mass);
   const double mass = mix.blockMass();
   double total = 0.0, worst = 0.0;
   std::vector<double> pdf(32 * 32);

@@ -188,8 +188,12 @@ double meanOfEval(const TensorNdf& t, const Footprint& fp, const SRect& r) {
   return integral / ((r.x1 - r.x0) * (r.y1 - r.y0));
 }
 
-TEST(TensorNdf, AverageEqualsMeanOfEval) {
-  const TensorNdf& t = assets().nonneg;
+// Compressed blocks (the non-negative asset) and exact blocks (the asset with exact levels, whose
+// range sums read only the columns a rectangle covers) alike.
+class TensorNdfAverage : public ::testing::TestWithParam<bool> {};
+
+TEST_P(TensorNdfAverage, EqualsMeanOfEval) {
+  const TensorNdf& t = GetParam() ? assets().exact : assets().nonneg;
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> pos(0.0, 64.0), sig(1.0, 40.0), c(-1.1, 1.1), w(0.001, 1.2);
   double worst = 0.0;
@@ -224,6 +228,11 @@ TEST(TensorNdf, AverageEqualsMeanOfEval) {
   EXPECT_EQ(t.average(footprint(1, 1, NAN), SRect{}, &v), RuntimeStatus::kInvalidArgument);
 }
 
+INSTANTIATE_TEST_SUITE_P(TensorNdf, TensorNdfAverage, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) {
+                           return i.param ? "ExactLevels" : "Compressed";
+                         });
+
 // pdf * mass against eval at the sampled points; returns the mean relative gap.
 double pdfEvalGap(const TensorNdf& t, const Footprint& fp, int n, uint64_t seed, double* worst) {
   std::mt19937_64 rng(seed);
@@ -244,19 +253,22 @@ double pdfEvalGap(const TensorNdf& t, const Footprint& fp, int n, uint64_t seed,
 }
 
 TEST(TensorNdf, PdfTimesMassEqualsEvalForNonNegativeAssets) {
-  const TensorNdf& t = assets().nonneg;
-  double worst_all = 0.0;
-  for (const Footprint& fp : {footprint(20, 30, 6), footprint(3, 60, 11), footprint(40, 40, 30)}) {
-    double m = 0.0;
-    ASSERT_EQ(t.mass(fp, &m), RuntimeStatus::kOk);
-    EXPECT_NEAR(m, 1.0, 2e-2);  // repeat map: every footprint's NDF is (nearly) normalised
-    double worst = 0.0;
-    const double mean = pdfEvalGap(t, fp, 4000, 3, &worst);
-    EXPECT_LT(mean, 1e-5);
-    EXPECT_LT(worst, 1e-4);
-    worst_all = std::max(worst_all, worst);
+  for (const TensorNdf* asset : {&assets().nonneg, &assets().exact}) {
+    const TensorNdf& t = *asset;
+    double worst_all = 0.0;
+    for (const Footprint& fp : {footprint(20, 30, 6), footprint(3, 60, 11), footprint(40, 40, 30)}) {
+      double m = 0.0;
+      ASSERT_EQ(t.mass(fp, &m), RuntimeStatus::kOk);
+      EXPECT_NEAR(m, 1.0, 2e-2);  // repeat map: every footprint's NDF is (nearly) normalised
+      double worst = 0.0;
+      const double mean = pdfEvalGap(t, fp, 4000, 3, &worst);
+      EXPECT_LT(mean, 1e-5);
+      EXPECT_LT(worst, 1e-4);
+      worst_all = std::max(worst_all, worst);
+    }
+    std::printf("[ figures  ] non-negative CP%s: worst |pdf*mass - eval| / eval = %.3g\n",
+                asset == &assets().exact ? " with exact levels" : "", worst_all);
   }
-  std::printf("[ figures  ] non-negative CP: worst |pdf*mass - eval| / eval = %.3g\n", worst_all);
 }
 
 TEST(TensorNdf, PlainCpGapsAreMeasured) {
