@@ -5,7 +5,9 @@
 #include <glintbake/bake/ndf/splat.h>
 #include <glintbake/bake/wang/wang.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 
@@ -66,6 +68,47 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
   if (format::ContainerStatus st = writer.finish(); st != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, path + ": " + writer.errorString(st));
   return readAndRemove(path, bytes);
+}
+
+format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, uint64_t grid_seed,
+                              double flakes_up_to, double pyramid_from, double max_sigma) {
+  format::WangRecord rec;
+  rec.colors = uint32_t(set.colors);
+  rec.tile_count = uint32_t(set.tile_count);
+  rec.tile_size = uint32_t(set.tile_size);
+  rec.margin = uint32_t(o.margin);
+  rec.seed = grid_seed;
+  rec.ndf_res = uint32_t(o.pyramid.splat.ndf_res);
+  rec.rate = uint32_t(o.pyramid.rate);
+  rec.sigma_r = o.pyramid.splat.sigma_r;
+  rec.flakes_up_to = flakes_up_to;
+  rec.pyramid_from = pyramid_from;
+  rec.max_sigma = max_sigma;
+  return rec;
+}
+
+BakeStatus writeWangSections(format::Writer& w, const WangTileSet& set, const format::WangRecord& rec,
+                             const std::vector<std::vector<uint8_t>>& tiles) {
+  if (const char* why = format::checkWangRecord(rec)) return makeError(ErrorCode::kBadArgument, why);
+  if (int(rec.tile_count) != set.tile_count || tiles.size() != size_t(set.tile_count))
+    return makeError(ErrorCode::kBadArgument, "the tile count of the record, the set and the assets differ");
+  std::vector<uint8_t> edges(format::wangEdgesBytes(rec));
+  for (uint32_t code = 0; code < rec.tile_count; ++code) std::memcpy(&edges[size_t(code) * 4], &code, 4);
+  for (int i = 0; i < set.tile_count; ++i)
+    std::copy_n(set.edges[size_t(i)].data(), 4, &edges[size_t(rec.tile_count) * 4 + size_t(i) * 4]);
+  std::vector<float> texels(format::wangTexelsBytes(rec) / sizeof(float));
+  for (size_t k = 0; k * 2 < texels.size(); ++k) {
+    texels[2 * k] = set.normals[3 * k];
+    texels[2 * k + 1] = set.normals[3 * k + 1];
+  }
+  format::ContainerStatus st = w.addSection(format::kSectionWangInfo, 0, &rec, sizeof rec);
+  if (st == format::ContainerStatus::kOk) st = w.addSection(format::kSectionWangEdges, 0, edges.data(), edges.size());
+  if (st == format::ContainerStatus::kOk)
+    st = w.addSection(format::kSectionWangTexels, 0, texels.data(), texels.size() * sizeof(float));
+  for (int i = 0; i < set.tile_count && st == format::ContainerStatus::kOk; ++i)
+    st = w.addSection(format::kSectionWangTileNdf, uint64_t(i), tiles[size_t(i)].data(), tiles[size_t(i)].size());
+  if (st != format::ContainerStatus::kOk) return makeError(ErrorCode::kIo, w.errorString(st));
+  return okStatus();
 }
 
 }  // namespace glintbake::bake::wang

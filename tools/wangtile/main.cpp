@@ -18,7 +18,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -212,32 +211,12 @@ int main(int argc, char** argv) {
     const double ndf_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ndf).count();
 
     // The container: record, edges, texels, then the tiles' assets in tile order.
-    format::WangRecord rec;
-    rec.colors = uint32_t(set.colors);
-    rec.tile_count = uint32_t(set.tile_count);
-    rec.tile_size = uint32_t(set.tile_size);
-    rec.margin = uint32_t(plan.margin);
-    rec.seed = o.grid_seed;
-    rec.ndf_res = uint32_t(res);
-    rec.rate = uint32_t(o.pyramid.options.rate);
-    rec.sigma_r = o.pyramid.options.splat.sigma_r;
-    rec.flakes_up_to = plan.flakes_up_to;
-    rec.pyramid_from = plan.pyramid_from;
-    rec.max_sigma = plan.max_sigma;
-    if (const char* why = format::checkWangRecord(rec)) throw Error(cli::kExitRuntime, o.input + ": " + why);
-    std::vector<uint8_t> edges(format::wangEdgesBytes(rec));
-    for (uint32_t code = 0; code < rec.tile_count; ++code) std::memcpy(&edges[size_t(code) * 4], &code, 4);
-    for (int i = 0; i < set.tile_count; ++i)
-      std::copy_n(set.edges[size_t(i)].data(), 4, &edges[size_t(rec.tile_count) * 4 + size_t(i) * 4]);
-    std::vector<float> texels(format::wangTexelsBytes(rec) / sizeof(float));
-    for (size_t k = 0; k * 2 < texels.size(); ++k) texels[2 * k] = set.normals[3 * k], texels[2 * k + 1] = set.normals[3 * k + 1];
-
+    const format::WangRecord rec =
+        wang::wangRecord(set, nopt, o.grid_seed, plan.flakes_up_to, plan.pyramid_from, plan.max_sigma);
     cli::ContainerOutput out(t, o.output, format::AssetKind::kWangTiles, o.tensor.zstd_level);
-    out.addSection(format::kSectionWangInfo, 0, &rec, sizeof rec);
-    out.addSection(format::kSectionWangEdges, 0, edges.data(), edges.size());
-    out.addSection(format::kSectionWangTexels, 0, texels.data(), texels.size() * sizeof(float));
-    for (int i = 0; i < set.tile_count; ++i)
-      out.addSection(format::kSectionWangTileNdf, uint64_t(i), tile_bytes[size_t(i)].data(), tile_bytes[size_t(i)].size());
+    if (bake::BakeStatus s = wang::writeWangSections(out.writer(), set, rec, tile_bytes); !s)
+      throw Error(cli::exitCodeOf(s.error()), o.output + ": " + s.error().message);
+    const uint64_t texel_bytes = format::wangTexelsBytes(rec);
 
     // The figures: seams, sizes, and what one baked map of a 16K x 16K surface would take at the
     // tiles' own bytes per texel of NDF (the extended squares overlap by the margins) plus its
@@ -298,7 +277,7 @@ int main(int argc, char** argv) {
     doc["relative_error"] = o.uncompressed ? Json(nullptr) : Json(relative_error);
     doc["max_tile_error"] = o.uncompressed ? Json(nullptr) : Json(totals.max_tile_error);
     doc["sizes"] = {{"file_bytes", out.bytesWritten()},
-                    {"texel_bytes", texels.size() * sizeof(float)},
+                    {"texel_bytes", texel_bytes},
                     {"tile_ndf_bytes", totals.ndf_bytes},
                     {"raw_ndf_bytes", totals.raw_bytes},
                     {"map_16k_estimate_bytes", map16k_bytes}};

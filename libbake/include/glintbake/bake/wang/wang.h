@@ -101,4 +101,13 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
                            const std::string& metadata_json, std::vector<uint8_t>* bytes, WangTileNdfReport* report,
                            const std::atomic<bool>* cancel = nullptr);
 
+// The wang-tiles record of a tile set (grid seed, NDF geometry and hand-over as given) and the
+// sections of a wang-tiles container: record, edges, texels, then the tiles' NDF assets (bytes of
+// bakeWangTileNdf, tile order) added to an open writer (the caller adds metadata and finishes).
+// kBadArgument when the record fails its check or the tile count differs, kIo on writer failure.
+format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& options, uint64_t grid_seed,
+                              double flakes_up_to, double pyramid_from, double max_sigma);
+BakeStatus writeWangSections(format::Writer& writer, const WangTileSet& set, const format::WangRecord& record,
+                             const std::vector<std::vector<uint8_t>>& tile_assets);
+
 }  // namespace glintbake::bake::wang
