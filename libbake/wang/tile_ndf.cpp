@@ -8,13 +8,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 namespace glintbake::bake::wang {
 namespace {
 
-// The tile seen from the extended square: position (x, y) of the square is (x - M, y - M) of the tile.
+// The tile seen from the extended square: position (x, y) of the square is (x - M, y - M) of the
+// tile. The square is clamped: beyond it the runtime's blend holds the edge centres, whose images
+// (a margin away from the tile) are next to nothing, instead of wrapping to the far side.
 class TileImageSource final : public ndf::FootprintImageSource {
  public:
   TileImageSource(const ndf::FlakeSet& flakes, const ndf::SplatParams& params, int margin)
@@ -27,6 +27,7 @@ class TileImageSource final : public ndf::FootprintImageSource {
     ndf::Splatter splatter(flakes_, params_);
     splatter.image(x - margin_, y - margin_, sigma, out);
   }
+  Wrap wrap() const override { return Wrap::kClamp; }
 
  private:
   const ndf::FlakeSet& flakes_;
@@ -35,11 +36,17 @@ class TileImageSource final : public ndf::FootprintImageSource {
 };
 
 BakeStatus readAndRemove(const std::string& path, std::vector<uint8_t>* bytes) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return makeError(ErrorCode::kIo, path + ": cannot read the tile's NDF asset back");
-  bytes->assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-  f.close();
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  bool ok = f != nullptr && std::fseek(f, 0, SEEK_END) == 0;
+  const long size = ok ? std::ftell(f) : -1;
+  ok = ok && size >= 0 && std::fseek(f, 0, SEEK_SET) == 0;
+  if (ok) {
+    bytes->resize(size_t(size));
+    ok = std::fread(bytes->data(), 1, bytes->size(), f) == bytes->size();
+  }
+  if (f) std::fclose(f);
   std::remove(path.c_str());
+  if (!ok) return makeError(ErrorCode::kIo, path + ": cannot read the tile's NDF asset back");
   return okStatus();
 }
 
