@@ -21,6 +21,11 @@ RuntimeStatus readExact(const format::Reader& reader, uint32_t type, void* out, 
   return fromFormatStatus(reader.readSectionInto(size_t(idx), out, size));
 }
 
+bool sectionHasSize(const format::Reader& reader, uint32_t type, size_t size) {
+  const int idx = reader.find(type, 0);
+  return idx >= 0 && reader.sections()[size_t(idx)].raw_size == size;
+}
+
 bool validFootprint(const Footprint& f) {
   return std::isfinite(f.x) && std::isfinite(f.y) && std::fabs(f.x) <= kMaxPosition &&
          std::fabs(f.y) <= kMaxPosition && std::isfinite(f.sigma) && f.sigma >= 0.0;
@@ -33,27 +38,6 @@ uint32_t tileOfCell(const format::WangRecord& rec, const uint32_t* code_to_tile,
 }
 
 }  // namespace
-
-WangGridTexels::WangGridTexels(const format::WangRecord& record, const float* tile_texels, int64_t i0, int64_t j0,
-                               int nx, int ny)
-    : record_(record), texels_(tile_texels), i0_(i0), j0_(j0), nx_(nx), ny_(ny) {
-  tiles_.resize(size_t(nx) * size_t(ny));
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      uint8_t e[4];
-      format::wangCellEdges(i0 + i, j0 + j, record.colors, record.seed, e);
-      tiles_[size_t(j) * nx + i] = format::wangTileCode(record.colors, e);  // a complete set: tile = code
-    }
-  }
-}
-
-void WangGridTexels::normal(int x, int y, float out[2]) const {
-  const int T = int(record_.tile_size);
-  const uint32_t t = tiles_[size_t(y / T) * size_t(nx_) + size_t(x / T)];
-  const float* n = texels_ + ((size_t(t) * T + size_t(y % T)) * T + size_t(x % T)) * 2;
-  out[0] = n[0];
-  out[1] = n[1];
-}
 
 struct WangNdf::Impl {
   format::WangRecord rec;
@@ -146,9 +130,14 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
   if (rec.magic == format::WangRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkWangRecord(rec)) return RuntimeStatus::kInvalidAsset;
   const size_t edge_bytes = format::wangEdgesBytes(rec);
+  const size_t texel_floats = format::wangTexelsBytes(rec) / sizeof(float);
+  // Sizes before allocations: an untrusted record must not make the loader allocate more than the
+  // file's sections hold (each within the reader's raw-size cap).
+  if (!sectionHasSize(reader, format::kSectionWangEdges, edge_bytes) ||
+      !sectionHasSize(reader, format::kSectionWangTexels, texel_floats * sizeof(float)))
+    return RuntimeStatus::kInvalidAsset;
   std::unique_ptr<uint8_t[]> edges(new (std::nothrow) uint8_t[edge_bytes]);
   impl->code_to_tile.reset(new (std::nothrow) uint32_t[rec.tile_count]);
-  const size_t texel_floats = format::wangTexelsBytes(rec) / sizeof(float);
   impl->texels.reset(new (std::nothrow) float[texel_floats]);
   impl->assets.reset(new (std::nothrow) std::unique_ptr<NdfSource>[rec.tile_count]);
   if (!edges || !impl->code_to_tile || !impl->texels || !impl->assets) return RuntimeStatus::kOutOfMemory;
@@ -316,6 +305,22 @@ RuntimeStatus WangNdf::image(const Footprint& f, float* out, size_t out_count) c
     for (size_t i = 0; i < n; ++i) out[i] += w * scratch[i];
   }
   return RuntimeStatus::kOk;
+}
+
+WangGridTexels::WangGridTexels(const WangNdf& asset, int64_t i0, int64_t j0, int nx, int ny)
+    : texels_(asset.tileTexels()), tile_size_(int(asset.record().tile_size)), nx_(nx), ny_(ny) {
+  tiles_.resize(size_t(nx) * size_t(ny));
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) tiles_[size_t(j) * size_t(nx) + size_t(i)] = asset.cellTile(i0 + i, j0 + j);
+  }
+}
+
+void WangGridTexels::normal(int x, int y, float out[2]) const {
+  const int T = tile_size_;
+  const uint32_t t = tiles_[size_t(y / T) * size_t(nx_) + size_t(x / T)];
+  const float* n = texels_ + ((size_t(t) * size_t(T) + size_t(y % T)) * size_t(T) + size_t(x % T)) * 2;
+  out[0] = n[0];
+  out[1] = n[1];
 }
 
 }  // namespace glintbake::runtime

@@ -37,26 +37,6 @@
 
 namespace glintbake::runtime {
 
-// The texels of a rectangle of cells of the implicit grid, [i0, i0 + nx) x [j0, j0 + ny), read
-// from the tiles' (n_x, n_y) (2 floats per texel, tile after tile, T x T each) as the grid lays
-// them: a TexelSource for evaluating a materialised region with the flake evaluator. Clamped at
-// the rectangle's edges. The tile texels must outlive the source.
-class WangGridTexels final : public TexelSource {
- public:
-  WangGridTexels(const format::WangRecord& record, const float* tile_texels, int64_t i0, int64_t j0, int nx, int ny);
-  int width() const override { return nx_ * int(record_.tile_size); }
-  int height() const override { return ny_ * int(record_.tile_size); }
-  bool repeats() const override { return false; }
-  void normal(int x, int y, float out[2]) const override;
-
- private:
-  format::WangRecord record_;
-  const float* texels_;
-  int64_t i0_, j0_;
-  int nx_, ny_;
-  std::vector<uint32_t> tiles_;  // tile of each cell of the rectangle, row-major
-};
-
 class WangNdf final : public NdfSource {
  public:
   WangNdf();
@@ -93,6 +73,23 @@ class WangNdf final : public NdfSource {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// The texels of a rectangle of cells of an asset's implicit grid, [i0, i0 + nx) x [j0, j0 + ny),
+// as the grid lays its tiles: a TexelSource for evaluating a materialised region with the flake
+// evaluator (FlakeNdf), clamped at the rectangle's edges. The asset must outlive the source.
+class WangGridTexels final : public TexelSource {
+ public:
+  WangGridTexels(const WangNdf& asset, int64_t i0, int64_t j0, int nx, int ny);
+  int width() const override { return nx_ * tile_size_; }
+  int height() const override { return ny_ * tile_size_; }
+  bool repeats() const override { return false; }
+  void normal(int x, int y, float out[2]) const override;
+
+ private:
+  const float* texels_;
+  int tile_size_, nx_, ny_;
+  std::vector<uint32_t> tiles_;  // tile of each cell of the rectangle, row-major
 };
 
 }  // namespace glintbake::runtime
