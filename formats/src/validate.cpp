@@ -3,6 +3,7 @@
 #include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/validate.h>
 
 #include "byte_source.h"
@@ -77,6 +78,45 @@ void checkFlakesPayload(size_t index, const SectionInfo& s, const std::vector<ui
     if (!std::isfinite(v)) {
       addError(messages, 4008, describe(index, s) + ": non-finite normals");
       return;
+    }
+  }
+}
+
+// The wang-tiles sections (SPEC.md 10.7): the record passes checkWangRecord; the edges section
+// passes checkWangEdges against the record and the texels section has the record's size and
+// finite values within [-1, 1] (both need the record, which writers put first). The embedded tile
+// assets are left to the runtime's loader (6004).
+void checkWangPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, WangRecord* record,
+                      bool* have_record, std::vector<ValidationMessage>* messages) {
+  if (s.type == kSectionWangInfo) {
+    if (raw.size() != sizeof(WangRecord)) {
+      addError(messages, 4009, describe(index, s) + ": not the size of the wang record");
+      return;
+    }
+    std::memcpy(record, raw.data(), sizeof(WangRecord));
+    if (const char* why = checkWangRecord(*record)) {
+      addError(messages, 4009, describe(index, s) + ": " + why);
+      return;
+    }
+    *have_record = true;
+    return;
+  }
+  if (!*have_record) return;
+  if (s.type == kSectionWangEdges) {
+    if (const char* why = checkWangEdges(*record, raw.data(), raw.size()))
+      addError(messages, 4009, describe(index, s) + ": " + why);
+  } else if (s.type == kSectionWangTexels) {
+    if (raw.size() != wangTexelsBytes(*record)) {
+      addError(messages, 4009, describe(index, s) + ": size does not match the wang record");
+      return;
+    }
+    for (size_t i = 0; i + 4 <= raw.size(); i += 4) {
+      float v;
+      std::memcpy(&v, raw.data() + i, 4);
+      if (!(std::fabs(v) <= 1.0f)) {
+        addError(messages, 4009, describe(index, s) + ": texel values not finite or outside [-1, 1]");
+        return;
+      }
     }
   }
 }
@@ -290,6 +330,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   std::vector<uint8_t> raw;
   std::string metadata_text;
   std::vector<bool> readable(sections.size(), false);
+  WangRecord wang_record;  // the wang-tiles record, once seen and valid (its sections check against it)
+  bool have_wang_record = false;
   for (size_t i = 0; i < sections.size(); ++i) {
     const SectionInfo& s = sections[i];
     if (!isRegisteredSectionType(s.type)) {
@@ -324,6 +366,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     }
     if (s.type == kSectionFlakes) {
       checkFlakesPayload(i, s, raw, &report.messages);
+    } else if (s.type >= kSectionWangInfo && s.type <= kSectionWangTileNdf) {
+      checkWangPayload(i, s, raw, &wang_record, &have_wang_record, &report.messages);
     } else if (s.type != kSectionMetadata) {
       checkImagePayload(i, s, raw, &report.messages);
     }

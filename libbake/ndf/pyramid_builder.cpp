@@ -498,7 +498,7 @@ BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOpti
   if (BakeStatus s = validatePyramidOptions(options); !s) return s;
   NormalMap geometry;  // the level records need the surface's size and wrap only
   source.mapSize(&geometry.width, &geometry.height);
-  geometry.wrap = Wrap::kRepeat;
+  geometry.wrap = source.wrap();
   PyramidReport local_report;
   PyramidReport& rep = report ? *report : local_report;
   rep = PyramidReport{};

@@ -167,3 +167,64 @@ inline std::vector<uint8_t> glitterIntegrals() {
 }
 
 }  // namespace glintbake::format::frozen
+
+namespace glintbake::format::frozen {
+
+// --- wang-tiles (SPEC 10.7): C = 2 (16 tiles) of 8 x 8 texels, margin 8, grid seed 3, R = 4; every
+// tile's NDF asset is the same embedded ndf-pyramid of one level (one centre, sigma 1, over the
+// 24 x 24 clamped extended square, a uniform image). ------------------------------------------------
+
+constexpr uint32_t kWangTile = 8, kWangMargin = 8, kWangRes = 4, kWangTiles = 16;
+
+inline std::vector<uint8_t> wangRecord() {
+  Bytes b(72);
+  b.u32(0, 0x474E5747).u32(4, 1).u32(8, 2).u32(12, kWangTiles).u32(16, kWangTile).u32(20, kWangMargin);
+  b.u32(24, 3).u32(28, 0);  // seed (u64)
+  b.u32(32, kWangRes).u32(36, 1);
+  b.f64(40, 0.005).f64(48, 0.5).f64(56, 1.0).f64(64, 1.5);
+  return b.bytes();
+}
+
+// Entry `code` names tile `code`; tile t's colours are the digits of t in base 2 (N E S W).
+inline std::vector<uint8_t> wangEdges() {
+  Bytes b(kWangTiles * 8);
+  for (uint32_t t = 0; t < kWangTiles; ++t) b.u32(4 * t, t);
+  std::vector<uint8_t> bytes = b.bytes();
+  for (uint32_t t = 0; t < kWangTiles; ++t) {
+    for (uint32_t e = 0; e < 4; ++e) bytes[4 * kWangTiles + 4 * t + e] = uint8_t((t >> (3 - e)) & 1u);
+  }
+  return bytes;
+}
+
+// (n_x, n_y) of texel (x, y) of tile t: small multiples of 1/64, exact in float32.
+inline float wangNormal(uint32_t t, uint32_t x, uint32_t y, uint32_t c) {
+  return c == 0 ? float(int((t + x) % 5) - 2) / 64.0f : float(int((t + 2 * y) % 3) - 1) / 64.0f;
+}
+
+inline std::vector<uint8_t> wangTexels() {
+  Bytes b(size_t(kWangTiles) * kWangTile * kWangTile * 8);
+  size_t at = 0;
+  for (uint32_t t = 0; t < kWangTiles; ++t)
+    for (uint32_t y = 0; y < kWangTile; ++y)
+      for (uint32_t x = 0; x < kWangTile; ++x)
+        for (uint32_t c = 0; c < 2; ++c, at += 4) b.f32(at, wangNormal(t, x, y, c));
+  return b.bytes();
+}
+
+// The embedded tile asset's level record (SPEC 10.1: 112 bytes) and its one image.
+inline std::vector<uint8_t> wangTileLevel() {
+  const uint32_t side = kWangTile + 2 * kWangMargin;
+  Bytes b(112);
+  b.u32(0, 0x4C444E47).u32(4, 1).u32(8, 0).u32(12, kWangRes);
+  b.u32(16, 1).u32(20, 1).u32(24, 1).u32(28, 1).u32(32, 1);
+  b.u32(36, 1).u32(40, side).u32(44, side).u32(48, 1).u32(52, 0);
+  b.f64(56, double(side)).f64(64, double(side)).f64(72, side / 2.0).f64(80, side / 2.0);
+  b.f64(88, 1.0).f64(96, 0.005).f64(104, 0.0);
+  return b.bytes();
+}
+
+inline std::vector<uint8_t> wangTileChunk() {
+  return imageSection(kWangRes, kWangRes, 1, 1, [](uint32_t, uint32_t, uint32_t, uint32_t) { return 0.25f; });
+}
+
+}  // namespace glintbake::format::frozen

@@ -7,6 +7,7 @@
 #include <glintbake/format/kinds/glitter.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
+#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/validate.h>
 
 #include "frozen_kinds.h"
@@ -154,6 +155,36 @@ TEST(FrozenKindsV1_0, Glitter) {
   std::vector<GlitterIntegral> entries(table.size() / sizeof(GlitterIntegral));
   std::memcpy(static_cast<void*>(entries.data()), table.data(), table.size());
   EXPECT_EQ(checkGlitterIntegrals(entries.data(), entries.size()), nullptr);
+}
+
+TEST(FrozenKindsV1_0, WangTiles) {
+  Reader reader;
+  openFrozen("v1_0_wang_tiles.gbk", AssetKind::kWangTiles, &reader);
+  ASSERT_EQ(reader.sections().size(), 4u + frozen::kWangTiles);
+  const std::vector<uint8_t> rec_bytes = section(reader, kSectionWangInfo, 0);
+  EXPECT_EQ(rec_bytes, frozen::wangRecord());
+  const WangRecord rec = as<WangRecord>(rec_bytes);
+  EXPECT_EQ(checkWangRecord(rec), nullptr);
+  EXPECT_EQ(rec.tile_count, 16u);
+  EXPECT_EQ(rec.seed, 3u);
+  const std::vector<uint8_t> edges = section(reader, kSectionWangEdges, 0);
+  EXPECT_EQ(edges, frozen::wangEdges());
+  EXPECT_EQ(checkWangEdges(rec, edges.data(), edges.size()), nullptr);
+  EXPECT_EQ(section(reader, kSectionWangTexels, 0), frozen::wangTexels());
+  for (uint32_t t = 0; t < frozen::kWangTiles; ++t) {
+    const std::vector<uint8_t> tile = section(reader, kSectionWangTileNdf, t);
+    Reader inner;
+    ASSERT_EQ(inner.openMemory(tile.data(), tile.size()), ContainerStatus::kOk);
+    EXPECT_EQ(inner.kind(), AssetKind::kNdfPyramid);
+    EXPECT_EQ(section(inner, kSectionNdfLevel, 0), frozen::wangTileLevel());
+    EXPECT_EQ(section(inner, kSectionNdfChunk, 0), frozen::wangTileChunk());
+  }
+  // The grid rule of SPEC 10.7, pinned: the hash and the colours of a few cells.
+  EXPECT_EQ(wangVertexHash(0, 0, 3), 0x06c45d188009454full);
+  EXPECT_EQ(wangVertexHash(-5, 7, 3), 0xb97d11c5a1cd53e4ull);
+  uint8_t e[4];
+  wangCellEdges(-5, 7, 2, 3, e);
+  EXPECT_EQ(wangTileCode(2, e), 10u);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf.h>
+#include <glintbake/runtime/wang_ndf.h>
 
 #include "frozen_kinds.h"
 
@@ -37,6 +38,28 @@ TEST(FrozenRuntimeV1_0, Glitter) {
   double mass = 0.0;
   ASSERT_EQ(glitter.mass(Footprint{5.0, 9.0, 2.0}, &mass), RuntimeStatus::kOk);
   EXPECT_NEAR(mass, 0.9799817112940431, 1e-12);
+}
+
+// The wang-tiles container: its grid (hash, tile choice) and its sums over the covered tiles.
+TEST(FrozenRuntimeV1_0, WangTiles) {
+  std::unique_ptr<NdfSource> src;
+  ASSERT_EQ(openNdfAsset(frozenPath("v1_0_wang_tiles.gbk").c_str(), &src), RuntimeStatus::kOk);
+  ASSERT_EQ(src->kind(), format::AssetKind::kWangTiles);
+  EXPECT_EQ(src->resolution(), 4);
+  const auto& wang = static_cast<const WangNdf&>(*src);
+  EXPECT_EQ(wang.cellTile(-5, 7), 10u);
+  EXPECT_EQ(wang.cellTile(1000000, -3), 2u);
+  // A footprint whose window meets 3 x 3 cells and one at a grid vertex meeting 2 x 2: each tile's
+  // uniform image (0.25) once per covered tile.
+  double v = 0.0;
+  ASSERT_EQ(src->eval({4.0, 4.0, 1.0}, {0.1, 0.1}, &v), RuntimeStatus::kOk);
+  EXPECT_EQ(v, 2.25);
+  ASSERT_EQ(src->eval({8.0, 16.0, 1.0}, {0.1, 0.1}, &v), RuntimeStatus::kOk);
+  EXPECT_EQ(v, 1.0);
+  // The flakes of small footprints.
+  double m = 0.0;
+  ASSERT_EQ(src->mass({4.0, 4.0, 0.3}, &m), RuntimeStatus::kOk);
+  EXPECT_NEAR(m, 0.98335298046632591, 1e-12);
 }
 
 TEST(FrozenRuntimeV1_0, NdfPyramid) {

@@ -4,6 +4,7 @@
 //   ./a.out v1_0        v1_0_minimal.gbk, v1_0_image.gbk
 //   ./a.out v1_0_kinds  one container per asset kind (frozen_kinds.h)
 //   ./a.out v1_0_glitter  the glitter container (frozen_kinds.h), added with the kind
+//   ./a.out v1_0_wang  the wang-tiles container (frozen_kinds.h), added with the kind
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
@@ -65,6 +66,29 @@ int writeGlitter() {
   return 0;
 }
 
+int writeWang() {
+  // The embedded tile asset, written first and read back as bytes.
+  if (!writeKind("v1_0_wang_tile.tmp", AssetKind::kNdfPyramid, "ndf-pyramid", "wangtile",
+                 {{kSectionNdfLevel, 0, frozen::wangTileLevel(), Codec::kRaw},
+                  {kSectionNdfChunk, 0, frozen::wangTileChunk(), Codec::kRaw}}))
+    return 1;
+  std::vector<uint8_t> tile;
+  if (std::FILE* f = std::fopen("v1_0_wang_tile.tmp", "rb")) {
+    int c;
+    while ((c = std::fgetc(f)) != EOF) tile.push_back(uint8_t(c));
+    std::fclose(f);
+  }
+  std::remove("v1_0_wang_tile.tmp");
+  if (tile.empty()) return 1;
+  std::vector<Section> sections = {{kSectionWangInfo, 0, frozen::wangRecord(), Codec::kRaw},
+                                   {kSectionWangEdges, 0, frozen::wangEdges(), Codec::kZstd},
+                                   {kSectionWangTexels, 0, frozen::wangTexels(), Codec::kZstd}};
+  for (uint32_t t = 0; t < frozen::kWangTiles; ++t) sections.push_back({kSectionWangTileNdf, t, tile, Codec::kRaw});
+  if (!writeKind("v1_0_wang_tiles.gbk", AssetKind::kWangTiles, "wang-tiles", "wangtile", sections)) return 1;
+  std::puts("wrote v1_0_wang_tiles.gbk");
+  return 0;
+}
+
 int writeV1_0() {
   {
     Writer writer;
@@ -96,6 +120,7 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0") == 0) return writeV1_0();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_kinds") == 0) return writeKinds();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_glitter") == 0) return writeGlitter();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_wang") == 0) return writeWang();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang\n", stderr);
   return 2;
 }

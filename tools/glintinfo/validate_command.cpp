@@ -23,7 +23,8 @@ void checkWithRuntime(const std::string& path, format::ValidationReport* report)
   reader.close();
   runtime::RuntimeStatus status = runtime::RuntimeStatus::kOk;
   int id = 0;
-  if (kind == format::AssetKind::kNdfPyramid || kind == format::AssetKind::kTensorNdf) {
+  if (kind == format::AssetKind::kNdfPyramid || kind == format::AssetKind::kTensorNdf ||
+      kind == format::AssetKind::kWangTiles) {
     std::unique_ptr<runtime::NdfSource> ndf;
     status = runtime::openNdfAsset(path.c_str(), &ndf);
     id = 6004;

@@ -9,6 +9,7 @@
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/tensor_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/json_depth.h>
@@ -169,55 +170,26 @@ Json rankHistogramJson(const tensor::TensorPackReport& r) {
 
 // Everything the command line sets; filled by CLI11 (addOptions) and checked by resolveOptions.
 struct Options {
-  std::string input, output, method_text = "compressed", precision_text = "float32";
+  std::string input, output;
   bake::IngestOptions ingest;
   cli::PyramidCliOptions pyramid;
   cli::GlitterCliOptions glitter;
-  tensor::TensorPackOptions pack;
-  double error_target = -1.0, max_error = -1.0;
-  double exact_mib = 16.0;
-  int zstd_level = 9;
+  cli::TensorCliOptions tensor;
+  tensor::TensorPackOptions& pack = tensor.pack;
+  double max_error = -1.0;
 };
 
 // Stage 1a: registers the options.
 void addOptions(CLI::App& app, Options& o) {
-  // Non-negative factors by default. Measured on 256^2 mapgen maps at the default pyramid (R = 128,
-  // B = 32): at equal rank their relative error is 1-4% higher than plain ALS (beckmann rank 16:
-  // 0.364 vs 0.356), but their files are about half as large (zstd packs the sparse HALS factors
-  // well), so at equal file size they are more accurate (beckmann: nonneg rank 32, 0.309 in 204 kB,
-  // vs plain rank 16, 0.356 in 247 kB; likewise on brushed, scratches and flakes); and they have no
-  // negative density, where plain factors put 1-5% of the absolute density below zero (queries
-  // clamp it, so pdf and value / mass disagree there).
-  o.pack.cp.nonneg = true;
-  tensor::TensorPackOptions& opt = o.pack;
   app.add_option("input", o.input,
                  "Normal map (or height field with --height), or an ndf-pyramid container (.gbk); none with "
                  "--procedural");
   cli::addGlitterOptions(app, o.glitter);
   app.add_option("-o,--output", o.output, "Output tensor-ndf container (default: the input's name with .gbk)");
-  app.add_option("--rank", opt.cp.rank, "CP rank per group (1..64); the largest rank with --error-target")
-      ->capture_default_str();
-  app.add_option("--block", opt.block, "Bins per angular block side B (divides --ndf-res)")->capture_default_str();
-  app.add_option("--method", o.method_text, "CP method: compressed, als or als-plain")->capture_default_str();
-  app.add_flag("--nonneg,!--no-nonneg", opt.cp.nonneg,
-               "Non-negative factors (HALS; default on): no negative density anywhere");
-  app.add_option("--tol", opt.cp.tol, "Stop when the fit changes by less than this (>= 0)")->capture_default_str();
-  app.add_option("--max-iters", opt.cp.max_iters, "Most ALS sweeps per group (>= 1)")->capture_default_str();
-  app.add_option("--error-target", o.error_target,
-                 "Per group, the smallest rank <= --rank whose relative error is <= this (0..1); a warning when "
-                 "the achieved error misses it");
+  cli::addTensorPackOptions(app, o.tensor);
   app.add_option("--max-error", o.max_error,
                  "Fail (exit 4, no output) when the relative error of the pyramid or of any group exceeds this "
                  "(>= 0; unset: no gate). Without --error-target, errors above 0.5 warn");
-  app.add_option("--blank-threshold", opt.blank_threshold, "Drop blocks whose mass is below this (0..1)")
-      ->capture_default_str();
-  app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
-  app.add_option("--exact-levels", o.exact_mib,
-                 "Store the levels above the finest whose NDF images take at most this many MiB (and 16 x 16 centres) "
-                 "(float32) exactly instead of compressed (0..1024; 0: compress every level)")
-      ->capture_default_str();
-  app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
-  app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
   cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
   cli::addIngestOptions(app, o.ingest);
@@ -225,48 +197,15 @@ void addOptions(CLI::App& app, Options& o) {
 
 // Stage 1b: checks the parsed options and derives the library's (exit 1 on anything out of range).
 void resolveOptions(const CLI::App& app, Options& o) {
-  const std::optional<tensor::CpMethod> method = tensor::parseCpMethod(o.method_text);
-  if (!method) throw Error(cli::kExitBadArguments, "--method must be compressed, als or als-plain");
-  o.pack.cp.method = *method;
-  if (o.precision_text != "float32" && o.precision_text != "float16") {
-    throw Error(cli::kExitBadArguments, "--precision must be float32 or float16");
-  }
-  o.pack.precision = o.precision_text == "float16" ? 1 : 0;
-  o.pack.error_target = o.error_target;
-  if (app.count("--error-target") && !(o.error_target >= 0.0 && o.error_target <= 1.0)) {
-    throw Error(cli::kExitBadArguments, "--error-target must be in [0, 1]");
-  }
+  cli::resolveTensorPackOptions(app, o.tensor);
   if (app.count("--max-error") && !(o.max_error >= 0.0 && std::isfinite(o.max_error))) {
     throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
   }
-  if (o.zstd_level < 1 || o.zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-  if (!(o.exact_mib >= 0.0 && o.exact_mib <= 1024.0))
-    throw Error(cli::kExitBadArguments, "--exact-levels must be in [0, 1024] MiB");
-  o.pack.exact_level_bytes = uint64_t(o.exact_mib * 1048576.0);
-  o.pack.exact_min_level = 1;  // level 0's footprints are the lobes' (from single flakes)
-  if (bake::BakeStatus s = tensor::validateTensorPackOptions(o.pack); !s)
-    throw Error(exitCodeOf(s.error()), s.error().message);
 }
 
 // Canonical parameters (container metadata and --json), in their recorded order; readInput adds
 // "pyramid" and "source".
-Json parametersJson(const Options& o) {
-  const tensor::TensorPackOptions& opt = o.pack;
-  Json params;
-  params["rank"] = opt.cp.rank;
-  params["block"] = opt.block;
-  params["method"] = tensor::cpMethodName(opt.cp.method);
-  params["nonneg"] = opt.cp.nonneg;
-  params["tol"] = opt.cp.tol;
-  params["max_iters"] = opt.cp.max_iters;
-  params["error_target"] = o.error_target < 0.0 ? Json(nullptr) : Json(o.error_target);
-  params["blank_threshold"] = opt.blank_threshold;
-  params["precision"] = o.precision_text;
-  params["exact_levels_mib"] = o.exact_mib;
-  params["seed"] = opt.cp.seed;
-  params["zstd_level"] = o.zstd_level;
-  return params;
-}
+Json parametersJson(const Options& o) { return cli::tensorPackOptionsJson(o.tensor); }
 
 // The input: an ndf-pyramid container (open reader) or a loaded normal map.
 struct Input {
@@ -437,7 +376,7 @@ void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& par
   asset["groups"] = report.groups;
   asset["max_rank"] = report.max_rank;
   asset["rank_histogram"] = rankHistogramJson(report);
-  asset["precision"] = o.precision_text;
+  asset["precision"] = o.tensor.precision_text;
   asset["nonneg"] = o.pack.cp.nonneg;
   asset["blank_threshold"] = o.pack.blank_threshold;
   if (!flakes.is_null()) asset["flakes"] = flakes;
@@ -513,14 +452,14 @@ int main(int argc, char** argv) {
     Json params = parametersJson(o);
     Input in;
     readInput(t, o, in, params);
-    cli::ContainerOutput out(t, o.output, format::AssetKind::kTensorNdf, o.zstd_level);
+    cli::ContainerOutput out(t, o.output, format::AssetKind::kTensorNdf, o.tensor.zstd_level);
     bake::ndf::FlakesHandover handover;
     uint64_t flake_bytes = 0;
     const tensor::TensorPackReport report = packAsset(t, o, in, out, handover, &flake_bytes);
     // The gate runs before anything is in place: a failure leaves no output.
     const GatedError gated = gatedError(report, handover);
     checkMaxError(report, gated, o.max_error, o.input);
-    const std::vector<std::string> warnings = qualityWarnings(report, gated, o.error_target, o.pack.cp.rank);
+    const std::vector<std::string> warnings = qualityWarnings(report, gated, o.tensor.error_target, o.pack.cp.rank);
     const Json flakes = flake_bytes > 0 ? cli::flakesJson(handover, flake_bytes) : Json(nullptr);
     writeAsset(t, o, in, params, report, flakes, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -48,6 +48,10 @@ static_assert(GB_KIND_TENSOR_NDF == int(glintbake::format::AssetKind::kTensorNdf
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kTensorNdf)->name) ==
                       "tensor-ndf",
               "GB_KIND_TENSOR_NDF is the registry's tensor-ndf");
+static_assert(GB_KIND_WANG_TILES == int(glintbake::format::AssetKind::kWangTiles) &&
+                  std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kWangTiles)->name) ==
+                      "wang-tiles",
+              "GB_KIND_WANG_TILES is the registry's wang-tiles");
 static_assert(GB_KIND_GLITTER == int(glintbake::format::AssetKind::kGlitter) &&
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kGlitter)->name) ==
                       "glitter",

@@ -87,6 +87,10 @@ enum SectionType : uint32_t {
   kSectionLtcTable = 48,           // ltc-table sections (48-63)
   kSectionRoughness = 64,          // roughness mips (64-79)
   kSectionFlakes = 80,             // NDF assets: the source normal map for exact small footprints (key = 0)
+  kSectionWangInfo = 96,           // wang-tiles: the tile-set record (key = 0)
+  kSectionWangEdges = 97,          // wang-tiles: edge colours of every tile and the edge-code-to-tile map (key = 0)
+  kSectionWangTexels = 98,         // wang-tiles: (n_x, n_y) of every texel of every tile (key = 0)
+  kSectionWangTileNdf = 99,        // wang-tiles: one tile's NDF asset, an embedded container (key = tile)
   kSectionGlitterInfo = 128,       // glitter: the surface record (key = 0)
   kSectionGlitterIntegrals = 129,  // glitter: the cached triangle integrals of the smooth NDF (key = 0)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
@@ -94,7 +98,8 @@ enum SectionType : uint32_t {
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
-// "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "glitter-info", "glitter-integrals",
+// "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "wang-info", "wang-edges", "wang-texels",
+// "wang-tile-ndf", "glitter-info", "glitter-integrals",
 // "image"); "private" for types >= kSectionFirstPrivate,
 // "unknown" otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);

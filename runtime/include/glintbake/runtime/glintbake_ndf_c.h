@@ -38,7 +38,7 @@ typedef struct gb_ndf_asset gb_ndf_asset;
 
 /* Container asset kinds of NDF assets (formats/SPEC.md section 4; the values of the kind registry,
  * glintbake/format/kinds.h). */
-enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2, GB_KIND_GLITTER = 7 };
+enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2, GB_KIND_WANG_TILES = 5, GB_KIND_GLITTER = 7 };
 
 /* GB_WRONG_KIND for containers of other asset kinds. */
 int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out);

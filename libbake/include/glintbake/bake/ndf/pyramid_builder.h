@@ -151,6 +151,9 @@ class FootprintImageSource {
   virtual ~FootprintImageSource() = default;
   virtual void mapSize(int* width, int* height) const = 0;
   virtual void image(double x, double y, double sigma, float* out) const = 0;
+  // How the level records say the surface continues beyond mapSize() (the runtime's blend wraps
+  // the centre grid of a repeating surface and clamps to the edge centres of a clamped one).
+  virtual Wrap wrap() const { return Wrap::kRepeat; }
 };
 
 // Builds the flakes of `map`, computes the pyramid and adds the level and chunk sections to an
@@ -167,8 +170,8 @@ BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, 
                            PyramidReport* report, const PyramidProgress& progress = {},
                            const std::atomic<bool>* cancel = nullptr);
 
-// The same pyramid with every image from `source` (a repeating surface of source.mapSize()
-// texels); options.rate and the splat's sigma_r are recorded in the level records only.
+// The same pyramid with every image from `source` (a surface of source.mapSize() texels that
+// continues as source.wrap() says); options.rate and the splat's sigma_r are recorded in the level records only.
 BakeStatus buildNdfPyramid(const FootprintImageSource& source, const PyramidOptions& options, PyramidSink& sink,
                            PyramidReport* report, const PyramidProgress& progress = {},
                            const std::atomic<bool>* cancel = nullptr);
