@@ -41,7 +41,13 @@ struct Options {
   bool plain_cut = false, uncompressed = false;
   bake::IngestOptions ingest;
   cli::PyramidCliOptions pyramid;
-  cli::TensorCliOptions tensor;
+  // Every tile carries its own pyramid, so the exact-level budget stays at 4 MiB a tile (tensorpack's
+  // 16 MiB would store 12 x 12-centre levels exactly for each of the C^4 tiles).
+  cli::TensorCliOptions tensor = [] {
+    cli::TensorCliOptions t;
+    t.exact_mib = 4.0;
+    return t;
+  }();
 };
 
 void addOptions(CLI::App& app, Options& o) {
