@@ -48,6 +48,10 @@ static_assert(GB_KIND_TENSOR_NDF == int(glintbake::format::AssetKind::kTensorNdf
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kTensorNdf)->name) ==
                       "tensor-ndf",
               "GB_KIND_TENSOR_NDF is the registry's tensor-ndf");
+static_assert(GB_KIND_TINY_EXAMPLE == int(glintbake::format::AssetKind::kTinyExample) &&
+                  std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kTinyExample)->name) ==
+                      "tiny-example",
+              "GB_KIND_TINY_EXAMPLE is the registry's tiny-example");
 static_assert(GB_KIND_GLITTER == int(glintbake::format::AssetKind::kGlitter) &&
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kGlitter)->name) ==
                       "glitter",

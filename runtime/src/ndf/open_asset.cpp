@@ -5,6 +5,7 @@
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/tensor_ndf.h>
+#include <glintbake/runtime/tiny_example_ndf.h>
 #include "../flakes/handover.h"
 #include "../format_status.h"
 
@@ -31,6 +32,8 @@ RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>*
       return loadAs<TensorNdf>(reader, out);
     case format::AssetKind::kGlitter:
       return loadAs<GlitterNdf>(reader, out);
+    case format::AssetKind::kTinyExample:
+      return loadAs<TinyExampleNdf>(reader, out);
     default:
       return RuntimeStatus::kWrongKind;
   }

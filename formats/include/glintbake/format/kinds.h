@@ -48,7 +48,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kLtcTable, "ltc-table", 48, 63, "ltcfit"},
     {AssetKind::kRoughness, "roughness", 64, 79, "ltcfit"},
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, ""},
-    {AssetKind::kTinyExample, "tiny-example", 112, 127, ""},
+    {AssetKind::kTinyExample, "tiny-example", 112, 127, "tinyexample"},
     {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
@@ -72,6 +72,9 @@ constexpr SectionTypeInfo kSectionTypeRegistry[] = {
     {kSectionLtcTable, "ltc-table"},
     {kSectionRoughness, "roughness"},
     {kSectionFlakes, "flakes"},
+    {kSectionTinyExampleInfo, "tiny-example-info"},
+    {kSectionTinyExampleTexels, "tiny-example-texels"},
+    {kSectionTinyExampleLevel, "tiny-example-level"},
     {kSectionGlitterInfo, "glitter-info"},
     {kSectionGlitterIntegrals, "glitter-integrals"},
     {kSectionImage, "image"},
