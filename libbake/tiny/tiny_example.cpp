@@ -112,7 +112,7 @@ std::vector<std::vector<float>> bakeTinyLevels(const std::vector<float>& texels,
   int levels = 0;
   while ((2 << levels) <= n) ++levels;
   const size_t image = size_t(res) * size_t(res);
-  std::vector<std::vector<float>> out(size_t(levels));
+  std::vector<std::vector<float>> out(static_cast<size_t>(levels));
   // Level 0 from the texels' lobes.
   const int m0 = n / 2;
   out[0].assign(size_t(m0) * m0 * image, 0.0f);

@@ -394,7 +394,7 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     if (level > 0) {
       const double dx = x0 + 0.5 * t - g.mx, dy = y0 + 0.5 * t - g.my;
       const double d = std::sqrt(dx * dx + dy * dy);
-      if (t * (d + t) > kTinyRefine * g.lambda_min) {
+      if (w * t * (d + t) > kTinyRefine * g.lambda_min) {
         for (int c = 0; c < 4; ++c) self(frame, g, ox, oy, self, level - 1, 2 * ix + (c & 1), 2 * iy + (c >> 1));
         return;
       }

@@ -181,16 +181,20 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
   ASSERT_TRUE(asset);
   ASSERT_TRUE(asset->hasFlakes());
   const reference::FlakeSet big = reference::buildFlakes(bake::tiny::materialiseTiled(map, 4), 1);
-  const double sigmas[] = {0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 16.0, 32.0, 64.0};
-  const double bounds[] = {1e-4, 1e-4, 1e-4, 1e-4, 0.10, 0.10, 0.08, 0.05, 0.03, 0.01};
+  // Below kTinyFlakesUpTo the flakes answer exactly; above, the tiles (README: the figures up to
+  // sigma 64, where the reference takes minutes).
+  const double sigmas[] = {0.5, 1.0, 2.0, 4.0, 5.5, 6.0, 8.0, 11.0};
+  const double bounds[] = {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 0.01, 5e-3, 5e-3};
   for (size_t k = 0; k < std::size(sigmas); ++k) {
     for (const double at : {21.3, 37.9}) {
+      if (sigmas[k] > 8.0 && at > 30.0) continue;  // the reference's cost grows with sigma^2
       const Footprint fp{at, 0.6 * at + 3.1, sigmas[k]};
       const std::vector<double> got = imageOf(*asset, fp);
       const std::vector<double> ref =
           reference::binAveragedImage(big, reference::Footprint{fp.x, fp.y, fp.sigma}, kSigmaR, res);
       const double l1 = relativeL1(got, ref);
-      std::printf("tiled identity: sigma %5.1f at (%.1f, %.1f): relative L1 %.4f\n", fp.sigma, fp.x, fp.y, l1);
+      std::printf("tiled identity: sigma %5.1f at (%.1f, %.1f): relative L1 %.2e\n", fp.sigma, fp.x, fp.y, l1);
+      std::fflush(stdout);
       EXPECT_LT(l1, bounds[k]) << "sigma " << fp.sigma;
     }
   }
@@ -214,7 +218,7 @@ TEST(TinyExample, TransformsActOnTheSlopes) {
   EXPECT_TRUE(rot->hasFlakes());
   EXPECT_TRUE(mir->hasFlakes());
   EXPECT_FALSE(big->hasFlakes());
-  for (const double sigma : {2.0, 6.0, 24.0}) {
+  for (const double sigma : {2.0, 8.0, 24.0}) {
     // The same example-frame footprint: u = M v for each transform (corner at the origin).
     const double vx = 5.3, vy = 9.7;
     double m0[2], c0[3], m1[2], c1[3];
@@ -233,7 +237,9 @@ TEST(TinyExample, TransformsActOnTheSlopes) {
     EXPECT_NEAR(m1[1], m0[1], 1e-4) << sigma;
     EXPECT_NEAR(c1[1], -c0[1], 1e-4) << sigma;
     EXPECT_NEAR(c1[0], c0[0], 1e-4) << sigma;
-    // Scale 2: the plane footprint 2 sigma sees the example footprint sigma; slopes / 2.
+    // Scale 2: the plane footprint 2 sigma sees the example footprint sigma; slopes / 2 (both
+    // through the tiles: the scaled example has no flakes).
+    if (sigma < runtime::kTinyFlakesUpTo) continue;
     moments(imageOf(*big, {2 * vx, 2 * vy, 2 * sigma}), res, m1, c1);
     EXPECT_NEAR(m1[0], 0.5 * m0[0], 2e-3) << sigma;
     EXPECT_NEAR(m1[1], 0.5 * m0[1], 2e-3) << sigma;
@@ -247,7 +253,7 @@ TEST(TinyExample, TransformsActOnTheSlopes) {
 // Stochastic layout: each point belongs to at most one example and the covered fraction matches
 // the density.
 TEST(TinyExample, StochasticCoverageIsAPartition) {
-  for (const double density : {0.2, 0.45}) {
+  for (const double density : {0.15, 0.3}) {
     TinyPlacementOptions p;
     p.type = format::TinyExampleType::kStochastic;
     p.rotate_range[0] = -30.0;
@@ -310,7 +316,7 @@ void checkSampling(const TinyExampleNdf& asset, const Footprint& fp) {
   std::vector<SPt> samples;
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (int k = 0; k < 40000; ++k) {
+  for (int k = 0; k < 8000; ++k) {
     runtime::NdfSample s;
     ASSERT_EQ(asset.sample(fp, u(rng), u(rng), &s), RuntimeStatus::kOk);
     if (s.pdf > 0.0) {
@@ -339,7 +345,7 @@ TEST(TinyExample, SamplingMatchesEval) {
   p.shear[0] = 0.2;
   const auto sheared = bakeAsset(map, 16, p, "chi_rot");
   ASSERT_TRUE(sheared);
-  checkSampling(*sheared, {10.0, 4.0, 6.0});
+  checkSampling(*sheared, {10.0, 4.0, 4.0});
   TinyPlacementOptions s;
   s.type = format::TinyExampleType::kStochastic;
   s.rotate_range[1] = 360.0;

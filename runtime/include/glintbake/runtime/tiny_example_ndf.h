@@ -12,8 +12,9 @@
 // Queries. A Gaussian footprint N((x, y), sigma^2) (texels of the plane) seen in an example's
 // frame is N(mu_e, Sigma_e), Sigma_e = sigma^2 M^-1 M^-T. Each example the footprint reaches (its
 // 6-sigma window) is entered at its top level (one tile, the whole example) and a tile is split
-// into its four children while it is large against the footprint there (side t, centre at
-// distance d from mu_e: t (d + t) > kTinyRefine lambda_min(Sigma_e)) and finer levels exist. A
+// into its four children while it is large against the footprint there, weighted by its share of
+// the footprint (side t, centre at distance d from mu_e, probability w: w t (d + t) > kTinyRefine
+// lambda_min(Sigma_e)) and finer levels exist. A
 // kept tile T adds w_T D_T(M' s) |det M|, w_T the footprint's probability over the tile (exact:
 // erf products, or the correlated-Gaussian rectangle integral for anisotropic frames), D_T the
 // stored bin-averaged image read as piecewise constant. Stochastic surfaces add the flat base
@@ -44,8 +45,8 @@
 
 namespace glintbake::runtime {
 
-constexpr double kTinyRefine = 0.25;     // split a tile while t (d + t) > kTinyRefine lambda_min
-constexpr double kTinyFlakesUpTo = 4.0;  // texels: smaller footprints use the flakes (when available)
+constexpr double kTinyRefine = 0.005;    // split a tile while w t (d + t) > kTinyRefine lambda_min
+constexpr double kTinyFlakesUpTo = 6.0;  // texels: smaller footprints use the flakes (when available)
 constexpr double kTinyWindowSigmas = 6.0;
 constexpr int64_t kTinyMaxCells = 1 << 18;  // stochastic: most layout cells one query visits
 
