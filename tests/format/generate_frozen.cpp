@@ -8,6 +8,8 @@
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
+#include <glintbake/format/kinds.h>
+
 #include <cstdio>
 #include <cstring>
 

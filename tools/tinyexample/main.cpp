@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
   std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G";
   double rotate = 0.0, density = 1.0, sigma_r = 0.005;
   bool rotate_given = false, mirror = false;
-  int ndf_res = 128, zstd_level = 9;
+  int ndf_res = 128, zstd_level = 3;
   uint64_t seed = 0;
   std::vector<int> crop_box;
   bake::IngestOptions ingest;

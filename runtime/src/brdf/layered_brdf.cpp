@@ -1,5 +1,5 @@
-// Two microfacet layers, f = f_base (1 - F_coat) + f_coat (see brdf.h, LayeredBrdf).
-#include <glintbake/runtime/brdf.h>
+// Two microfacet layers, f = f_base (1 - F_coat) + f_coat (see layered_brdf.h).
+#include <glintbake/runtime/layered_brdf.h>
 
 #include <algorithm>
 #include <cmath>

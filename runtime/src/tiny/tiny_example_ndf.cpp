@@ -529,14 +529,6 @@ RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* 
 
 namespace {
 
-// Tiles of one frame gathered so that the transformed rectangles are clipped once for all of them.
-constexpr int kBatch = 256;
-struct Batch {
-  TinyExampleNdf::Frame frame;
-  bool has_frame = false;
-  WeightedImage images[kBatch];
-  int count = 0;
-};
 
 Poly transformedRect(const double b[4], double x0, double x1, double y0, double y1) {
   Poly p;
@@ -555,6 +547,35 @@ bool sameFrame(const TinyExampleNdf::Frame& a, const TinyExampleNdf::Frame& b) {
 
 }  // namespace
 
+// Tiles of one frame gathered so that the transformed rectangles are clipped once for all of them.
+struct TinyExampleNdf::Batch {
+  static constexpr int kCapacity = 256;
+  Frame frame;
+  bool has_frame = false;
+  WeightedImage images[kCapacity];
+  int count = 0;
+};
+
+template <typename F>
+bool TinyExampleNdf::batched(const Footprint& fp, F&& flush) const {
+  Batch batch;
+  auto emit = [&]() {
+    if (batch.count > 0) flush(static_cast<const Batch&>(batch));
+    batch.count = 0;
+  };
+  if (!traverse(fp, [&](const Visit& v) {
+        if (!batch.has_frame || !sameFrame(batch.frame, *v.frame) || batch.count == Batch::kCapacity) {
+          emit();
+          batch.frame = *v.frame;
+          batch.has_frame = true;
+        }
+        batch.images[batch.count++] = {v.image, v.weight};
+      }))
+    return false;
+  emit();
+  return true;
+}
+
 RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
   if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
   if (useFlakes(fp)) {
@@ -568,23 +589,11 @@ RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, do
     return RuntimeStatus::kOk;
   }
   const int res = int(record_.ndf_res);
-  Batch batch;
   double integral = 0.0;
-  auto flush = [&]() {
-    if (batch.count == 0) return;
-    integral += polygonIntegral(transformedRect(batch.frame.b, x0, x1, y0, y1), batch.images, batch.count, res);
-    batch.count = 0;
-  };
-  if (!traverse(fp, [&](const Visit& v) {
-        if (!batch.has_frame || !sameFrame(batch.frame, *v.frame) || batch.count == kBatch) {
-          flush();
-          batch.frame = *v.frame;
-          batch.has_frame = true;
-        }
-        batch.images[batch.count++] = {v.image, v.weight};
+  if (!batched(fp, [&](const Batch& batch) {
+        integral += polygonIntegral(transformedRect(batch.frame.b, x0, x1, y0, y1), batch.images, batch.count, res);
       }))
     return RuntimeStatus::kInvalidArgument;
-  flush();
   *value = integral / out_area;
   return RuntimeStatus::kOk;
 }
@@ -598,9 +607,7 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
   }
   std::fill(out, out + count, 0.0f);
   const double bin = 2.0 / res;
-  Batch batch;
-  auto flush = [&]() {
-    if (batch.count == 0) return;
+  if (!batched(fp, [&](const Batch& batch) {
     const Frame& f = batch.frame;
     for (int j = 0; j < res; ++j) {
       for (int i = 0; i < res; ++i) {
@@ -620,18 +627,8 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
         out[size_t(j) * res + i] += float(v);
       }
     }
-    batch.count = 0;
-  };
-  if (!traverse(fp, [&](const Visit& v) {
-        if (!batch.has_frame || !sameFrame(batch.frame, *v.frame) || batch.count == kBatch) {
-          flush();
-          batch.frame = *v.frame;
-          batch.has_frame = true;
-        }
-        batch.images[batch.count++] = {v.image, v.weight};
-      }))
+  }))
     return RuntimeStatus::kInvalidArgument;
-  flush();
   return RuntimeStatus::kOk;
 }
 

@@ -7,12 +7,14 @@
 #include <glintbake/format/kinds/tiny_example.h>
 #include <glintbake/reference/flakes.h>
 #include <glintbake/reference/pndf.h>
+#include <glintbake/runtime/layered_brdf.h>
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/tiny_example_ndf.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -183,9 +185,14 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
   const reference::FlakeSet big = reference::buildFlakes(bake::tiny::materialiseTiled(map, 4), 1);
   // Below kTinyFlakesUpTo the flakes answer exactly; above, the tiles (README: the figures up to
   // sigma 64, where the reference takes minutes).
-  const double sigmas[] = {0.5, 1.0, 2.0, 4.0, 5.5, 6.0, 8.0, 11.0};
-  const double bounds[] = {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 0.01, 5e-3, 5e-3};
-  for (size_t k = 0; k < std::size(sigmas); ++k) {
+  // GLINTBAKE_TINY_WIDE=1 adds the footprints of many examples (minutes of reference time).
+  std::vector<double> sigmas = {0.5, 1.0, 2.0, 4.0, 5.5, 6.0, 8.0, 11.0};
+  std::vector<double> bounds = {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 0.01, 5e-3, 5e-3};
+  if (const char* wide = std::getenv("GLINTBAKE_TINY_WIDE"); wide && wide[0] == '1') {
+    sigmas.insert(sigmas.end(), {16.0, 32.0, 64.0});
+    bounds.insert(bounds.end(), {5e-3, 5e-3, 5e-3});
+  }
+  for (size_t k = 0; k < sigmas.size(); ++k) {
     for (const double at : {21.3, 37.9}) {
       if (sigmas[k] > 8.0 && at > 30.0) continue;  // the reference's cost grows with sigma^2
       const Footprint fp{at, 0.6 * at + 3.1, sigmas[k]};
@@ -389,6 +396,44 @@ TEST(TinyExample, ImageIsTheBinAverageAndArgumentsAreChecked) {
   EXPECT_EQ(other.open("/nonexistent/file.gbk"), RuntimeStatus::kIoError);
   const unsigned char junk[16] = {1, 2, 3};
   EXPECT_NE(other.openMemory(junk, sizeof junk), RuntimeStatus::kOk);
+}
+
+// The layered helper: f = f_base (1 - F_coat) + f_coat, each layer its own NDF, and its sampler's
+// pdf is pdf().
+TEST(TinyExample, LayeredBrdf) {
+  const auto asset = bakeAsset(example(8), 32, TinyPlacementOptions(), "layered");
+  ASSERT_TRUE(asset);
+  runtime::Fresnel none;
+  runtime::Fresnel coat_f;
+  coat_f.kind = runtime::FresnelKind::kSchlick;
+  coat_f.f0 = {0.04, 0.04, 0.04};
+  const auto base = runtime::MicrofacetBrdf::glinty(asset.get(), {3.0, 5.0, 8.0}, runtime::MicrofacetModel::kGgx, 0.3,
+                                                    none);
+  const auto coat = runtime::MicrofacetBrdf::smooth(runtime::MicrofacetModel::kGgx, 0.08, coat_f);
+  const runtime::LayeredBrdf layered(base, coat, coat_f);
+  const runtime::Vec3 wo = runtime::normalize({0.3, -0.2, 0.9});
+  const runtime::Vec3 wi = runtime::normalize({-0.25, 0.2, 0.95});
+  runtime::Rgb f, fb, fc;
+  ASSERT_EQ(layered.eval(wi, wo, &f), RuntimeStatus::kOk);
+  ASSERT_EQ(base.eval(wi, wo, &fb), RuntimeStatus::kOk);
+  ASSERT_EQ(coat.eval(wi, wo, &fc), RuntimeStatus::kOk);
+  const runtime::Vec3 h = runtime::normalize(wi + wo);
+  const double F = runtime::evalFresnel(coat_f, runtime::dot(wi, h)).r;
+  EXPECT_NEAR(f.r, fb.r * (1.0 - F) + fc.r, 1e-12 * (1.0 + f.r));
+  EXPECT_GT(fc.r, 0.0);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int used = 0;
+  for (int k = 0; k < 200; ++k) {
+    runtime::BrdfSample s;
+    ASSERT_EQ(layered.sample(wo, u(rng), u(rng), &s), RuntimeStatus::kOk);
+    if (!(s.pdf > 0.0) || !(s.wi.z > 0.0)) continue;
+    double p = 0.0;
+    ASSERT_EQ(layered.pdf(s.wi, wo, &p), RuntimeStatus::kOk);
+    EXPECT_NEAR(p, s.pdf, 1e-9 * p);
+    ++used;
+  }
+  EXPECT_GT(used, 100);
 }
 
 }  // namespace

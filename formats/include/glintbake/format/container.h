@@ -87,9 +87,6 @@ enum SectionType : uint32_t {
   kSectionLtcTable = 48,           // ltc-table sections (48-63)
   kSectionRoughness = 64,          // roughness mips (64-79)
   kSectionFlakes = 80,             // NDF assets: the source normal map for exact small footprints (key = 0)
-  kSectionTinyExampleInfo = 112,    // tiny-example: the asset record (key = 0)
-  kSectionTinyExampleTexels = 113,  // tiny-example: the example's (n_x, n_y) texels (key = 0)
-  kSectionTinyExampleLevel = 114,   // tiny-example: the tile NDF images of one level (key = level)
   kSectionGlitterInfo = 128,       // glitter: the surface record (key = 0)
   kSectionGlitterIntegrals = 129,  // glitter: the cached triangle integrals of the smooth NDF (key = 0)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
@@ -97,8 +94,7 @@ enum SectionType : uint32_t {
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
-// "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "tiny-example-info",
-// "tiny-example-texels", "tiny-example-level", "glitter-info", "glitter-integrals",
+// "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "glitter-info", "glitter-integrals",
 // "image"); "private" for types >= kSectionFirstPrivate,
 // "unknown" otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);

@@ -102,7 +102,7 @@ class AccumulatingNdfSource : public NdfSource {
   }
 };
 
-// Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf, glitter, tiny-example), chosen by the container's
+// Opens any NDF asset kind the runtime knows (ndf-pyramid, tensor-ndf, glitter), chosen by the container's
 // asset kind. kIoError, kInvalidAsset, kWrongKind (a container of another kind), kUnsupportedVersion,
 // kOutOfMemory. Safe on untrusted input. On failure *out is reset.
 RuntimeStatus openNdfAsset(const char* path, std::unique_ptr<NdfSource>* out);

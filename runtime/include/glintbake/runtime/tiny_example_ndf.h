@@ -120,6 +120,7 @@ class TinyExampleNdf final : public NdfSource {
 
   struct Frame;
   struct Visit;
+  struct Batch;
 
  private:
   bool validFootprint(const Footprint& f) const;
@@ -127,6 +128,9 @@ class TinyExampleNdf final : public NdfSource {
   Footprint flakeFootprint(const Footprint& f) const;
   template <typename F>
   bool traverse(const Footprint& f, F&& visit, int64_t* entered = nullptr) const;
+  // traverse(), handing the tiles over in batches of one frame.
+  template <typename F>
+  bool batched(const Footprint& f, F&& flush) const;
 
   bool open_ = false;
   format::TinyExampleRecord record_;

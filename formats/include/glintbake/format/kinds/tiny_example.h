@@ -5,6 +5,7 @@
 #pragma once
 
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds.h>
 
 #include <cstddef>
 #include <cstdint>
