@@ -4,6 +4,7 @@
 #include <glintbake/format/kinds.h>
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/format/kinds/wang.h>
+#include <glintbake/format/kinds/tiny_example.h>
 #include <glintbake/format/validate.h>
 
 #include "byte_source.h"
@@ -148,6 +149,86 @@ void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uin
   }
   if (non_finite != 0) {
     addError(messages, 4006, describe(index, s) + ": " + std::to_string(non_finite) + " non-finite values");
+  }
+}
+
+// What the payload pass saw of a tiny-example asset's own sections (SPEC.md 10.8).
+struct TinyExampleSeen {
+  int info = 0;  // info sections read
+  bool record_ok = false;
+  TinyExampleRecord record;
+  std::vector<std::pair<uint64_t, ImageSectionHeader>> levels;  // (key, image header) of readable levels
+};
+
+void noteTinyExamplePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, TinyExampleSeen* seen,
+                            std::vector<ValidationMessage>* messages) {
+  if (s.type == kSectionTinyExampleInfo) {
+    ++seen->info;
+    if (raw.size() != sizeof(TinyExampleRecord)) {
+      addError(messages, 6006, describe(index, s) + ": the tiny-example record is not 168 bytes");
+      return;
+    }
+    std::memcpy(&seen->record, raw.data(), sizeof(TinyExampleRecord));
+    if (const char* why = checkTinyExampleRecord(seen->record)) {
+      addError(messages, 6006, describe(index, s) + ": " + why);
+      return;
+    }
+    seen->record_ok = true;
+  } else if (s.type == kSectionTinyExampleTexels) {
+    for (size_t i = 0; i + 4 <= raw.size(); i += 4) {
+      float v;
+      std::memcpy(&v, raw.data() + i, 4);
+      if (!std::isfinite(v) || std::fabs(v) > 1.0f) {
+        addError(messages, 6006, describe(index, s) + ": example texels not finite or outside [-1, 1]");
+        return;
+      }
+    }
+  } else if (s.type == kSectionTinyExampleLevel) {
+    ImageSectionHeader header;
+    if (!parseImageSection(raw.data(), raw.size(), &header)) return;  // 4004/4005 already reported
+    for (size_t i = layout::kImageHeaderSize; i + 4 <= raw.size(); i += 4) {
+      float v;
+      std::memcpy(&v, raw.data() + i, 4);
+      if (v < 0.0f) {
+        addError(messages, 6006, describe(index, s) + ": negative NDF values");
+        return;
+      }
+    }
+    seen->levels.emplace_back(s.key, header);
+  }
+}
+
+// The layout of a tiny-example asset: one valid record, the example's texels, and every level's
+// tile images with the record's sizes.
+void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const TinyExampleSeen& seen,
+                            std::vector<ValidationMessage>* messages) {
+  if (seen.info != 1) {
+    addError(messages, 6006, "a tiny-example asset holds " + std::to_string(seen.info) + " info sections (type 112), not one");
+    return;
+  }
+  if (!seen.record_ok) return;
+  const TinyExampleRecord& r = seen.record;
+  const uint64_t n = r.example_size;
+  auto texels = std::find_if(sections.begin(), sections.end(),
+                             [](const SectionInfo& s) { return s.type == kSectionTinyExampleTexels && s.key == 0; });
+  if (texels == sections.end() || texels->raw_size != n * n * 8)
+    addError(messages, 6006, "the tiny-example texels (type 113) are missing or not example_size^2 (n_x, n_y) pairs");
+  for (uint32_t l = 0; l < r.levels; ++l) {
+    auto level = std::find_if(sections.begin(), sections.end(),
+                              [&](const SectionInfo& s) { return s.type == kSectionTinyExampleLevel && s.key == l; });
+    if (level == sections.end() || level->raw_size != tinyLevelSectionSize(r, l)) {
+      addError(messages, 6006, "tiny-example level " + std::to_string(l) + " (type 114) is missing or has the wrong size");
+      continue;
+    }
+    const uint64_t m = tinyTilesPerSide(r.example_size, l);
+    for (const auto& [key, h] : seen.levels) {
+      if (key == l && (h.width != r.ndf_res || h.height != r.ndf_res || h.channels != 1 || h.layers != m * m))
+        addError(messages, 6006, "tiny-example level " + std::to_string(l) + " images are not tiles^2 layers of R x R");
+    }
+  }
+  for (const SectionInfo& s : sections) {
+    if (s.type == kSectionTinyExampleLevel && s.key >= r.levels)
+      addError(messages, 6006, "tiny-example level " + std::to_string(s.key) + " beyond the record's levels");
   }
 }
 
@@ -332,6 +413,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   std::vector<bool> readable(sections.size(), false);
   WangRecord wang_record;  // the wang-tiles record, once seen and valid (its sections check against it)
   bool have_wang_record = false;
+  TinyExampleSeen tiny;
   for (size_t i = 0; i < sections.size(); ++i) {
     const SectionInfo& s = sections[i];
     if (!isRegisteredSectionType(s.type)) {
@@ -364,10 +446,13 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       if (metadata_text.empty()) metadata_text.assign(raw.begin(), raw.end());
       continue;
     }
+    if (kind == AssetKind::kTinyExample) noteTinyExamplePayload(i, s, raw, &tiny, &report.messages);
     if (s.type == kSectionFlakes) {
       checkFlakesPayload(i, s, raw, &report.messages);
     } else if (s.type >= kSectionWangInfo && s.type <= kSectionWangTileNdf) {
       checkWangPayload(i, s, raw, &wang_record, &have_wang_record, &report.messages);
+    } else if (s.type == kSectionTinyExampleInfo || s.type == kSectionTinyExampleTexels) {
+      // Records, not images.
     } else if (s.type != kSectionMetadata) {
       checkImagePayload(i, s, raw, &report.messages);
     }
@@ -401,6 +486,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     addWarning(&report.messages, 6001,
                "asset kind " + std::to_string(parsed.header.asset_kind) + " is not known to this version");
   }
+  if (kind == AssetKind::kTinyExample && index_sound && options.check_payloads)
+    checkTinyExampleLayout(sections, tiny, &report.messages);
   uint32_t first = 0, last = 0;
   if (kindTypeRange(kind, &first, &last) && std::none_of(sections.begin(), sections.end(), [&](const SectionInfo& s) {
         return s.type >= first && s.type <= last;

@@ -166,6 +166,40 @@ inline std::vector<uint8_t> glitterIntegrals() {
   return b.bytes();
 }
 
+// --- tiny-example (SPEC 10.8): a 4 x 4 example, R = 4, tiled with the identity, sigma_r 0.05;
+// levels of 2 x 2 tiles and one tile. -----------------------------------------------------------
+
+inline std::vector<uint8_t> tinyRecord() {
+  Bytes b(168);
+  b.u32(0, 0x594E5447).u32(4, 1).u32(8, 4).u32(12, 2).u32(16, 4).u32(20, 0).u32(24, 0).u32(28, 0);
+  b.f64(32, 0.05);
+  b.f64(40, 1.0).f64(48, 0.0).f64(56, 0.0).f64(64, 1.0);  // matrix
+  b.f64(136, 1.0).f64(144, 1.0);                          // scale_range
+  return b.bytes();
+}
+
+inline float tinyTexel(uint32_t x, uint32_t y, uint32_t c) { return 0.0625f * float(x) - 0.125f * float(y) + 0.25f * float(c); }
+
+inline std::vector<uint8_t> tinyTexels() {
+  Bytes b(4 * 4 * 8);
+  for (uint32_t y = 0; y < 4; ++y)
+    for (uint32_t x = 0; x < 4; ++x)
+      for (uint32_t c = 0; c < 2; ++c) b.f32(((y * 4 + x) * 2 + c) * 4, tinyTexel(x, y, c));
+  return b.bytes();
+}
+
+// Bin (x, y) of tile `tile` of `level`; the corner bins (centres outside the unit disk) hold 0.
+inline float tinyValue(uint32_t level, uint32_t tile, uint32_t x, uint32_t y) {
+  if ((x == 0 || x == 3) && (y == 0 || y == 3)) return 0.0f;
+  return 0.125f * float(1 + x + 4 * y) + 0.5f * float(level) + 0.0625f * float(tile);
+}
+
+inline std::vector<uint8_t> tinyLevel(uint32_t level) {
+  return imageSection(4, 4, 1, level == 0 ? 4 : 1, [level](uint32_t x, uint32_t y, uint32_t, uint32_t layer) {
+    return tinyValue(level, layer, x, y);
+  });
+}
+
 }  // namespace glintbake::format::frozen
 
 namespace glintbake::format::frozen {

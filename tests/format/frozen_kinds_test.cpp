@@ -8,6 +8,7 @@
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
 #include <glintbake/format/kinds/wang.h>
+#include <glintbake/format/kinds/tiny_example.h>
 #include <glintbake/format/validate.h>
 
 #include "frozen_kinds.h"
@@ -185,6 +186,23 @@ TEST(FrozenKindsV1_0, WangTiles) {
   uint8_t e[4];
   wangCellEdges(-5, 7, 2, 3, e);
   EXPECT_EQ(wangTileCode(2, e), 10u);
+}
+
+TEST(FrozenKindsV1_0, TinyExample) {
+  Reader reader;
+  openFrozen("v1_0_tiny_example.gbk", AssetKind::kTinyExample, &reader);
+  const std::vector<uint8_t> rec = section(reader, kSectionTinyExampleInfo, 0);
+  EXPECT_EQ(rec, frozen::tinyRecord());
+  const TinyExampleRecord r = as<TinyExampleRecord>(rec);
+  EXPECT_EQ(checkTinyExampleRecord(r), nullptr);
+  EXPECT_EQ(r.example_size, 4u);
+  EXPECT_EQ(r.levels, 2u);
+  EXPECT_EQ(r.ndf_res, 4u);
+  EXPECT_EQ(r.sigma_r, 0.05);
+  EXPECT_EQ(section(reader, kSectionTinyExampleTexels, 0), frozen::tinyTexels());
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 0), frozen::tinyLevel(0));
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1), frozen::tinyLevel(1));
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1).size(), tinyLevelSectionSize(r, 1));
 }
 
 }  // namespace

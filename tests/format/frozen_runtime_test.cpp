@@ -1,6 +1,7 @@
 // The runtime reads the frozen 1.0 container of every kind it knows and answers from the frozen
 // records exactly (frozen_kinds.h).
 #include <glintbake/runtime/glitter_ndf.h>
+#include <glintbake/runtime/tiny_example_ndf.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf.h>
@@ -102,6 +103,20 @@ TEST(FrozenRuntimeV1_0, LtcTable) {
   LtcTable table;
   ASSERT_EQ(table.open(frozenPath("v1_0_ltc_table.gbk").c_str()), RuntimeStatus::kOk);
   EXPECT_EQ(table.size(), 2);
+}
+
+// The frozen tiny example: a footprint much wider than the example answers from the top tile alone.
+TEST(FrozenRuntimeV1_0, TinyExample) {
+  TinyExampleNdf tiny;
+  ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example.gbk").c_str()), RuntimeStatus::kOk);
+  EXPECT_EQ(tiny.resolution(), 4);
+  EXPECT_EQ(tiny.mapSize().width, 4);
+  EXPECT_TRUE(tiny.hasFlakes());
+  double v = 0.0;
+  ASSERT_EQ(tiny.eval(Footprint{1.0, 2.0, 100.0}, SPoint{-0.25, 0.25}, &v), RuntimeStatus::kOk);
+  EXPECT_DOUBLE_EQ(v, 0.125 * 6 + 0.5);
+  ASSERT_EQ(tiny.eval(Footprint{1.0, 2.0, 100.0}, SPoint{0.75, -0.75}, &v), RuntimeStatus::kOk);
+  EXPECT_EQ(v, 0.0);
 }
 
 }  // namespace

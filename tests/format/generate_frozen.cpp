@@ -5,8 +5,11 @@
 //   ./a.out v1_0_kinds  one container per asset kind (frozen_kinds.h)
 //   ./a.out v1_0_glitter  the glitter container (frozen_kinds.h), added with the kind
 //   ./a.out v1_0_wang  the wang-tiles container (frozen_kinds.h), added with the kind
+//   ./a.out v1_0_tiny_example  the tiny-example container (frozen_kinds.h), added with the kind
 #include "frozen_content.h"
 #include "frozen_kinds.h"
+
+#include <glintbake/format/kinds.h>
 
 #include <cstdio>
 #include <cstring>
@@ -89,6 +92,17 @@ int writeWang() {
   return 0;
 }
 
+int writeTinyExample() {
+  if (!writeKind("v1_0_tiny_example.gbk", AssetKind::kTinyExample, "tiny-example", "tinyexample",
+                 {{kSectionTinyExampleInfo, 0, frozen::tinyRecord(), Codec::kRaw},
+                  {kSectionTinyExampleTexels, 0, frozen::tinyTexels(), Codec::kRaw},
+                  {kSectionTinyExampleLevel, 0, frozen::tinyLevel(0), Codec::kZstd},
+                  {kSectionTinyExampleLevel, 1, frozen::tinyLevel(1), Codec::kZstd}}))
+    return 1;
+  std::puts("wrote v1_0_tiny_example.gbk");
+  return 0;
+}
+
 int writeV1_0() {
   {
     Writer writer;
@@ -121,6 +135,7 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0_kinds") == 0) return writeKinds();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_glitter") == 0) return writeGlitter();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_wang") == 0) return writeWang();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_tiny_example") == 0) return writeTinyExample();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang | v1_0_tiny_example\n", stderr);
   return 2;
 }

@@ -52,6 +52,10 @@ static_assert(GB_KIND_WANG_TILES == int(glintbake::format::AssetKind::kWangTiles
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kWangTiles)->name) ==
                       "wang-tiles",
               "GB_KIND_WANG_TILES is the registry's wang-tiles");
+static_assert(GB_KIND_TINY_EXAMPLE == int(glintbake::format::AssetKind::kTinyExample) &&
+                  std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kTinyExample)->name) ==
+                      "tiny-example",
+              "GB_KIND_TINY_EXAMPLE is the registry's tiny-example");
 static_assert(GB_KIND_GLITTER == int(glintbake::format::AssetKind::kGlitter) &&
                   std::string_view(glintbake::format::findKind(glintbake::format::AssetKind::kGlitter)->name) ==
                       "glitter",

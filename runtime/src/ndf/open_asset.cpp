@@ -6,6 +6,7 @@
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/tensor_ndf.h>
 #include <glintbake/runtime/wang_ndf.h>
+#include <glintbake/runtime/tiny_example_ndf.h>
 #include "../flakes/handover.h"
 #include "../format_status.h"
 
@@ -34,6 +35,8 @@ RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>*
       return loadAs<GlitterNdf>(reader, out);
     case format::AssetKind::kWangTiles:
       return loadAs<WangNdf>(reader, out);
+    case format::AssetKind::kTinyExample:
+      return loadAs<TinyExampleNdf>(reader, out);
     default:
       return RuntimeStatus::kWrongKind;
   }

@@ -12,6 +12,11 @@
 
 namespace glintbake::format {
 
+// Section types of the tiny-example kind (SPEC.md 10.8), in its block 112-127.
+constexpr uint32_t kSectionTinyExampleInfo = 112;    // the asset record (key = 0)
+constexpr uint32_t kSectionTinyExampleTexels = 113;  // the example's (n_x, n_y) texels (key = 0)
+constexpr uint32_t kSectionTinyExampleLevel = 114;   // the tile NDF images of one level (key = level)
+
 // One asset kind: its header value, its stable name (metadata `asset_kind`, glintinfo), the range
 // of section types it owns (first..last inclusive; first = last = 0 when it owns none) and the
 // program that writes it (empty for kinds no tool writes yet).
@@ -48,7 +53,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kLtcTable, "ltc-table", 48, 63, "ltcfit"},
     {AssetKind::kRoughness, "roughness", 64, 79, "ltcfit"},
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, "wangtile"},
-    {AssetKind::kTinyExample, "tiny-example", 112, 127, ""},
+    {AssetKind::kTinyExample, "tiny-example", 112, 127, "tinyexample"},
     {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
@@ -76,6 +81,9 @@ constexpr SectionTypeInfo kSectionTypeRegistry[] = {
     {kSectionWangEdges, "wang-edges"},
     {kSectionWangTexels, "wang-texels"},
     {kSectionWangTileNdf, "wang-tile-ndf"},
+    {kSectionTinyExampleInfo, "tiny-example-info"},
+    {kSectionTinyExampleTexels, "tiny-example-texels"},
+    {kSectionTinyExampleLevel, "tiny-example-level"},
     {kSectionGlitterInfo, "glitter-info"},
     {kSectionGlitterIntegrals, "glitter-integrals"},
     {kSectionImage, "image"},

@@ -31,14 +31,14 @@ enum {
 /* Stable text of a status code; never NULL. */
 const char* gb_status_string(int32_t status);
 
-/* Any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf), behind one handle. The queries
+/* Any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf, glitter, tiny-example), behind one handle. The queries
  * follow ndf_source.h: blended P-NDF values >= 0, averages over s-rectangles, importance
  * samples whose pdf equals gb_ndf_asset_pdf at the sampled point bit for bit. */
 typedef struct gb_ndf_asset gb_ndf_asset;
 
 /* Container asset kinds of NDF assets (formats/SPEC.md section 4; the values of the kind registry,
  * glintbake/format/kinds.h). */
-enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2, GB_KIND_WANG_TILES = 5, GB_KIND_GLITTER = 7 };
+enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2, GB_KIND_WANG_TILES = 5, GB_KIND_TINY_EXAMPLE = 6, GB_KIND_GLITTER = 7 };
 
 /* GB_WRONG_KIND for containers of other asset kinds. */
 int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out);

@@ -1,0 +1,94 @@
+// The tiny-example asset kind (formats/SPEC.md 10.8): one small normal-map example with its
+// multi-scale tile NDFs, placed procedurally over the unbounded plane (Xing et al., "Tiny
+// example-based procedural microstructures"). The records, their checks and the placement rules
+// shared by the baker, the runtime, the validator and the tests.
+#pragma once
+
+#include <glintbake/format/container.h>
+#include <glintbake/format/kinds.h>
+
+#include <cstddef>
+#include <cstdint>
+
+namespace glintbake::format {
+
+enum class TinyExampleType : uint32_t {
+  kTiled = 0,       // copies of the example tile the plane, one transform for all
+  kStochastic = 1,  // at most one example per cell of a square grid, each with its own transform
+};
+const char* tinyExampleTypeString(TinyExampleType type);  // "tiled", "stochastic"; "unknown" otherwise
+
+// Section kSectionTinyExampleInfo (key 0, exactly one), 168 bytes little-endian.
+struct TinyExampleRecord {
+  uint32_t magic = 0x594E5447;  // "GTNY"
+  uint32_t version = 1;
+  uint32_t example_size = 0;  // n: texels per side of the example, a power of two in [4, 256]
+  uint32_t levels = 0;        // log2(n): level l holds (n / 2^(l+1))^2 tiles of 2^(l+1) texels per side
+  uint32_t ndf_res = 0;       // R: bins per side of every tile NDF image, 2..1024
+  uint32_t type = 0;          // TinyExampleType
+  uint32_t flags = 0;         // 0 (reserved)
+  uint32_t reserved = 0;
+  double sigma_r = 0.0;       // intrinsic roughness of the texels' lobes, (0, 1]
+  // The 2x2 part of the example transform, row-major {m00, m01, m10, m11}, acting on positions
+  // (texels, y down): tiled: the one transform; stochastic: the part every example shares (mirror),
+  // applied after its own rotation, scale and shear. |det| in [kMinTinyDet, kMaxTinyDet].
+  double matrix[4] = {1.0, 0.0, 0.0, 1.0};
+  double translate[2] = {0.0, 0.0};  // tiled: where the example's corner (0, 0) lands (texels)
+  // Stochastic layout (ignored by the tiled type, 0 there).
+  uint64_t seed = 0;
+  double density = 0.0;    // the covered fraction the layout was made for, (0, 1]
+  double cell_size = 0.0;  // L: side of the grid cells (texels), each holds at most one example
+  double occupancy = 0.0;  // probability that a cell holds an example, (0, 1]
+  double rotate_range[2] = {0.0, 0.0};  // degrees, min <= max, |.| <= 3600
+  double scale_range[2] = {1.0, 1.0};   // min <= max, both in [kMinTinyScale, kMaxTinyScale]
+  double shear[2] = {0.0, 0.0};         // (hx, hy), |.| <= kMaxTinyShear, hx hy != 1
+};
+static_assert(sizeof(TinyExampleRecord) == 168, "TinyExampleRecord is 168 bytes");
+
+constexpr uint32_t kMinTinyExampleSize = 4;
+constexpr uint32_t kMaxTinyExampleSize = 256;
+constexpr uint32_t kMaxTinyNdfRes = 1024;
+constexpr double kMinTinyScale = 0.125;
+constexpr double kMaxTinyScale = 8.0;
+constexpr double kMaxTinyShear = 2.0;
+constexpr double kMinTinyDet = 1.0 / 64.0;
+constexpr double kMaxTinyDet = 64.0;
+
+// Tiles per side of level l of an n x n example: n / 2^(l+1); 0 when l >= levels.
+uint32_t tinyTilesPerSide(uint32_t example_size, uint32_t level);
+// Bytes of the level section of level l: the 32-byte image header plus tiles^2 x R^2 float32.
+uint64_t tinyLevelSectionSize(const TinyExampleRecord& record, uint32_t level);
+
+// Checks every field of a record against SPEC.md 10.8 (null when valid, otherwise a short message
+// naming the first offending field). Safe on untrusted input.
+const char* checkTinyExampleRecord(const TinyExampleRecord& record);
+
+// The smallest cell side that holds every example of the ranges (rotation, scale, shear and the
+// shared matrix) whole: twice the largest half-extent of the transformed example square.
+double tinyMinCellSize(const TinyExampleRecord& record);
+// Expected covered fraction of a stochastic layout: occupancy x E|det M| x n^2 / L^2 (the scale
+// uniform on its range).
+double tinyCoveredFraction(const TinyExampleRecord& record);
+
+// One example of a layout: its 2x2 transform M (row-major, positions, y down) and its centre c;
+// the example covers {c + M (v - n/2) : v in [0, n)^2}, texel v of the example frame.
+struct TinyPlacement {
+  bool present = false;
+  int64_t cell_x = 0, cell_y = 0;
+  double matrix[4] = {1.0, 0.0, 0.0, 1.0};
+  double centre[2] = {0.0, 0.0};
+};
+
+// The example of stochastic cell (i, j) (present = false for an empty cell). Pure function of the
+// record and the cell: the same everywhere (runtime, baker, tests).
+TinyPlacement tinyCellPlacement(const TinyExampleRecord& record, int64_t i, int64_t j);
+
+// The example that covers the point (x, y) of the plane (texels), with the point in the example's
+// frame (texels, [0, n)^2) in *local; present = false when no example covers it. Tiled: the copy
+// holding the point. Each point belongs to at most one example (examples never overlap).
+TinyPlacement tinyOwner(const TinyExampleRecord& record, double x, double y, double local[2]);
+
+// Inverse of a 2x2 row-major matrix; false when it is singular.
+bool tinyInvert(const double m[4], double inv[4]);
+
+}  // namespace glintbake::format

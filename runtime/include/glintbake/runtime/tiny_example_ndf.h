@@ -1,0 +1,148 @@
+// Runtime-lite reader of tiny-example assets (formats/SPEC.md 10.8): one small example with its
+// multi-scale tile NDFs, placed over the unbounded plane, after Xing et al., "Tiny example-based
+// procedural microstructures".
+//
+// The surface. Example texel v (frame [0, n)^2, texels, y down) of the example at centre c with
+// transform M lands at u = c + M (v - n/2) (tiled: u = t + M (v + n k), k in Z^2). Its slopes
+// follow the inverse transpose: a point s_e of the example's s-plane becomes s = A s_e with
+// A = F M^-T F, F = diag(1, -1) (positions have y down, the s-plane y up), so densities transform
+// as D(s) = |det M| D_e(M' s) with M' = F M^T F = A^-1. A rotation rotates the NDF, a mirror
+// mirrors it, a scale by k divides the slopes by k.
+//
+// Queries. A Gaussian footprint N((x, y), sigma^2) (texels of the plane) seen in an example's
+// frame is N(mu_e, Sigma_e), Sigma_e = sigma^2 M^-1 M^-T. Each example the footprint reaches (its
+// 6-sigma window) is entered at its top level (one tile, the whole example) and a tile is split
+// into its four children while it is large against the footprint there, weighted by its share of
+// the footprint (side t, centre at distance d from mu_e, probability w: w t (d + t) > kTinyRefine
+// lambda_min(Sigma_e)) and finer levels exist. A
+// kept tile T adds w_T D_T(M' s) |det M|, w_T the footprint's probability over the tile (exact:
+// erf products, or the correlated-Gaussian rectangle integral for anisotropic frames), D_T the
+// stored bin-averaged image read as piecewise constant. Stochastic surfaces add the flat base
+// lobe N(0, sigma_r^2) with the probability no example holds. Tiled surfaces whose transform maps
+// the texel grid onto itself (rotations by multiples of 90 degrees and mirrors) answer footprints
+// with sigma below kTinyFlakesUpTo from the exact flakes of the transformed example
+// (TransformedExampleTexels through FlakeNdf); above n sigma the periodic sum is the top tile.
+//
+// Contract (NdfSource): eval() is the sum above inside [-1, 1]^2 and 0 outside; average() its
+// exact mean over a rectangle (the transformed rectangle clipped against the stored bins);
+// image() those bin averages with bins whose centre lies outside the unit disk set to 0; mass()
+// the integral over the plane, sum w_T m_T (m_T the tile image's integral); sample() picks a tile
+// in proportion to w_T m_T, a bin of it, a uniform point in the bin, maps it by A and returns
+// pdf() at that point (eval / mass, bit for bit); a point mapped outside [-1, 1]^2 comes back with
+// pdf 0 (a failed sample, as with the flakes). Queries are const, thread-safe, never allocate and
+// never throw. load() is safe on untrusted input.
+#pragma once
+
+#include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/texel_source.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace glintbake::runtime {
+
+constexpr double kTinyRefine = 0.005;    // split a tile while w t (d + t) > kTinyRefine lambda_min
+constexpr double kTinyFlakesUpTo = 6.0;  // texels: smaller footprints use the flakes (when available)
+constexpr double kTinyWindowSigmas = 6.0;
+constexpr int64_t kTinyMaxCells = 1 << 18;  // stochastic: most layout cells one query visits
+
+// The bin-averaged NDF image (R x R, row 0 at s_y = +1, bins outside the unit disk 0) of the texels
+// [x0, x0 + side) x [y0, y0 + side) of an n x n example: the mean over those texels of their lobes
+// N(s; n_k, sigma_r^2 I + sigma_h^2 J_k J_k^T) (the flake model of formats/SPEC.md 10.5 at rate 1,
+// integrated over position; J_k from the example with its wrap). texels: n * n (n_x, n_y) pairs.
+// out: R * R floats. kInvalidArgument for sizes out of range. Thread-safe, no allocation.
+RuntimeStatus tinyTileImage(const float* texels, int n, bool repeats, double sigma_r, int resolution, int x0, int y0,
+                            int side, float* out);
+
+// The example under one of the eight transforms that map the texel grid onto itself (matrix with
+// entries in {-1, 0, 1}, one non-zero per row and column): an n x n grid whose texel g is example
+// texel M^-1 (g + 1/2 + o) - 1/2 (o the corner of M [0, n]^2), with its normal mapped by A.
+class TransformedExampleTexels final : public TexelSource {
+ public:
+  // False (and an identity source) when matrix is not such a transform.
+  static bool isGridTransform(const double matrix[4]);
+  TransformedExampleTexels(const float* texels, int n, bool repeats, const double matrix[4]);
+  int width() const override { return n_; }
+  int height() const override { return n_; }
+  bool repeats() const override { return repeats_; }
+  void normal(int x, int y, float out[2]) const override;
+  // Where grid texel (0, 0)'s corner lies relative to M's image of the example corner: o.
+  double offsetX() const { return off_[0]; }
+  double offsetY() const { return off_[1]; }
+
+ private:
+  const float* texels_;
+  int n_;
+  bool repeats_;
+  int m_[4];
+  double off_[2];
+};
+
+class TinyExampleNdf final : public NdfSource {
+ public:
+  TinyExampleNdf();
+  ~TinyExampleNdf() override;
+  TinyExampleNdf(const TinyExampleNdf&) = delete;
+  TinyExampleNdf& operator=(const TinyExampleNdf&) = delete;
+
+  // kIoError, kInvalidAsset, kWrongKind, kUnsupportedVersion, kOutOfMemory.
+  RuntimeStatus open(const char* path);
+  RuntimeStatus openMemory(const void* data, size_t size);
+  RuntimeStatus load(const format::Reader& reader);
+  bool isOpen() const { return open_; }
+
+  const format::TinyExampleRecord& record() const { return record_; }
+  // The stored tile image of (level, tile index row-major) (R * R floats), or null.
+  const float* tileImage(int level, int tile) const;
+  bool hasFlakes() const { return flakes_ && flakes_->isBuilt(); }
+
+  format::AssetKind kind() const override { return format::AssetKind::kTinyExample; }
+  int resolution() const override { return open_ ? int(record_.ndf_res) : 0; }
+  FootprintRange footprintRange() const override;
+  // The example's size (the plane is unbounded).
+  MapSize mapSize() const override;
+  MapWrap wrap() const override { return MapWrap::kRepeat; }
+
+  RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
+  RuntimeStatus sample(const Footprint& footprint, double u1, double u2, NdfSample* sample) const override;
+  RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
+  RuntimeStatus mass(const Footprint& footprint, double* value) const override;
+  RuntimeStatus image(const Footprint& footprint, float* out, size_t out_count) const override;
+
+  // Tiles (and the base) a footprint combines, for tests and benchmarks: examples entered and tiles
+  // kept. kInvalidArgument as the queries.
+  RuntimeStatus traversalCount(const Footprint& footprint, int64_t* examples, int64_t* tiles) const;
+
+  struct Frame;
+  struct Visit;
+  struct Batch;
+
+ private:
+  bool validFootprint(const Footprint& f) const;
+  bool useFlakes(const Footprint& f) const;
+  Footprint flakeFootprint(const Footprint& f) const;
+  template <typename F>
+  bool traverse(const Footprint& f, F&& visit, int64_t* entered = nullptr) const;
+  // traverse(), handing the tiles over in batches of one frame.
+  template <typename F>
+  bool batched(const Footprint& f, F&& flush) const;
+
+  bool open_ = false;
+  format::TinyExampleRecord record_;
+  std::vector<float> texels_;
+  std::vector<std::vector<float>> levels_;  // per level: tiles^2 images of R^2
+  std::vector<std::vector<double>> tile_mass_;
+  std::vector<std::vector<double>> row_mass_;  // per level: tiles^2 x R row integrals
+  std::vector<float> base_;                    // the flat lobe (stochastic surfaces)
+  std::vector<double> base_rows_;
+  double base_mass_ = 0.0;
+  std::unique_ptr<FlakeNdf> flakes_;
+  std::unique_ptr<TransformedExampleTexels> flake_texels_;
+};
+
+}  // namespace glintbake::runtime

@@ -1,0 +1,697 @@
+// Tiny-example assets (formats/SPEC.md 10.8): loading, the tile images, the traversal of the
+// examples a footprint reaches and the NdfSource queries over the tiles it keeps.
+#include <glintbake/runtime/tiny_example_ndf.h>
+
+#include <glintbake/format/validate.h>
+
+#include "../flakes/flake_model.h"
+#include "../flakes/gaussian_rect.h"
+#include "../format_status.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <new>
+
+namespace glintbake::runtime {
+
+using format::TinyExampleRecord;
+using format::TinyExampleType;
+
+namespace {
+
+constexpr double kSigmaH = 1.5 / 3.4641016151377544;  // flake spatial std at rate 1 (SPEC.md 10.5)
+constexpr double kMinSigma = 1e-3;                    // tile path: smaller footprints are points
+constexpr double kNegligible = 1e-15;                 // tiles with less probability are skipped
+
+bool finitePoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
+
+// Bin (column, row) of an s-plane point of [-1, 1]^2 in an R x R image.
+inline int binColumn(double sx, int res) { return std::clamp(int(std::floor((sx + 1.0) * 0.5 * res)), 0, res - 1); }
+inline int binRow(double sy, int res) { return std::clamp(int(std::floor((1.0 - sy) * 0.5 * res)), 0, res - 1); }
+
+// Area of a convex polygon (counter-clockwise or clockwise) clipped to [x0, x1] x [y0, y1].
+struct Poly {
+  double x[12], y[12];
+  int n = 0;
+};
+
+void clipAxis(const Poly& in, int axis, double bound, bool keep_below, Poly* out) {
+  out->n = 0;
+  for (int i = 0; i < in.n; ++i) {
+    const int j = (i + 1) % in.n;
+    const double a = axis == 0 ? in.x[i] : in.y[i], b = axis == 0 ? in.x[j] : in.y[j];
+    const bool ia = keep_below ? a <= bound : a >= bound, ib = keep_below ? b <= bound : b >= bound;
+    if (ia) {
+      out->x[out->n] = in.x[i];
+      out->y[out->n] = in.y[i];
+      ++out->n;
+    }
+    if (ia != ib) {
+      const double t = (bound - a) / (b - a);
+      out->x[out->n] = in.x[i] + t * (in.x[j] - in.x[i]);
+      out->y[out->n] = in.y[i] + t * (in.y[j] - in.y[i]);
+      ++out->n;
+    }
+  }
+}
+
+double area(const Poly& p) {
+  double a = 0.0;
+  for (int i = 0; i < p.n; ++i) {
+    const int j = (i + 1) % p.n;
+    a += p.x[i] * p.y[j] - p.x[j] * p.y[i];
+  }
+  return 0.5 * std::fabs(a);
+}
+
+// Integral of the piecewise-constant images (weighted sum over `count` of them) over a convex
+// polygon of the s-plane.
+struct WeightedImage {
+  const float* image;
+  double weight;
+};
+
+double polygonIntegral(const Poly& p, const WeightedImage* images, int count, int res) {
+  double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
+  for (int i = 0; i < p.n; ++i) {
+    lo_x = std::min(lo_x, p.x[i]);
+    hi_x = std::max(hi_x, p.x[i]);
+    lo_y = std::min(lo_y, p.y[i]);
+    hi_y = std::max(hi_y, p.y[i]);
+  }
+  if (hi_x <= -1.0 || lo_x >= 1.0 || hi_y <= -1.0 || lo_y >= 1.0) return 0.0;
+  const double bin = 2.0 / res;
+  const int i0 = binColumn(std::max(lo_x, -1.0), res), i1 = binColumn(std::min(hi_x, 1.0), res);
+  const int j0 = binRow(std::min(hi_y, 1.0), res), j1 = binRow(std::max(lo_y, -1.0), res);
+  double total = 0.0;
+  Poly band, tmp, cell;
+  for (int j = j0; j <= j1; ++j) {
+    const double top = 1.0 - j * bin, bottom = 1.0 - (j + 1) * bin;
+    clipAxis(p, 1, top, true, &tmp);
+    clipAxis(tmp, 1, bottom, false, &band);
+    if (band.n < 3) continue;
+    for (int i = i0; i <= i1; ++i) {
+      const double left = -1.0 + i * bin, right = -1.0 + (i + 1) * bin;
+      clipAxis(band, 0, left, false, &tmp);
+      clipAxis(tmp, 0, right, true, &cell);
+      if (cell.n < 3) continue;
+      const double a = area(cell);
+      if (!(a > 0.0)) continue;
+      double v = 0.0;
+      for (int k = 0; k < count; ++k) v += images[k].weight * double(images[k].image[size_t(j) * res + i]);
+      total += v * a;
+    }
+  }
+  return total;
+}
+
+// Probability of a Gaussian N(mu, Sigma) over the box [x0, x1] x [y0, y1].
+struct Gauss {
+  double mx, my, cxx, cxy, cyy;
+  double sx, sy;
+  bool separable;
+  double lambda_min;
+};
+
+Gauss makeGauss(double mx, double my, double cxx, double cxy, double cyy) {
+  Gauss g{mx, my, cxx, cxy, cyy, std::sqrt(cxx), std::sqrt(cyy), false, 0.0};
+  g.separable = std::fabs(cxy) <= 1e-12 * std::max(cxx, cyy);
+  const double tr = 0.5 * (cxx + cyy), dd = std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
+  g.lambda_min = std::max(tr - dd, 1e-300);
+  return g;
+}
+
+double boxProbability(const Gauss& g, double x0, double x1, double y0, double y1) {
+  if (g.separable) {
+    const double px = flakes::normalCdf((x1 - g.mx) / g.sx) - flakes::normalCdf((x0 - g.mx) / g.sx);
+    if (!(px > 0.0)) return 0.0;
+    return px * (flakes::normalCdf((y1 - g.my) / g.sy) - flakes::normalCdf((y0 - g.my) / g.sy));
+  }
+  const flakes::Lobe lobe{g.mx, g.my, g.cxx, g.cxy, g.cyy};
+  return flakes::lobeRectProbability(lobe, x0, x1, y0, y1, flakes::LobeAccuracy::kImage);
+}
+
+void mul(const double a[4], const double b[4], double out[4]) {
+  const double r[4] = {a[0] * b[0] + a[1] * b[2], a[0] * b[1] + a[1] * b[3], a[2] * b[0] + a[3] * b[2],
+                       a[2] * b[1] + a[3] * b[3]};
+  std::memcpy(out, r, sizeof r);
+}
+
+}  // namespace
+
+// An example's view of the s-plane: s_e = B s (B = F M^T F), s = A s_e, densities times |det M|.
+struct TinyExampleNdf::Frame {
+  double b[4], a[4];
+  double jac = 1.0;
+  bool grid = false;  // B maps bins onto bins (a signed permutation)
+};
+
+namespace {
+
+TinyExampleNdf::Frame makeFrame(const double m[4]) {
+  TinyExampleNdf::Frame f;
+  f.b[0] = m[0];
+  f.b[1] = -m[2];
+  f.b[2] = -m[1];
+  f.b[3] = m[3];
+  format::tinyInvert(f.b, f.a);
+  f.jac = std::fabs(m[0] * m[3] - m[1] * m[2]);
+  f.grid = TransformedExampleTexels::isGridTransform(m);
+  return f;
+}
+
+const double kIdentity[4] = {1.0, 0.0, 0.0, 1.0};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Tile images.
+
+RuntimeStatus tinyTileImage(const float* texels, int n, bool repeats, double sigma_r, int res, int x0, int y0,
+                            int side, float* out) {
+  if (!texels || !out || n < 1 || n > 65536 || res < 2 || res > 4096 || side < 1 || x0 < 0 || y0 < 0 ||
+      x0 + side > n || y0 + side > n || !(sigma_r > 0.0 && sigma_r <= 1.0))
+    return RuntimeStatus::kInvalidArgument;
+  std::fill(out, out + size_t(res) * res, 0.0f);
+  const double bin = 2.0 / res;
+  const double weight = 1.0 / (double(side) * side * bin * bin);
+  const double r2 = sigma_r * sigma_r, h2 = kSigmaH * kSigmaH;
+  for (int y = y0; y < y0 + side; ++y) {
+    for (int x = x0; x < x0 + side; ++x) {
+      float nk[2], j[4];
+      flakes::flakeAt(texels, n, n, repeats, x + 0.5, y + 0.5, nk, j);
+      const double j0 = j[0], j1 = j[1], j2 = j[2], j3 = j[3];
+      const flakes::Lobe g{double(nk[0]), double(nk[1]), r2 + h2 * (j0 * j0 + j1 * j1), h2 * (j0 * j2 + j1 * j3),
+                           r2 + h2 * (j2 * j2 + j3 * j3)};
+      flakes::splatLobe(g, weight, res, out);
+    }
+  }
+  return RuntimeStatus::kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The transformed example as a texel grid.
+
+bool TransformedExampleTexels::isGridTransform(const double m[4]) {
+  for (int i = 0; i < 4; ++i)
+    if (m[i] != 0.0 && m[i] != 1.0 && m[i] != -1.0) return false;
+  return std::fabs(m[0] * m[3] - m[1] * m[2]) == 1.0 && (m[0] == 0.0) == (m[3] == 0.0);
+}
+
+TransformedExampleTexels::TransformedExampleTexels(const float* texels, int n, bool repeats, const double matrix[4])
+    : texels_(texels), n_(n), repeats_(repeats) {
+  const double* m = isGridTransform(matrix) ? matrix : kIdentity;
+  for (int i = 0; i < 4; ++i) m_[i] = int(m[i]);
+  // The image of the corner (n, n): the square M [0, n]^2 starts at min(0, that) per axis.
+  off_[0] = std::min(0.0, double((m_[0] + m_[1]) * n));
+  off_[1] = std::min(0.0, double((m_[2] + m_[3]) * n));
+}
+
+void TransformedExampleTexels::normal(int x, int y, float out[2]) const {
+  // Texel centre in the plane relative to M's image of the example corner, back through M^-1 = M^T.
+  const double gx = off_[0] + x + 0.5, gy = off_[1] + y + 0.5;
+  const int vx = int(std::floor(m_[0] * gx + m_[2] * gy)), vy = int(std::floor(m_[1] * gx + m_[3] * gy));
+  const float* t = texels_ + (size_t(std::clamp(vy, 0, n_ - 1)) * n_ + size_t(std::clamp(vx, 0, n_ - 1))) * 2;
+  // A = F M^-T F = F M F for a signed permutation.
+  const double a0 = m_[0], a1 = -m_[1], a2 = -m_[2], a3 = m_[3];
+  out[0] = float(a0 * t[0] + a1 * t[1]);
+  out[1] = float(a2 * t[0] + a3 * t[1]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading.
+
+TinyExampleNdf::TinyExampleNdf() = default;
+TinyExampleNdf::~TinyExampleNdf() = default;
+
+RuntimeStatus TinyExampleNdf::open(const char* path) {
+  if (!path) return RuntimeStatus::kInvalidArgument;
+  format::Reader reader;
+  if (format::ContainerStatus st = reader.open(path); st != format::ContainerStatus::kOk) return fromFormatStatus(st);
+  return load(reader);
+}
+
+RuntimeStatus TinyExampleNdf::openMemory(const void* data, size_t size) {
+  if (!data) return RuntimeStatus::kInvalidArgument;
+  format::Reader reader;
+  if (format::ContainerStatus st = reader.openMemory(data, size); st != format::ContainerStatus::kOk)
+    return fromFormatStatus(st);
+  return load(reader);
+}
+
+namespace {
+
+RuntimeStatus readSized(const format::Reader& reader, uint32_t type, uint64_t key, uint64_t size,
+                        std::vector<uint8_t>* bytes) {
+  const int idx = reader.find(type, key);
+  if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
+  return fromFormatStatus(reader.readSection(size_t(idx), bytes));
+}
+
+// Integral of each row of an R x R density image, and of the whole image.
+double rowIntegrals(const float* img, int res, double* rows) {
+  const double bin_area = (2.0 / res) * (2.0 / res);
+  double total = 0.0;
+  for (int j = 0; j < res; ++j) {
+    double r = 0.0;
+    for (int i = 0; i < res; ++i) r += double(img[size_t(j) * res + i]);
+    rows[j] = r * bin_area;
+    total += rows[j];
+  }
+  return total;
+}
+
+}  // namespace
+
+RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
+  open_ = false;
+  flake_texels_.reset();
+  flakes_.reset();
+  if (reader.kind() != format::AssetKind::kTinyExample) return RuntimeStatus::kWrongKind;
+  std::vector<uint8_t> bytes;
+  TinyExampleRecord rec;
+  if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleInfo, 0, sizeof rec, &bytes);
+      s != RuntimeStatus::kOk)
+    return s;
+  std::memcpy(&rec, bytes.data(), sizeof rec);
+  if (rec.magic == TinyExampleRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
+  if (format::checkTinyExampleRecord(rec)) return RuntimeStatus::kInvalidAsset;
+  const int n = int(rec.example_size), res = int(rec.ndf_res);
+  if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleTexels, 0, uint64_t(n) * n * 8, &bytes);
+      s != RuntimeStatus::kOk)
+    return s;
+  texels_.assign(size_t(n) * n * 2, 0.0f);
+  std::memcpy(texels_.data(), bytes.data(), texels_.size() * 4);
+  for (float v : texels_)
+    if (!std::isfinite(v) || std::fabs(v) > 1.0f) return RuntimeStatus::kInvalidAsset;
+  levels_.assign(rec.levels, {});
+  tile_mass_.assign(rec.levels, {});
+  row_mass_.assign(rec.levels, {});
+  const size_t image = size_t(res) * res;
+  for (uint32_t l = 0; l < rec.levels; ++l) {
+    const uint64_t m = format::tinyTilesPerSide(rec.example_size, l);
+    if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleLevel, l, format::tinyLevelSectionSize(rec, l),
+                                    &bytes);
+        s != RuntimeStatus::kOk)
+      return s;
+    format::ImageSectionHeader h;
+    if (!format::parseImageSection(bytes.data(), bytes.size(), &h) || h.width != rec.ndf_res ||
+        h.height != rec.ndf_res || h.channels != 1 || h.layers != m * m)
+      return RuntimeStatus::kInvalidAsset;
+    levels_[l].resize(size_t(m * m) * image);
+    std::memcpy(levels_[l].data(), bytes.data() + 32, levels_[l].size() * 4);
+    for (float v : levels_[l])
+      if (!(std::isfinite(v) && v >= 0.0f)) return RuntimeStatus::kInvalidAsset;
+    tile_mass_[l].resize(size_t(m * m));
+    row_mass_[l].resize(size_t(m * m) * res);
+    for (size_t t = 0; t < m * m; ++t)
+      tile_mass_[l][t] = rowIntegrals(levels_[l].data() + t * image, res, row_mass_[l].data() + t * res);
+  }
+  std::vector<uint8_t>().swap(bytes);
+  // The flat base of stochastic layouts: N(0, sigma_r^2 I), bin-integrated.
+  base_.assign(image, 0.0f);
+  base_rows_.assign(size_t(res), 0.0);
+  const double bin = 2.0 / res;
+  flakes::splatLobe({0.0, 0.0, rec.sigma_r * rec.sigma_r, 0.0, rec.sigma_r * rec.sigma_r}, 1.0 / (bin * bin), res,
+                    base_.data());
+  base_mass_ = rowIntegrals(base_.data(), res, base_rows_.data());
+  record_ = rec;
+  if (rec.type == uint32_t(TinyExampleType::kTiled) && TransformedExampleTexels::isGridTransform(rec.matrix)) {
+    flake_texels_.reset(new (std::nothrow) TransformedExampleTexels(texels_.data(), n, true, rec.matrix));
+    flakes_.reset(new (std::nothrow) FlakeNdf());
+    if (!flake_texels_ || !flakes_) return RuntimeStatus::kOutOfMemory;
+    if (RuntimeStatus s = flakes_->build(*flake_texels_, 1, rec.sigma_r, res); s != RuntimeStatus::kOk) return s;
+  }
+  open_ = true;
+  return RuntimeStatus::kOk;
+}
+
+const float* TinyExampleNdf::tileImage(int level, int tile) const {
+  if (!open_ || level < 0 || level >= int(levels_.size())) return nullptr;
+  const size_t image = size_t(record_.ndf_res) * record_.ndf_res;
+  if (tile < 0 || size_t(tile) >= levels_[size_t(level)].size() / image) return nullptr;
+  return levels_[size_t(level)].data() + size_t(tile) * image;
+}
+
+FootprintRange TinyExampleNdf::footprintRange() const {
+  FootprintRange r;
+  if (!open_) return r;
+  r.pyramid_min_sigma = 2.0;
+  r.pyramid_max_sigma = record_.type == uint32_t(TinyExampleType::kTiled)
+                            ? 1e300
+                            : std::sqrt(double(kTinyMaxCells)) * record_.cell_size / (2.0 * kTinyWindowSigmas);
+  if (hasFlakes()) r.exact_max_sigma = kTinyFlakesUpTo;
+  return r;
+}
+
+MapSize TinyExampleNdf::mapSize() const {
+  return open_ ? MapSize{int(record_.example_size), int(record_.example_size)} : MapSize{};
+}
+
+bool TinyExampleNdf::validFootprint(const Footprint& f) const {
+  if (!(open_ && std::isfinite(f.x) && std::isfinite(f.y) && std::isfinite(f.sigma) && f.sigma >= 0.0)) return false;
+  if (std::fabs(f.x) > 1e12 || std::fabs(f.y) > 1e12) return false;
+  return f.sigma <= footprintRange().pyramid_max_sigma;
+}
+
+bool TinyExampleNdf::useFlakes(const Footprint& f) const { return hasFlakes() && f.sigma < kTinyFlakesUpTo; }
+
+// The footprint in the transformed example's grid (the flakes' coordinates).
+Footprint TinyExampleNdf::flakeFootprint(const Footprint& f) const {
+  return {f.x - record_.translate[0] - flake_texels_->offsetX(), f.y - record_.translate[1] - flake_texels_->offsetY(),
+          f.sigma};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Traversal: visit(frame, image, rows, tile mass, weight) for every kept tile, the base last.
+
+struct TinyExampleNdf::Visit {
+  const Frame* frame;
+  const float* image;
+  const double* rows;
+  double mass;
+  double weight;
+};
+
+template <typename F>
+bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) const {
+  const TinyExampleRecord& r = record_;
+  const double n = r.example_size;
+  const int top = int(r.levels) - 1;
+  const size_t image = size_t(r.ndf_res) * r.ndf_res;
+  const int res = int(r.ndf_res);
+  const double sigma = std::max(fp.sigma, kMinSigma);
+
+  // Descends from the top tile of one example (example frame offset ox, oy; Gaussian g).
+  auto descend = [&](const Frame& frame, const Gauss& g, double ox, double oy, auto&& self, int level, int ix,
+                     int iy) -> void {
+    const double t = double(2 << level);
+    const double x0 = ox + ix * t, y0 = oy + iy * t;
+    const double w = boxProbability(g, x0, x0 + t, y0, y0 + t);
+    if (!(w > kNegligible)) return;
+    if (level > 0) {
+      const double dx = x0 + 0.5 * t - g.mx, dy = y0 + 0.5 * t - g.my;
+      const double d = std::sqrt(dx * dx + dy * dy);
+      if (w * t * (d + t) > kTinyRefine * g.lambda_min) {
+        for (int c = 0; c < 4; ++c) self(frame, g, ox, oy, self, level - 1, 2 * ix + (c & 1), 2 * iy + (c >> 1));
+        return;
+      }
+    }
+    const int m = int(n) >> (level + 1);
+    const size_t tile = size_t(iy) * size_t(m) + size_t(ix);
+    visit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
+                tile_mass_[size_t(level)][tile], w});
+  };
+
+  if (r.type == uint32_t(TinyExampleType::kTiled)) {
+    const Frame frame = makeFrame(r.matrix);
+    double inv[4];
+    format::tinyInvert(r.matrix, inv);
+    const double dx = fp.x - r.translate[0], dy = fp.y - r.translate[1];
+    const double mx = inv[0] * dx + inv[1] * dy, my = inv[2] * dx + inv[3] * dy;
+    double cov[4];
+    const double inv_t[4] = {inv[0], inv[2], inv[1], inv[3]};
+    mul(inv, inv_t, cov);
+    const double s2 = sigma * sigma;
+    const Gauss g = makeGauss(mx, my, s2 * cov[0], s2 * cov[1], s2 * cov[3]);
+    if (g.lambda_min >= n * n) {
+      // The periodic sum of a footprint this wide weighs every texel alike (within 1e-8): the top tile.
+      if (entered) ++*entered;
+      visit(Visit{&frame, levels_[size_t(top)].data(), row_mass_[size_t(top)].data(), tile_mass_[size_t(top)][0], 1.0});
+      return true;
+    }
+    const double rx = kTinyWindowSigmas * g.sx, ry = kTinyWindowSigmas * g.sy;
+    const int64_t cx0 = int64_t(std::floor((mx - rx) / n)), cx1 = int64_t(std::floor((mx + rx) / n));
+    const int64_t cy0 = int64_t(std::floor((my - ry) / n)), cy1 = int64_t(std::floor((my + ry) / n));
+    for (int64_t cy = cy0; cy <= cy1; ++cy) {
+      for (int64_t cx = cx0; cx <= cx1; ++cx) {
+        if (entered) ++*entered;
+        descend(frame, g, double(cx) * n, double(cy) * n, descend, top, 0, 0);
+      }
+    }
+    return true;
+  }
+
+  // Stochastic: the cells of the window, each example in its own frame, then the flat base.
+  const double cell = r.cell_size;
+  const double reach = kTinyWindowSigmas * sigma;
+  const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)), i1 = int64_t(std::floor((fp.x + reach) / cell));
+  const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)), j1 = int64_t(std::floor((fp.y + reach) / cell));
+  if ((i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells) return false;
+  double covered = 0.0;
+  for (int64_t j = j0; j <= j1; ++j) {
+    for (int64_t i = i0; i <= i1; ++i) {
+      const format::TinyPlacement p = format::tinyCellPlacement(r, i, j);
+      if (!p.present) continue;
+      double inv[4];
+      if (!format::tinyInvert(p.matrix, inv)) continue;
+      const double dx = fp.x - p.centre[0], dy = fp.y - p.centre[1];
+      const double mx = inv[0] * dx + inv[1] * dy + 0.5 * n, my = inv[2] * dx + inv[3] * dy + 0.5 * n;
+      double cov[4];
+      const double inv_t[4] = {inv[0], inv[2], inv[1], inv[3]};
+      mul(inv, inv_t, cov);
+      const double s2 = sigma * sigma;
+      const Gauss g = makeGauss(mx, my, s2 * cov[0], s2 * cov[1], s2 * cov[3]);
+      if (mx + kTinyWindowSigmas * g.sx < 0.0 || mx - kTinyWindowSigmas * g.sx > n ||
+          my + kTinyWindowSigmas * g.sy < 0.0 || my - kTinyWindowSigmas * g.sy > n)
+        continue;
+      covered += boxProbability(g, 0.0, n, 0.0, n);
+      const Frame frame = makeFrame(p.matrix);
+      if (entered) ++*entered;
+      descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+    }
+  }
+  const double rest = 1.0 - covered;
+  if (rest > kNegligible) {
+    static const Frame base_frame = makeFrame(kIdentity);
+    visit(Visit{&base_frame, base_.data(), base_rows_.data(), base_mass_, rest});
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Queries.
+
+RuntimeStatus TinyExampleNdf::traversalCount(const Footprint& fp, int64_t* examples, int64_t* tiles) const {
+  if (!validFootprint(fp) || !examples || !tiles) return RuntimeStatus::kInvalidArgument;
+  int64_t e = 0, t = 0;
+  if (!traverse(
+          fp, [&](const Visit&) { ++t; }, &e))
+    return RuntimeStatus::kInvalidArgument;
+  *examples = e;
+  *tiles = t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (useFlakes(fp)) {
+    return flakes_->eval(flakeFootprint(fp), s, value);
+  }
+  if (!inSquare(s)) {
+    *value = 0.0;
+    return RuntimeStatus::kOk;
+  }
+  const int res = int(record_.ndf_res);
+  double sum = 0.0;
+  if (!traverse(fp, [&](const Visit& v) {
+        const Frame& f = *v.frame;
+        const double ex = f.b[0] * s.x + f.b[1] * s.y, ey = f.b[2] * s.x + f.b[3] * s.y;
+        if (!(ex >= -1.0 && ex <= 1.0 && ey >= -1.0 && ey <= 1.0)) return;
+        sum += v.weight * f.jac * double(v.image[size_t(binRow(ey, res)) * res + size_t(binColumn(ex, res))]);
+      }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
+  if (!value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  if (useFlakes(fp)) {
+    return flakes_->mass(flakeFootprint(fp), value);
+  }
+  double sum = 0.0;
+  if (!traverse(fp, [&](const Visit& v) { sum += v.weight * v.mass; })) return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  double e = 0.0, m = 0.0;
+  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
+  *value = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+namespace {
+
+
+Poly transformedRect(const double b[4], double x0, double x1, double y0, double y1) {
+  Poly p;
+  const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
+  for (int k = 0; k < 4; ++k) {
+    p.x[k] = b[0] * xs[k] + b[1] * ys[k];
+    p.y[k] = b[2] * xs[k] + b[3] * ys[k];
+  }
+  p.n = 4;
+  return p;
+}
+
+bool sameFrame(const TinyExampleNdf::Frame& a, const TinyExampleNdf::Frame& b) {
+  return std::memcmp(a.b, b.b, sizeof a.b) == 0;
+}
+
+}  // namespace
+
+// Tiles of one frame gathered so that the transformed rectangles are clipped once for all of them.
+struct TinyExampleNdf::Batch {
+  static constexpr int kCapacity = 256;
+  Frame frame;
+  bool has_frame = false;
+  WeightedImage images[kCapacity];
+  int count = 0;
+};
+
+template <typename F>
+bool TinyExampleNdf::batched(const Footprint& fp, F&& flush) const {
+  Batch batch;
+  auto emit = [&]() {
+    if (batch.count > 0) flush(static_cast<const Batch&>(batch));
+    batch.count = 0;
+  };
+  if (!traverse(fp, [&](const Visit& v) {
+        if (!batch.has_frame || !sameFrame(batch.frame, *v.frame) || batch.count == Batch::kCapacity) {
+          emit();
+          batch.frame = *v.frame;
+          batch.has_frame = true;
+        }
+        batch.images[batch.count++] = {v.image, v.weight};
+      }))
+    return false;
+  emit();
+  return true;
+}
+
+RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
+  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
+  if (useFlakes(fp)) {
+    return flakes_->average(flakeFootprint(fp), rect, value);
+  }
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  const double out_area = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
+  if (!(x1 > x0 && y1 > y0)) {
+    *value = 0.0;
+    return RuntimeStatus::kOk;
+  }
+  const int res = int(record_.ndf_res);
+  double integral = 0.0;
+  if (!batched(fp, [&](const Batch& batch) {
+        integral += polygonIntegral(transformedRect(batch.frame.b, x0, x1, y0, y1), batch.images, batch.count, res);
+      }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = integral / out_area;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_count) const {
+  const int res = resolution();
+  const size_t count = size_t(res) * size_t(res);
+  if (!out || count == 0 || out_count < count || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  if (useFlakes(fp)) {
+    return flakes_->image(flakeFootprint(fp), out, out_count);
+  }
+  std::fill(out, out + count, 0.0f);
+  const double bin = 2.0 / res;
+  if (!batched(fp, [&](const Batch& batch) {
+    const Frame& f = batch.frame;
+    for (int j = 0; j < res; ++j) {
+      for (int i = 0; i < res; ++i) {
+        if (!flakes::binInDisk(i, j, res)) continue;
+        const double cx = -1.0 + (i + 0.5) * bin, cy = 1.0 - (j + 0.5) * bin;
+        double v = 0.0;
+        if (f.grid) {
+          // A signed permutation maps the bin onto one stored bin.
+          const double ex = f.b[0] * cx + f.b[1] * cy, ey = f.b[2] * cx + f.b[3] * cy;
+          const size_t at = size_t(binRow(ey, res)) * res + size_t(binColumn(ex, res));
+          for (int k = 0; k < batch.count; ++k) v += batch.images[k].weight * double(batch.images[k].image[at]);
+        } else {
+          v = polygonIntegral(transformedRect(f.b, cx - 0.5 * bin, cx + 0.5 * bin, cy - 0.5 * bin, cy + 0.5 * bin),
+                              batch.images, batch.count, res) /
+              (bin * bin);
+        }
+        out[size_t(j) * res + i] += float(v);
+      }
+    }
+  }))
+    return RuntimeStatus::kInvalidArgument;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return RuntimeStatus::kInvalidArgument;
+  if (useFlakes(fp)) {
+    return flakes_->sample(flakeFootprint(fp), u1, u2, out);
+  }
+  double total = 0.0;
+  if (RuntimeStatus st = mass(fp, &total); st != RuntimeStatus::kOk) return st;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+  // The tile, in proportion to weight x mass, in the traversal's order.
+  double target = u1 * total, acc = 0.0;
+  bool found = false;
+  Frame frame;
+  Visit chosen{};
+  traverse(fp, [&](const Visit& v) {
+    if (found) return;
+    const double p = v.weight * v.mass;
+    if (p <= 0.0) return;
+    chosen = v;
+    frame = *v.frame;  // the visit's frame lives only during the call
+    if (target < acc + p) {
+      found = true;
+      return;
+    }
+    acc += p;
+  });
+  if (!chosen.image) return RuntimeStatus::kInvalidArgument;
+  if (!found) acc -= chosen.weight * chosen.mass;  // rounding left the target at the end: the last tile
+  const int res = int(record_.ndf_res);
+  const double bin = 2.0 / res;
+  double u = std::clamp((target - acc) / (chosen.weight * chosen.mass), 0.0, 0.99999999999999989);
+  // A row by its integral, then a bin of the row; the uniform is rescaled and reused.
+  double row_target = u * chosen.mass;
+  int j = 0;
+  for (; j < res - 1; ++j) {
+    if (row_target < chosen.rows[j]) break;
+    row_target -= chosen.rows[j];
+  }
+  while (j > 0 && chosen.rows[j] <= 0.0) --j;
+  const double row = chosen.rows[j];
+  double col_target = row > 0.0 ? std::clamp(row_target / row, 0.0, 0.99999999999999989) : 0.5;
+  const float* line = chosen.image + size_t(j) * res;
+  double line_sum = 0.0;
+  for (int i = 0; i < res; ++i) line_sum += double(line[i]);
+  col_target *= line_sum;
+  int i = 0;
+  for (; i < res - 1; ++i) {
+    if (col_target < double(line[i])) break;
+    col_target -= double(line[i]);
+  }
+  while (i > 0 && line[i] <= 0.0f) --i;
+  const double rest = line[i] > 0.0f ? std::clamp(col_target / double(line[i]), 0.0, 0.99999999999999989) : 0.5;
+  const double ex = -1.0 + (i + u2) * bin, ey = 1.0 - (j + rest) * bin;
+  out->s.x = frame.a[0] * ex + frame.a[1] * ey;
+  out->s.y = frame.a[2] * ex + frame.a[3] * ey;
+  if (!inSquare(out->s)) {
+    out->pdf = 0.0;
+    return RuntimeStatus::kOk;
+  }
+  return pdf(fp, out->s, &out->pdf);
+}
+
+}  // namespace glintbake::runtime
