@@ -7,4 +7,5 @@ glintbake_add_library(reference
           ${CMAKE_CURRENT_LIST_DIR}/sampling.cpp
           ${CMAKE_CURRENT_LIST_DIR}/glitter.cpp
   PUBLIC_DEPS glintbake::bake
+  COMPONENT bake
   PRIVATE_DEPS TBB::tbb)

@@ -9,4 +9,6 @@ glintbake_add_library(render
           ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
           ${CMAKE_CURRENT_LIST_DIR}/image_compare.cpp
   PUBLIC_DEPS glintbake::bake glintbake::runtime
-  PRIVATE_DEPS glintbake::reference TBB::tbb OpenImageIO::OpenImageIO nlohmann_json::nlohmann_json)
+  COMPONENT render
+  # nlohmann-json is a header library used only inside the scene reader.
+  PRIVATE_DEPS glintbake::reference TBB::tbb OpenImageIO::OpenImageIO $<BUILD_INTERFACE:nlohmann_json::nlohmann_json>)

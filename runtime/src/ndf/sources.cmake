@@ -2,4 +2,5 @@
 list(APPEND GLINTBAKE_RUNTIME_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/ndf_pyramid.cpp
   ${CMAKE_CURRENT_LIST_DIR}/open_asset.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/ndf_asset.cpp
   ${CMAKE_CURRENT_LIST_DIR}/glintbake_ndf_c.cpp)
