@@ -2,6 +2,7 @@
 // relations (Tao et al. 2021) and per-normal-map roughness mips.
 #include "commands.h"
 
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/ingest_options.h>
 
 #include <glintbake/format/container.h>
@@ -10,7 +11,7 @@
 
 namespace glintbake::ltcfit {}  // namespace glintbake::ltcfit
 
-int main(int argc, char** argv) {
+int glintbake::cli::ltcfitMain(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("ltcfit", "Fits LTC tables for area lights and bakes multi-scale roughness");
   CLI::App& app = tool.app();

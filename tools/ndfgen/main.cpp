@@ -6,6 +6,7 @@
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
@@ -67,7 +68,7 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
     const bake::glitter::GlitterImageSource source(model, opt.splat.ndf_res, opt.sigma0);
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback());
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     asset["ndf_res"] = opt.splat.ndf_res;
@@ -111,7 +112,7 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int glintbake::cli::ndfgenMain(int argc, char** argv) {
   cli::Tool tool("ndfgen", "Bakes the footprint pyramid of P-NDF images of a normal map (ndf-pyramid asset)");
   std::string input, output;
   bake::IngestOptions ingest;
@@ -146,7 +147,7 @@ int main(int argc, char** argv) {
 
     bake::ndf::PyramidReport report;
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);

@@ -6,6 +6,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
@@ -371,13 +372,14 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   if (in.source) {
     cli::LevelProgress progress(t);
     s = tensor::packTensorNdfFromSource(*in.source, o.pyramid.options, o.pack, out.writer(), &report,
-                                        progress.callback());
+                                        progress.callback(), cli::cancelFlag());
     progress.finish();
   } else if (in.from_container) {
-    s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
+    s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report, cli::cancelFlag());
   } else {
     cli::LevelProgress progress(t);
-    s = tensor::packTensorNdfFromMap(in.map, o.pyramid.options, o.pack, out.writer(), &report, progress.callback());
+    s = tensor::packTensorNdfFromMap(in.map, o.pyramid.options, o.pack, out.writer(), &report, progress.callback(),
+                                     cli::cancelFlag());
     progress.finish();
   }
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
@@ -501,7 +503,7 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int glintbake::cli::tensorpackMain(int argc, char** argv) {
   cli::Tool tool(
       "tensorpack",
       "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");

@@ -1,5 +1,6 @@
 // Command scaffolding shared by every tool: parsing, exit codes, reporting, progress, depfiles,
 // atomic outputs and the thread limit.
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 #include <glintbake/version.h>
@@ -132,8 +133,31 @@ void writeDepfile(const std::string& depfile, const std::vector<std::string>& ta
 }
 
 // ---------------------------------------------------------------------------------------------
+// The hooks of an embedded run (embed.h), guarded so that one embedded run is active at a time.
+std::mutex g_embed_mutex;
+std::atomic<EmbedHooks*> g_embed_hooks{nullptr};
+
+EmbedScope::EmbedScope(EmbedHooks* hooks) {
+  g_embed_mutex.lock();
+  g_embed_hooks.store(hooks);
+}
+
+EmbedScope::~EmbedScope() {
+  g_embed_hooks.store(nullptr);
+  g_embed_mutex.unlock();
+}
+
+EmbedHooks* embedHooks() { return g_embed_hooks.load(); }
+
+const std::atomic<bool>* cancelFlag() {
+  const EmbedHooks* hooks = embedHooks();
+  return hooks ? hooks->cancel : nullptr;
+}
+
 struct Progress::Impl {
   std::string label;
+  EmbedHooks* hooks = nullptr;  // embedded: report to the host instead of drawing
+  std::chrono::steady_clock::time_point last_report;
   uint64_t total = 0;
   std::atomic<uint64_t> done{0};
   bool enabled = false;
@@ -158,13 +182,24 @@ Progress::Progress(const std::string& label, uint64_t total, bool enabled) : imp
   impl_->label = label;
   impl_->total = total;
   impl_->enabled = enabled;
-  impl_->start = impl_->last_draw = std::chrono::steady_clock::now();
+  impl_->start = impl_->last_draw = impl_->last_report = std::chrono::steady_clock::now();
+  EmbedHooks* hooks = embedHooks();
+  if (hooks && hooks->progress) impl_->hooks = hooks;
 }
 
 Progress::~Progress() { finish(); }
 
 void Progress::advance(uint64_t n) {
   impl_->done += n;
+  if (impl_->hooks) {
+    std::unique_lock<std::mutex> lock(impl_->mutex, std::try_to_lock);
+    if (!lock.owns_lock() || impl_->finished) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - impl_->last_report < std::chrono::milliseconds(50)) return;
+    impl_->last_report = now;
+    impl_->hooks->progress(impl_->label, std::min(impl_->done.load(), impl_->total), impl_->total);
+    return;
+  }
   if (!impl_->enabled) return;
   std::unique_lock<std::mutex> lock(impl_->mutex, std::try_to_lock);
   if (!lock.owns_lock() || impl_->finished) return;
@@ -175,6 +210,13 @@ void Progress::advance(uint64_t n) {
 }
 
 void Progress::finish() {
+  if (impl_ && impl_->hooks) {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    if (impl_->finished) return;
+    impl_->finished = true;
+    impl_->hooks->progress(impl_->label, std::min(impl_->done.load(), impl_->total), impl_->total);
+    return;
+  }
   if (!impl_ || !impl_->enabled) return;
   std::lock_guard<std::mutex> lock(impl_->mutex);
   if (impl_->finished) return;
@@ -217,10 +259,12 @@ Tool::~Tool() = default;
 int Tool::threadCount() const { return common_.threads > 0 ? common_.threads : int(tbb::info::default_concurrency()); }
 
 int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
-  installSignalHandlers();
-  const auto fail = [this](int code, const std::string& message) {
+  EmbedHooks* hooks = embedHooks();
+  if (!hooks) installSignalHandlers();
+  const auto fail = [this, hooks](int code, const std::string& message) {
     std::string line = message;
     std::replace(line.begin(), line.end(), '\n', ' ');
+    if (hooks) hooks->error = line;
     std::fprintf(stderr, "%s: error: %s\n", name_.c_str(), line.c_str());
     return code;
   };
@@ -268,7 +312,13 @@ std::unique_ptr<Progress> Tool::progress(const std::string& label, uint64_t tota
   return std::make_unique<Progress>(label, total, enabled);
 }
 
-void Tool::printJson(const Json& document) const { std::cout << document.dump(2) << "\n"; }
+void Tool::printJson(const Json& document) const {
+  if (EmbedHooks* hooks = embedHooks()) {
+    hooks->json = document;
+    return;
+  }
+  std::cout << document.dump(2) << "\n";
+}
 
 std::string Tool::addInput(const std::string& path) {
   std::string hex;
