@@ -2,6 +2,7 @@
 #   install   cmake --install the build tree into PREFIX (the fixture the consumers share)
 #   cmake     configure and build the consumer project SOURCE_DIR against PREFIX, then run its
 #             program (if it builds one) with WORK_DIR/ARG
+#   python    import the installed Python package (PREFIX/PYTHON_DIR) and open ARGS with it
 #   pkgconfig compile the C program C_SOURCE with `cc $(pkg-config --cflags --libs glintbake-runtime)`
 #             from PREFIX and run it with ARGS
 function(run_step)
@@ -40,6 +41,9 @@ elseif(MODE STREQUAL "pkgconfig")
   separate_arguments(flags UNIX_COMMAND "${flags}")
   run_step(${C_COMPILER} -std=c99 -Wall -Wextra -Werror ${C_SOURCE} -o ${WORK_DIR}/program ${flags})
   run_step(${WORK_DIR}/program ${ARGS})
+elseif(MODE STREQUAL "python")
+  set(ENV{PYTHONPATH} ${PREFIX}/${PYTHON_DIR})
+  run_step(${PYTHON} -c "import glintbake, sys; a = glintbake.open(sys.argv[1]); print('python from install:', glintbake.__file__, a.kind, a.map_size); assert a.kind == 'ndf-pyramid'" ${ARGS})
 else()
   message(FATAL_ERROR "unknown MODE '${MODE}'")
 endif()
