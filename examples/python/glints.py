@@ -37,7 +37,7 @@ def main():
 
     summary = glintbake.ndfgen(map_path, output=asset_path, ndf_res=32, stride=8, sigma0=4, progress=progress)
     print(file=sys.stderr)
-    print("baked %s: %d levels" % (asset_path, len(summary.get("asset", summary).get("levels", []))))
+    print("baked %s: %d levels (%s)" % (asset_path, len(summary["levels"]), summary["stop_reason"]))
 
     asset = glintbake.open(asset_path)
     print("kind %s, map %s, wrap %s, NDF %d x %d" % (asset.kind, asset.map_size, asset.wrap, asset.resolution,

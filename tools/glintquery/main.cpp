@@ -7,6 +7,8 @@ int main(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("glintquery",
                  "Queries baked NDF assets (ndf-pyramid, tensor-ndf) through the runtime (point, image, batch)");
+  tool.addExample("glintquery point brushed.gbk --at 64,64 --sigma 4 --s 0.1,0", "The P-NDF density of one footprint at one s-plane point.");
+  tool.addExample("glintquery image brushed.gbk --at 64,64 --sigma 4 -o ndf.exr", "The NDF image the runtime blends for that footprint.");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
   app.fallthrough();

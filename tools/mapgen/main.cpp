@@ -64,6 +64,8 @@ int main(int argc, char** argv) {
   int max_size = kDefaultMaxSize;
   int png_bits = 16;
   bool half = false;
+  tool.addExample("mapgen brushed -o brushed.png --size 512", "A 512 x 512 brushed-metal normal map.");
+  tool.addExample("mapgen flakes -o flakes.exr --cone 15 --seed 7", "A flake map with normals within 15 degrees of the surface normal.");
   CLI::App& app = tool.app();
   app.add_option("kind", kind_name, "Map kind: " + bake::mapKindList())->required();
   app.add_option("-o,--output", output, "Output image: .exr (signed float RGB), .png or .tif ((n+1)/2, 16-bit)")

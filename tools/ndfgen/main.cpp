@@ -119,6 +119,9 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
   cli::PyramidCliOptions pyramid;
   const bake::ndf::PyramidOptions& opt = pyramid.options;
   int zstd_level = 3;
+  tool.addExample("ndfgen brushed.png -o brushed.gbk", "Bake the footprint pyramid of a normal map.");
+  tool.addExample("ndfgen brushed.png -o brushed.gbk --ndf-res 32 --depfile brushed.gbk.d -q", "Smaller NDF images, a depfile for make or ninja, warnings only.");
+  tool.addExample("ndfgen --procedural glitter -o glitter.gbk", "The pyramid of a procedural glitter surface instead of a map.");
   CLI::App& app = tool.app();
   app.add_option("map", input, "Normal map (or height field with --height); none with --procedural");
   app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();

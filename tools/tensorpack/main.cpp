@@ -217,7 +217,10 @@ void addOptions(CLI::App& app, Options& o) {
                  "Store the levels above the finest whose NDF images take at most this many MiB (and 64 centres) "
                  "(float32) exactly instead of compressed (0..1024; 0: compress every level)")
       ->capture_default_str();
-  app.add_option("--seed", opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
+  app.add_option("--seed", opt.cp.seed,
+                 "Seed of the randomised steps of the CP methods (any integer; equal seeds give identical files)")
+      ->default_str("fixed")
+      ->type_name("INT");
   app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
   cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
@@ -508,6 +511,8 @@ int glintbake::cli::tensorpackMain(int argc, char** argv) {
       "tensorpack",
       "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
   Options o;
+  tool.addExample("tensorpack brushed.png -o brushed-t.gbk", "Bake and compress a normal map into a tensor-ndf asset in one step.");
+  tool.addExample("tensorpack brushed.gbk --rank 16 --strict", "Compress an ndf-pyramid asset; fail if the fit misses its error bound.");
   addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
