@@ -31,12 +31,12 @@ int main(int argc, char** argv) {
       double l[3] = {light[0] - u, light[1] - v, light[2]};
       const double dist2 = l[0] * l[0] + l[1] * l[1] + l[2] * l[2], inv = 1.0 / sqrt(dist2);
       for (int k = 0; k < 3; ++k) l[k] *= inv;
-      /* Half vector in the tangent frame (x along +u, y along +v in texels, z the normal). */
+      /* Half vector; the tangent frame is x right (+u), y UP (-v: texel rows grow downwards), z out. */
       double h[3] = {l[0] + view[0], l[1] + view[1], l[2] + view[2]};
       const double hn = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
       for (int k = 0; k < 3; ++k) h[k] /= hn;
       double d_s = 0.0; /* density per unit s-plane area at s = (h_x, h_y) */
-      if (gb_ndf_asset_eval(asset, u * width, v * height, sigma, h[0], h[1], &d_s) != GB_OK) d_s = 0.0;
+      if (gb_ndf_asset_eval(asset, u * width, v * height, sigma, h[0], -h[1], &d_s) != GB_OK) d_s = 0.0;
       /* The microfacet BRDF D(h) / (4 cos_i cos_o) (no shadowing, no Fresnel) times cos_i and the
        * light's inverse-square falloff; D per solid angle of h is D_s * cos(theta_h). */
       const double radiance = d_s * h[2] / (4.0 * view[2] * dist2);

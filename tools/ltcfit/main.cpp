@@ -15,7 +15,7 @@ int glintbake::cli::ltcfitMain(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("ltcfit", "Fits LTC tables for area lights and bakes multi-scale roughness");
   tool.addExample("ltcfit table --brdf ggx --size 64 -o ggx.gbk", "Fit a 64 x 64 GGX table for area lights.");
-  tool.addExample("ltcfit roughness map.png -o map-rough.gbk", "Bake the per-texel roughness mips of a normal map.");
+  tool.addExample("ltcfit roughness map.png -o map-rough.exr", "Bake the per-texel roughness mips of a normal map (mipmapped EXR).");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
 
