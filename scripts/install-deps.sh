@@ -8,6 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config make python3 python3-jsonschema
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev libeigen3-dev libceres-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libgtest-dev libgmock-dev libbenchmark-dev
   clang  # libFuzzer targets (scripts/fuzz.sh)
 )
