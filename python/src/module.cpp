@@ -140,46 +140,46 @@ class Asset {
     return d;
   }
 
-  // eval / pdf: footprints (n, 3) x points (n, 2) -> (n,); NaN where a query was refused.
-  template <bool kPdf>
-  py::array_t<double> pointQuery(const DoubleArray& footprints, const DoubleArray& points) const {
-    Rows f = rows(footprints, 3, "footprints"), s = rows(points, 2, "s");
-    const py::ssize_t n = batchSize(f, s);
+  // One query per row of footprints (n, 3) and of args (n, width), rows of width 1 shared:
+  // query(source, footprint, args row, &value) -> status. Returns (n,) with NaN where refused.
+  template <typename Query>
+  py::array_t<double> batch(const DoubleArray& footprints, const DoubleArray& args, py::ssize_t width,
+                            const char* name, Query query) const {
+    Rows f = rows(footprints, 3, "footprints"), a = rows(args, width, name);
+    const py::ssize_t n = batchSize(f, a);
     py::array_t<double> out(n);
     double* o = out.mutable_data();
     {
       py::gil_scoped_release release;
       const rt::NdfSource& src = source();
       for (py::ssize_t i = 0; i < n; ++i) {
-        const rt::SPoint p{s.row(i)[0], s.row(i)[1]};
         double v = kNaN;
-        const rt::RuntimeStatus st =
-            kPdf ? src.pdf(footprintOf(f.row(i)), p, &v) : src.eval(footprintOf(f.row(i)), p, &v);
-        o[i] = st == rt::RuntimeStatus::kOk ? v : kNaN;
+        o[i] = query(src, footprintOf(f.row(i)), a.row(i), &v) == rt::RuntimeStatus::kOk ? v : kNaN;
       }
     }
     return out;
   }
 
+  py::array_t<double> eval(const DoubleArray& footprints, const DoubleArray& points) const {
+    return batch(footprints, points, 2, "s", [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s,
+                                                double* v) { return src.eval(fp, rt::SPoint{s[0], s[1]}, v); });
+  }
+
+  py::array_t<double> pdf(const DoubleArray& footprints, const DoubleArray& points) const {
+    return batch(footprints, points, 2, "s", [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s,
+                                                double* v) { return src.pdf(fp, rt::SPoint{s[0], s[1]}, v); });
+  }
+
   py::array_t<double> average(const DoubleArray& footprints, const DoubleArray& rects) const {
-    Rows f = rows(footprints, 3, "footprints"), r = rows(rects, 4, "rects");
-    const py::ssize_t n = batchSize(f, r);
-    py::array_t<double> out(n);
-    double* o = out.mutable_data();
-    {
-      py::gil_scoped_release release;
-      const rt::NdfSource& src = source();
-      for (py::ssize_t i = 0; i < n; ++i) {
-        rt::SRect rect;
-        rect.x0 = r.row(i)[0];
-        rect.y0 = r.row(i)[1];
-        rect.x1 = r.row(i)[2];
-        rect.y1 = r.row(i)[3];
-        double v = kNaN;
-        o[i] = src.average(footprintOf(f.row(i)), rect, &v) == rt::RuntimeStatus::kOk ? v : kNaN;
-      }
-    }
-    return out;
+    return batch(footprints, rects, 4, "rects",
+                 [](const rt::NdfSource& src, const rt::Footprint& fp, const double* r, double* v) {
+                   rt::SRect rect;
+                   rect.x0 = r[0];
+                   rect.y0 = r[1];
+                   rect.x1 = r[2];
+                   rect.y1 = r[3];
+                   return src.average(fp, rect, v);
+                 });
   }
 
   py::tuple sample(const DoubleArray& footprints, const DoubleArray& u) const {
@@ -336,9 +336,9 @@ PYBIND11_MODULE(_glintbake, m) {
       .def_property_readonly("footprint_range", &Asset::footprintRange,
                              "The sigma (texels) each path answers (ndf_source.h, FootprintRange)")
       .def_property_readonly("metadata_text", &Asset::metadataText, "The container's metadata JSON text")
-      .def("eval", &Asset::pointQuery<false>, py::arg("footprints"), py::arg("s"),
+      .def("eval", &Asset::eval, py::arg("footprints"), py::arg("s"),
            "P-NDF density per unit s-plane area at each point: float64 (n,)")
-      .def("pdf", &Asset::pointQuery<true>, py::arg("footprints"), py::arg("s"),
+      .def("pdf", &Asset::pdf, py::arg("footprints"), py::arg("s"),
            "Density with which sample() draws each point: float64 (n,)")
       .def("average", &Asset::average, py::arg("footprints"), py::arg("rects"),
            "Mean density over s-plane rectangles, rows (x0, y0, x1, y1): float64 (n,)")

@@ -126,20 +126,8 @@ void NdfAsset::close() {
 
 const char* NdfAsset::kindName() const { return format::assetKindString(kind_); }
 
-RuntimeStatus NdfAsset::open(const char* path, OpenError* error) {
-  close();
-  std::unique_ptr<NdfSource> source;
-  const RuntimeStatus s = openNdfAsset(path, &source, error);
-  if (s != RuntimeStatus::kOk) return s;
-  format::Reader reader;
-  if (format::ContainerStatus st = reader.open(path); st != format::ContainerStatus::kOk) {
-    // The file changed between the two reads.
-    if (error) {
-      error->status = RuntimeStatus::kIoError;
-      setMessage(error, 0, "the asset could not be read again for its metadata");
-    }
-    return RuntimeStatus::kIoError;
-  }
+// Keeps an opened source with the metadata and kind of its container.
+RuntimeStatus NdfAsset::adopt(const format::Reader& reader, std::unique_ptr<NdfSource> source, OpenError* error) {
   if (RuntimeStatus m = copyMetadata(reader, &metadata_, &metadata_size_); m != RuntimeStatus::kOk) {
     explain(m, error, [] { return format::ValidationReport(); }, [] { return format::AssetKind::kUnknown; });
     return m;
@@ -149,6 +137,23 @@ RuntimeStatus NdfAsset::open(const char* path, OpenError* error) {
   return RuntimeStatus::kOk;
 }
 
+RuntimeStatus NdfAsset::open(const char* path, OpenError* error) {
+  close();
+  std::unique_ptr<NdfSource> source;
+  const RuntimeStatus s = openNdfAsset(path, &source, error);
+  if (s != RuntimeStatus::kOk) return s;
+  format::Reader reader;
+  if (reader.open(path) != format::ContainerStatus::kOk) {
+    // The file changed between the two reads.
+    if (error) {
+      error->status = RuntimeStatus::kIoError;
+      setMessage(error, 0, "the asset could not be read again for its metadata");
+    }
+    return RuntimeStatus::kIoError;
+  }
+  return adopt(reader, std::move(source), error);
+}
+
 RuntimeStatus NdfAsset::openMemory(const void* data, size_t size, OpenError* error) {
   close();
   std::unique_ptr<NdfSource> source;
@@ -156,13 +161,7 @@ RuntimeStatus NdfAsset::openMemory(const void* data, size_t size, OpenError* err
   if (s != RuntimeStatus::kOk) return s;
   format::Reader reader;
   if (reader.openMemory(data, size) != format::ContainerStatus::kOk) return RuntimeStatus::kInvalidAsset;
-  if (RuntimeStatus m = copyMetadata(reader, &metadata_, &metadata_size_); m != RuntimeStatus::kOk) {
-    explain(m, error, [] { return format::ValidationReport(); }, [] { return format::AssetKind::kUnknown; });
-    return m;
-  }
-  kind_ = source->kind();
-  source_ = std::move(source);
-  return RuntimeStatus::kOk;
+  return adopt(reader, std::move(source), error);
 }
 
 }  // namespace glintbake::runtime

@@ -51,6 +51,8 @@ class NdfAsset {
   size_t metadataSize() const { return metadata_size_; }
 
  private:
+  RuntimeStatus adopt(const format::Reader& reader, std::unique_ptr<NdfSource> source, OpenError* error);
+
   std::unique_ptr<NdfSource> source_;
   std::unique_ptr<char[]> metadata_;
   size_t metadata_size_ = 0;
