@@ -51,6 +51,12 @@ class Help(ToolTestCase):
             for option in long_options(help_text):
                 self.assertIn(option, plain, f"{tool}: {option} of --help missing from the man page")
 
+    def test_subcommand_help_lists_the_global_options(self):
+        out, _ = self.run_ok("glintinfo", "validate", "--help")
+        for option in ("--json", "--quiet", "--strict", "--threads", "--depfile"):
+            self.assertIn(option, out)
+        self.assertIn("Examples:", out)
+
     def test_ingest_choices_by_name(self):
         out, _ = self.run_ok("ndfgen", "--help")
         self.assertIn("auto|unorm|snorm", out)

@@ -404,6 +404,13 @@ int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
     std::fprintf(stderr, "%s: error: %s\n", name_.c_str(), line.c_str());
     return code;
   };
+  // A subcommand's --help also lists the options every command takes, and the tool's examples.
+  std::string global = "Options of every " + name_ + " command (before or after the subcommand):\n";
+  for (const CLI::Option* opt : app_.get_options()) {
+    if (opt->get_group().empty() || opt->get_name() == "--help") continue;
+    global += "  " + opt->get_name(false, true) + "\n      " + opt->get_description() + "\n";
+  }
+  for (CLI::App* sub : app_.get_subcommands([](CLI::App*) { return true; })) sub->footer(global + "\n" + app_.get_footer());
   for (int i = 1; i < argc; ++i)
     if (std::strcmp(argv[i], "--help-man") == 0) {
       std::cout << manPage();
