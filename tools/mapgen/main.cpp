@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
                                               std::to_string(params.size) +
                                               (params.size > max_size ? " (raise the limit with --max-size)" : ""));
     }
+    if (output == "-")
+      throw Error(cli::kExitBadArguments, "images cannot be written to standard output ('-'): name a .exr, .png or .tif file");
     const std::string ext = bake::imageExtension(output);
     if (ext != "exr" && ext != "png" && ext != "tif" && ext != "tiff") {
       throw Error(cli::kExitBadArguments, "output " + output + " must end in .exr, .png or .tif");
