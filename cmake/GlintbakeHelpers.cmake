@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Shared build helpers: the warnings target, the one function that defines every library, and the
 # package export.
 include_guard(GLOBAL)

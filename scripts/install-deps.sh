@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian packages glintbake needs to build, test and run its examples, if any are
 # missing. As root it runs apt-get; otherwise it prints the exact command and exits non-zero.
 #   scripts/install-deps.sh [--browser]   (--browser adds chromium for the report's browser test)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # SPDX licence identifiers of the source files (every tracked C/C++, Python, CMake, shell and Make
 # file; documents, JSON and binary assets carry none).
 #   scripts/spdx.sh --check [DIR]   lists the files without an SPDX-License-Identifier line; exit 1 if any

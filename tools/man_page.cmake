@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -P script: writes the man page a tool prints with --help-man (TOOL, OUTPUT).
 set(ENV{ASAN_OPTIONS} "detect_leaks=0")  # sanitizer builds: printing a page is no leak check
 get_filename_component(_dir ${OUTPUT} DIRECTORY)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* Renders a glinty plane lit by a point light with the glintbake C API and writes a PPM image.
  *   render_small ASSET.gbk OUT.ppm [SIZE]
  * The plane z = 0 carries the asset's map once over [0, 1]^2; an orthographic camera looks straight

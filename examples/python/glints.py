@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Bakes a small ndf-pyramid asset from a generated normal map and queries it with numpy.
 
     PYTHONPATH=build/python python3 examples/python/glints.py [OUT_DIR]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image output through OpenImageIO: atomic (temporary file + rename) and byte-reproducible.
 #include <glintbake/bake/io/image_io.h>
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The reference renderer (glintbake::render): scenes, camera and objects with ray differentials,
 # direct lighting with the glinty BRDF over image tiles, and image comparison. Its own target,
 # because it uses both the runtime (assets, BRDF) and the reference evaluator (ground truth).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintbake: baked glinty-appearance assets from Python.
 
 Queries (no Python loop per query; the GIL is released while a batch runs)::

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The glintbake Python module (_glintbake, wrapped by the glintbake package): NDF assets with
 // vectorised queries over numpy arrays (one call per batch, the GIL released while it runs), and
 // the bake entry points, which run the tools' own option parsing (cli::*Main) with progress,

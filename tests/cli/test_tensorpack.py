@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """tensorpack: tensor-ndf assets from normal maps and ndf-pyramid containers. Schema-valid --json,
 the default output name, byte-identical output for every thread count and run, and the documented
 exit codes for bad arguments and bad input with nothing left behind."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Help, manual pages and everyday usability of every tool: examples at the end of --help, help in
 plain words, man pages generated from the same option definitions, "did you mean" suggestions,
 '-' as standard output where a stream makes sense, warnings under --quiet, and --strict."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -P script of the install tests, one step per call (MODE):
 #   install   cmake --install the build tree into PREFIX (the fixture the consumers share)
 #   cmake     configure and build the consumer project SOURCE_DIR against PREFIX, then run its

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The glintbake Python module: asset information, vectorised queries against their one-row forms,
 sampling consistency, errors carrying exit codes and validator ids, and the bake entry points
 (same options as the tools, progress, cancellation)."""

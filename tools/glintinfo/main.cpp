@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo: inspects, validates, compares and exports glintbake containers.
 #include "commands.h"
 

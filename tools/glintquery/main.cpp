@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery: answers P-NDF queries on a baked NDF asset (ndf-pyramid or tensor-ndf) through the
 // runtime-lite, exactly as a renderer would see them: point values, the blended image of a
 // footprint, and JSON-lines batches of point, range, sample, pdf and mass queries.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref: the reference P-NDF evaluator of glintbake (the slow, obviously-correct definition
 // every fast path is checked against): point values, bin-averaged NDF images and samples, a
 // reference renderer and image comparison.

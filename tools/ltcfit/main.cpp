@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ltcfit: LTC tables for area lights (Heitz et al. 2016), their fit error, multi-scale roughness
 // relations (Tao et al. 2021) and per-normal-map roughness mips.
 #include "commands.h"

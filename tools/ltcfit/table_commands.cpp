@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ltcfit table and ltcfit eval.
 #include "commands.h"
 

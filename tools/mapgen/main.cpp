@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mapgen: writes procedural microstructure normal maps with known statistics (flat, beckmann,
 // brushed, scratches, flakes), deterministic by seed; see libbake mapgen/mapgen.h for the models.
 #include <glintbake/bake/io/image_io.h>

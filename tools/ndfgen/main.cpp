@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
 // ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md). With
 // --procedural glitter the images come from a procedural glitter surface instead of a map

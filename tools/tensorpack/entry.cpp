@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tensorpack program: its body is cli::tensorpackMain (main.cpp), which the Python module also runs.
 #include <glintbake/cli/embed.h>
 

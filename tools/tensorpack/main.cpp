@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tensorpack: compresses the footprint pyramid of NDF images of a normal map (built on the fly) or of
 // an ndf-pyramid container into a tensor-ndf asset: per region and level, the non-blank B x B
 // angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md

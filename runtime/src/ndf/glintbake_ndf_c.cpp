@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/runtime/glintbake_ndf_c.h>

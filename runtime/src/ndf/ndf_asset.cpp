@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // NdfAsset: an opened NDF asset with its container metadata, and open failures explained by the
 // container validator (the same checks and message ids as `glintinfo validate`).
 #include <glintbake/format/container.h>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Runtime-lite reader of ndf-pyramid assets and its C API.
 list(APPEND GLINTBAKE_RUNTIME_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/ndf_pyramid.cpp

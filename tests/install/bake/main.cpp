@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A consumer of an installed glintbake::bake and glintbake::reference: generates a small normal
 // map, writes it with the image library the baker uses, and builds the reference flakes of it.
 #include <glintbake/bake/io/image_io.h>

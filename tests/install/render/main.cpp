@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A consumer of an installed glintbake::render: compares two small images.
 #include <glintbake/bake/render/image_compare.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A renderer-side consumer of an installed glintbake (COMPONENTS runtime): writes a container,
 // reads it back through the installed format library, and asks the runtime about it.
 #include <glintbake/format/container.h>

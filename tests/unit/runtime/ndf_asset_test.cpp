@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // NdfAsset and the C API's asset information: kind, map size and wrap, footprint ranges, metadata
 // JSON, the library version, and open failures carrying the validator's message id and text. Runs
 // on the frozen containers of tests/format, so it needs nothing but the runtime.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The normal-map ingest options shared by every tool that reads a normal map, their canonical JSON
 // form, and the loader that maps library errors to exit codes.
 #include <glintbake/cli/exit_codes.h>

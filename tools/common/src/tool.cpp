@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Command scaffolding shared by every tool: parsing, exit codes, reporting, progress, depfiles,
 // atomic outputs and the thread limit.
 #include <glintbake/cli/embed.h>

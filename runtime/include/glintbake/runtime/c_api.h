@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* Linkage of the runtime's C API (glintbake_ndf_c.h, glintbake_brdf_c.h, ltc_c.h). Every C function
  * is declared GLINTBAKE_C_API: exported from a shared runtime (default visibility on ELF and
  * Mach-O, dllexport/dllimport on Windows when GLINTBAKE_RUNTIME_SHARED is defined, which the CMake

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* C API of the glintbake microfacet BRDF and spherical Gaussian environment prefiltering
  * (brdf.h, sg.h), for engines that do not link C++ directly.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* C API of the glintbake runtime-lite's NDF assets (ndf-pyramid, tensor-ndf, behind one handle),
  * for engines that do not link C++ directly. The BRDF and LTC C APIs are glintbake_brdf_c.h and
  * ltc_c.h; they share the status codes below.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* C API of the runtime-lite LTC area lights (see ltc.h for the conventions).
  *
  * Status codes are those of glintbake_ndf_c.h (GB_OK = 0, ...). A table is immutable after opening;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An opened NDF asset file: its NdfSource (the queries, ndf_source.h) together with what the
 // container says about it (kind, metadata JSON), and open failures explained by the validator.
 #pragma once

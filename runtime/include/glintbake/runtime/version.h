@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The version of the runtime library a program runs against (which may differ from the headers
 // it was compiled with, glintbake/version.h, when the runtime is a shared library).
 #pragma once

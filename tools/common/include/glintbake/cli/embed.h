@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Running a tool inside another program (the Python module): the tool parses the same options
 // with the same CLI11 definitions as on the command line, and its progress, cancellation, error
 // text and --json summary go to the host instead of the terminal.

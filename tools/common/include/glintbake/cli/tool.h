@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared scaffolding of every glintbake command-line tool: exit codes, common options, the
 // reporter, progress, depfiles and atomic outputs. Tools are thin main()s over the libraries:
 //
