@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CP tensor compression and its runtime queries: one sweep against the GEMM-bound floor, full
 // decompositions per method (time and error), and blended point / range / sample latency.
 // Targets: sweep on 32x32x2048 rank 16 within 1.3x of the floor

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Latency of the runtime's exact small-footprint evaluator (FlakeNdf): point eval, sample and the
 // reference evaluator at the same footprints, on 1024^2 maps. By default three procedural maps
 // (beckmann, scratches, flakes); GLINTBAKE_BENCH_MAPS=a.png,b.png benchmarks real maps instead.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural glitter (Jakob et al. 2014): the cost of one counting query (a uv box of side 0.01 and
 // a 1-degree cone, the paper's split rule for that query, with the binomial early stop) for N from
 // 1e3 to 1e9 facets, against explicit enumeration of every facet (generate and test; up to 1e7).

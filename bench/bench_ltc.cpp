@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LTC benchmarks: the full 64 x 64 GGX table fit at the default (refined) settings and with the
 // published settings, each reporting its fit error on the `ltcfit eval` measure (128^2 samples per
 // strategy), and the runtime cost of one lookup + rectangle integral.

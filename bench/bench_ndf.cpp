@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // NDF image generation per footprint (splat vs reference, one thread each) and runtime query
 // latency (eval, sample, average) on a baked pyramid.
 #include <glintbake/bake/mapgen/mapgen.h>

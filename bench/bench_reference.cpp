@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference evaluator's cost: bin-averaged NDF images (R = 128) at footprint sigmas of 2, 8 and
 // 32 texels, and point evaluations of D(s) at sigma 32, on a 256^2 Beckmann map (alpha 0.3) built
 // in the benchmark. Images run on one thread (a TBB arena of 1) so that the figures do not depend

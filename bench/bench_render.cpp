@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Render time per NDF mode of the report's far view (examples/scenes/plane_far.json at 64 x 64
 // pixels) on a procedural flakes map: the reference P-NDF, the uncompressed ndf-pyramid, the
 // rank-16 tensor-ndf and the smooth BRDF. The asset's speedup over the reference is the ratio of

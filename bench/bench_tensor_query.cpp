@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Query latency of the tensor-ndf runtime (rank 16, R = 128, blocks of 32; also with the small
 // levels stored exactly, tensorpack's default) against the uncompressed ndf-pyramid it was packed
 // from: point eval, range average, sample and pdf. Queries

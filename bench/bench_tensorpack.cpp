@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tensorpack: the CP methods on a realistic group (the non-blank 32 x 32 blocks of one 16 x 16
 // region of level 0 of a mapgen map's pyramid, R = 128), time and relative error side by side;
 // and the whole packer (pyramid generation + CP + writing) on a small map.

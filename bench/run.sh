@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Runs every bench_* program of a build with repetitions and prints the median of each benchmark.
 #
 #   bench/run.sh [BUILD_DIR] [REPETITIONS] [FILTER]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Finds OpenImageIO and repairs a packaging defect of some distributions: the imported target
 # lists /usr/include/opencv4 among its include directories even when OpenCV's headers are not
 # installed (OIIO's core library does not need them), which makes CMake refuse to generate.

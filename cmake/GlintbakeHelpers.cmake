@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Shared build helpers: the warnings target, the one function that defines every library, and the
 # package export.
 include_guard(GLOBAL)
@@ -17,14 +18,23 @@ endif()
 set_property(GLOBAL PROPERTY GLINTBAKE_EXPORTED_TARGETS "")
 
 # glintbake_add_library(<name> SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...] [INCLUDE_DIR dir]
-#                       [NO_EXCEPTIONS] [INTERNAL])
-# Defines target glintbake_<name> with alias glintbake::<name>. Public headers live in
-# <INCLUDE_DIR> (default: include/ beside the CMakeLists that calls it). INTERNAL libraries are
-# not installed (tool scaffolding, test helpers).
+#                       [COMPONENT runtime|bake|render] [NO_EXCEPTIONS] [INTERNAL])
+# Defines target glintbake_<name> with alias glintbake::<name>, static or shared as BUILD_SHARED_LIBS
+# says. Public headers live in <INCLUDE_DIR> (default: include/ beside the CMakeLists that calls it).
+# Installed libraries belong to a package component (find_package(glintbake COMPONENTS ...)), whose
+# export set is glintbake-<component>Targets. INTERNAL libraries are static and not installed (tool
+# scaffolding, test helpers).
 function(glintbake_add_library name)
-  cmake_parse_arguments(ARG "NO_EXCEPTIONS;INTERNAL" "INCLUDE_DIR" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_EXCEPTIONS;INTERNAL" "INCLUDE_DIR;COMPONENT" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   set(target glintbake_${name})
-  add_library(${target} ${ARG_SOURCES})
+  if(ARG_INTERNAL)
+    add_library(${target} STATIC ${ARG_SOURCES})
+  else()
+    if(NOT ARG_COMPONENT)
+      message(FATAL_ERROR "glintbake_add_library(${name}): installed libraries name their COMPONENT")
+    endif()
+    add_library(${target} ${ARG_SOURCES})
+  endif()
   add_library(glintbake::${name} ALIAS ${target})
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name} OUTPUT_NAME glintbake_${name}
                                              POSITION_INDEPENDENT_CODE ON)
@@ -43,13 +53,14 @@ function(glintbake_add_library name)
     target_compile_options(${target} PRIVATE -fno-exceptions -fno-rtti)
   endif()
   if(NOT ARG_INTERNAL)
-    install(TARGETS ${target} EXPORT glintbakeTargets
+    install(TARGETS ${target} EXPORT glintbake-${ARG_COMPONENT}Targets
             ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
             RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
     if(EXISTS ${ARG_INCLUDE_DIR})
       install(DIRECTORY ${ARG_INCLUDE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
     endif()
     set_property(GLOBAL APPEND PROPERTY GLINTBAKE_EXPORTED_TARGETS ${target})
+    set_property(GLOBAL APPEND PROPERTY GLINTBAKE_INSTALLED_COMPONENTS ${ARG_COMPONENT})
   endif()
 endfunction()
 
@@ -58,21 +69,29 @@ function(glintbake_add_tool name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE glintbake::cli ${ARG_DEPS} glintbake_warnings)
-  install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  install(TARGETS ${name} EXPORT glintbake-toolsTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  set_property(GLOBAL APPEND PROPERTY GLINTBAKE_INSTALLED_COMPONENTS tools)
 endfunction()
 
+# The package: one export set and dependency list per component (cmake/glintbakeConfig.cmake.in),
+# the version header, the pkg-config file of the runtime, and the documents and schemas.
 function(glintbake_install_package)
-  if(TARGET glintbake_bake)
-    set(GLINTBAKE_CONFIG_WITH_BAKE ON)
+  get_property(components GLOBAL PROPERTY GLINTBAKE_INSTALLED_COMPONENTS)
+  list(REMOVE_DUPLICATES components)
+  set(GLINTBAKE_CONFIG_COMPONENTS "${components}")
+  if(BUILD_SHARED_LIBS)
+    set(GLINTBAKE_CONFIG_STATIC OFF)
   else()
-    set(GLINTBAKE_CONFIG_WITH_BAKE OFF)
+    set(GLINTBAKE_CONFIG_STATIC ON)
   endif()
   configure_file(${PROJECT_SOURCE_DIR}/cmake/version.h.in
                  ${PROJECT_BINARY_DIR}/generated/include/glintbake/version.h @ONLY)
   install(FILES ${PROJECT_BINARY_DIR}/generated/include/glintbake/version.h
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glintbake)
-  install(EXPORT glintbakeTargets NAMESPACE glintbake:: FILE glintbakeTargets.cmake
-          DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/glintbake)
+  foreach(component ${components})
+    install(EXPORT glintbake-${component}Targets NAMESPACE glintbake:: FILE glintbake-${component}Targets.cmake
+            DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/glintbake)
+  endforeach()
   configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/glintbakeConfig.cmake.in
                                 ${PROJECT_BINARY_DIR}/glintbakeConfig.cmake
                                 INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/glintbake)
@@ -81,5 +100,28 @@ function(glintbake_install_package)
   install(FILES ${PROJECT_BINARY_DIR}/glintbakeConfig.cmake ${PROJECT_BINARY_DIR}/glintbakeConfigVersion.cmake
                 ${PROJECT_SOURCE_DIR}/cmake/FindGlintbakeOIIO.cmake
           DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/glintbake)
+
+  # pkg-config: a static runtime needs zstd and the C++ standard library at link time, a shared one
+  # only for its own loading.
+  if(BUILD_SHARED_LIBS)
+    set(GLINTBAKE_PC_REQUIRES "")
+    set(GLINTBAKE_PC_REQUIRES_PRIVATE "libzstd")
+    set(GLINTBAKE_PC_LIBS_EXTRA "")
+  else()
+    set(GLINTBAKE_PC_REQUIRES "libzstd")
+    set(GLINTBAKE_PC_REQUIRES_PRIVATE "")
+    set(GLINTBAKE_PC_LIBS_EXTRA "-lstdc++ -lm")
+  endif()
+  file(RELATIVE_PATH GLINTBAKE_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/glintbake-runtime.pc.in ${PROJECT_BINARY_DIR}/glintbake-runtime.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/glintbake-runtime.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/schemas/ DESTINATION ${CMAKE_INSTALL_DATADIR}/glintbake/schemas)
+  install(FILES ${PROJECT_SOURCE_DIR}/formats/SPEC.md ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/LICENSE
+                ${PROJECT_SOURCE_DIR}/NOTICE ${PROJECT_SOURCE_DIR}/THIRD_PARTY_NOTICES.md
+          DESTINATION ${CMAKE_INSTALL_DOCDIR})
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/schemas/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/schemas)
+  if(EXISTS ${PROJECT_SOURCE_DIR}/docs)
+    install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
+  endif()
 endfunction()

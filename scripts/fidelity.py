@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Fidelity harness: NDF images of baked assets against the reference evaluator.
 
 For every normal map and asset it draws random footprints (x, y uniform over the map, sigma from a

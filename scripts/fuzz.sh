@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds the libFuzzer targets (clang, runtime-only configuration, in build-fuzz/) and runs each for
 # SECONDS (default 20), seeded from valid files of every kind: the frozen containers of
 # tests/format/ for the container and runtime targets, tests/fuzz/json/ for the JSON target.

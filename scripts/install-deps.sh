@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian packages glintbake needs to build, test and run its examples, if any are
 # missing. As root it runs apt-get; otherwise it prints the exact command and exits non-zero.
 #   scripts/install-deps.sh [--browser]   (--browser adds chromium for the report's browser test)
@@ -8,6 +9,7 @@ packages=(
   build-essential cmake ninja-build pkg-config make python3 python3-jsonschema
   libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev libeigen3-dev libceres-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libgtest-dev libgmock-dev libbenchmark-dev
   clang  # libFuzzer targets (scripts/fuzz.sh)
 )

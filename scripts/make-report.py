@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Renders the example maps and real normal maps at six footprints (0.5 to 64 texels) with the
 reference P-NDF, the baked assets (uncompressed ndf-pyramid and tensor-ndf rank 16) and the smooth
 BRDF, compares every render with the reference, compares NDF images of the assets with the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The main job on the bundled example: builds the tools, runs the example asset build
 # (examples/Makefile) into examples/out/, then renders the report (out/report/index.html).
 # Installs missing dependencies first.

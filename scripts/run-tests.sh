@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Builds everything and runs the whole test suite (CTest). Installs missing dependencies first.
 #  1. a runtime-only configuration (container library + runtime-lite, no OpenImageIO, Ceres, TBB
 #     or Eigen), built and tested as a renderer would build it;

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Sanitizer builds (Debug, so the DCHECKs run too):
 #   build-asan/  the whole project under ASan+UBSan; runs the unit tests (and the CLI tests with
 #                --cli), every finding failing its test;

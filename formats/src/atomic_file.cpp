@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AtomicFile: anonymous (O_TMPFILE) or named temporary file, checked writes, link/rename into place.
 #include <glintbake/format/atomic_file.h>
 

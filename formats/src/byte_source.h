@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where a container's bytes come from: a caller-owned memory buffer or a file read with positioned
 // reads. Private to the container library; shared by the reader and the validator so both run the
 // same checks on the same bytes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Structural checks of a container's header and index (formats/SPEC.md, "Reader requirements").
 #include "container_parse.h"
 

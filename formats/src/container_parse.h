@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Header and index checks shared by Reader::open() and validate(): one implementation of every
 // structural rule of formats/SPEC.md, reporting either the first failure (reader) or every
 // failure with its stable message id (validator). Private to the container library.

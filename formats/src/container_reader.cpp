@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reader: random access to the sections of a container, checked against untrusted input.
 #include <glintbake/format/container.h>
 

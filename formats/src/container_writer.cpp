@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writer: streams sections into a temporary file, then writes index and header and renames.
 #include <glintbake/format/atomic_file.h>
 #include <glintbake/format/container.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Content hashes: XXH3-64 for checksums, XXH3-128 for provenance (Collet, xxHash, XXH3 variant).
 #include <glintbake/format/container.h>
 

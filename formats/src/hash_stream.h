@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Incremental XXH3-64 (for the whole-file checksum, which the writer computes while streaming
 // sections out and the reader verifies in chunks). Private to the container library.
 #pragma once

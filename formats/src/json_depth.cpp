@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // jsonNestingDepth: one scan over the text, skipping strings and their escapes.
 #include <glintbake/format/json_depth.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Byte offsets of the on-disk structures (formats/SPEC.md, "Header" and "Section index"), and
 // little-endian load/store helpers. Private to the container library.
 #pragma once

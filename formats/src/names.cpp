@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stable names of status codes, asset kinds, section types and codecs (used in messages, JSON and
 // metadata; kind and type names come from the registry, kinds.h), and the magic test.
 #include "layout.h"

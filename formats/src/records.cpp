@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Record status names and the binary16 codec.
 #include <glintbake/format/binary16.h>
 #include <glintbake/format/records.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // validate(): runs every check of formats/SPEC.md ("Validation") and reports each finding with
 // its stable id. Structural checks are shared with Reader::open() (container_parse.cpp).
 #include <glintbake/format/json_depth.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image output through OpenImageIO: atomic (temporary file + rename) and byte-reproducible.
 #include <glintbake/bake/io/image_io.h>
 
@@ -61,6 +62,10 @@ bool isFloatImagePath(const std::string& path) {
 
 BakeStatus writeImage(const std::string& path, int width, int height, int channels, const float* pixels,
                       const ImageWriteOptions& options) {
+  if (path == "-") {
+    return makeError(ErrorCode::kBadArgument,
+                     "images cannot be written to standard output ('-'): name a file (.exr, .png, ...)");
+  }
   if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || pixels == nullptr) {
     return makeError(ErrorCode::kBadArgument, path + ": cannot write a " + std::to_string(width) + "x" +
                                                   std::to_string(height) + "x" + std::to_string(channels) + " image");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading normal maps and height fields from image files through OpenImageIO.
 //
 // Decoding: integer files store n = 2 c / max - 1; float files are

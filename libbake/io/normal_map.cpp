@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The in-memory normal map: wrap-mode texel fetch, and the renormalisation and repair shared by
 // every way a map enters the library (files, raw pixels, generated maps).
 #include <glintbake/bake/io/normal_map.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The per-cell LTC fit: the published objective of Heitz et al. 2016 with precomputed sample sets,
 // Nelder-Mead, and a Levenberg-Marquardt polish with Ceres.
 #include "ltc/cell_fit.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private: the per-cell LTC fit (objective, Nelder-Mead, Ceres polish).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deterministic EXR output through the OpenEXR library.
 #include "ltc/exr_writer.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private: deterministic float EXR output (no capture date or other run-dependent attributes),
 // written atomically (temporary file + rename).
 #pragma once

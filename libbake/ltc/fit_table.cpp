@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fitting a whole LTC table: the published fit order and warm starts, parallel over roughness.
 #include <glintbake/bake/ltc/table.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Microfacet BRDFs and linearly transformed cosines: evaluation and sampling.
 #include <glintbake/bake/ltc/ltc.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Multi-scale LTC roughness (Tao et al. 2021): meso roughness from the mean resultant length, the
 // micro/meso combination from a numerical spherical convolution, and Ceres refits of both.
 #include <glintbake/bake/ltc/ltc.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The published two-texture layout of LTC tables, the sphere table, and the table error measure.
 #include <glintbake/bake/ltc/table.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Roughness mips of a normal map: box-filtered unnormalised normals, |b| -> alpha_me -> alpha.
 #include <glintbake/bake/ltc/roughness.h>
 

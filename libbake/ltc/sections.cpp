@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The container sections of ltc-table and roughness assets (formats/SPEC.md 10.2, 10.3).
 #include <glintbake/bake/ltc/roughness.h>
 #include <glintbake/bake/ltc/table.h>

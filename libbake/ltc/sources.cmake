@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # LTC tables (Heitz et al. 2016), multi-scale roughness (Tao et al. 2021) and roughness mips.
 find_package(Ceres REQUIRED CONFIG)
 find_package(OpenEXR REQUIRED CONFIG)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Published-layout LTC tables as image files.
 #include <glintbake/bake/ltc/table.h>
 

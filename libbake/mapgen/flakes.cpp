@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flake maps: periodic Voronoi cells, one normal per cell drawn uniformly (in solid angle) from a
 // cone around z. Nearest sites are found through a uniform grid of bins on the torus.
 #include "mapgen/generators.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Gaussian random surfaces (beckmann and brushed maps): white Gaussian noise circularly convolved
 // with a separable Gaussian kernel, differentiated analytically, with slopes scaled to the target
 // standard deviation by the exact variance of the discrete filter.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The generators behind generateMap(), one per file. Parameters are validated by the caller.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural maps: kind names, parameter validation, dispatch to the generators, and the
 // statistics the tests and the mapgen tool report.
 #include <glintbake/bake/mapgen/mapgen.h>

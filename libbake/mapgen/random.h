@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Counter-based random numbers for the map generators: every value is a pure function of
 // (seed, stream, index), so results do not depend on thread count, scheduling or the standard
 // library (std::normal_distribution differs between implementations; this does not).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scratched maps: a flat base with straight V-groove scratches, rasterised with 4x4 sub-samples
 // per texel on the torus (the map is tileable).
 #include "mapgen/generators.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writing the flakes section of NDF assets (see flakes_section.h).
 #include <glintbake/bake/ndf/flakes_section.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/kinds/ndf_pyramid_blend.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exact bin averages of the reference P-NDF: the integral of every lobe over every bin it reaches
 // (see pndf.h, gaussianRectangleIntegral and binAveragedImage).
 //

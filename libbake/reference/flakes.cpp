@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flakes of a normal map per the flake model of formats/SPEC.md (see flakes.h).
 #include <glintbake/reference/flakes.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private: enumeration of the flakes a footprint sees, shared by every reference entry point so
 // that all of them sum the same lobes in the same order.
 #pragma once

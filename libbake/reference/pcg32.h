@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private: the PCG32 generator (O'Neill 2014, "PCG: A Family of Simple Fast Space-Efficient
 // Statistically Good Algorithms for Random Number Generation", pcg32 = XSH-RR 64/32), and the
 // portable uniform and normal variates built on it. Same sequence on every platform.

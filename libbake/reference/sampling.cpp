@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Importance sampling of the reference P-NDF as a mixture of the footprint's lobes (sampling.h).
 #include <glintbake/reference/sampling.h>
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The reference evaluator (glintbake::reference): the slow, obviously-correct P-NDF every fast path
 # is checked against. Shares no code with libbake/ndf or runtime/.
 glintbake_add_library(reference
@@ -7,4 +8,5 @@ glintbake_add_library(reference
           ${CMAKE_CURRENT_LIST_DIR}/sampling.cpp
           ${CMAKE_CURRENT_LIST_DIR}/glitter.cpp
   PUBLIC_DEPS glintbake::bake
+  COMPONENT bake
   PRIVATE_DEPS TBB::tbb)

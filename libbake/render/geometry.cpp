@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera rays, object intersection and pixel footprints.
 #include <glintbake/bake/render/geometry.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image loading, error metrics, heat maps and display previews.
 #include <glintbake/bake/render/image_compare.h>
 

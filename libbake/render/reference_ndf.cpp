@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference P-NDF of one footprint as an NdfSource.
 #include "reference_ndf.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference P-NDF of one footprint behind the runtime's NdfSource interface, so that the
 // renderer's BRDF code is the same for every --ndf mode. The lobes (glintbake::reference,
 // footprintLobes) are gathered at construction; every query ignores its footprint argument and

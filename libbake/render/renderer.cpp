@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Direct lighting of one object with the glinty microfacet BRDF, over image tiles.
 #include <glintbake/bake/render/renderer.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scene JSON parsing and validation (schemas/scene.schema.json).
 #include <glintbake/bake/render/scene.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CP decomposition drivers: the three methods, extrapolation with restart, error-target rank
 // search and the parallel batch.
 #include <glintbake/bake/tensor/cp_decomposition.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sweep kernels of CP-ALS and HALS with a dimension tree (Kolda & Bader 2009, sec. 3.4; Phan et
 // al. 2013, "Fast alternating LS algorithms for high order CANDECOMP/PARAFAC tensor
 // factorizations"): the two large contractions are single-threaded Eigen GEMMs, everything else is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The sweep kernels of CP-ALS and HALS over one B x B x K tensor stored K x (B*B) row-major
 // (private to libbake/tensor). See cp_decomposition.h for the method.
 #pragma once

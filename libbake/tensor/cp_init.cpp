@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deterministic starts (HOSVD, seeded random) and the randomised mode-3 range finder.
 #include "cp_init.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Starting points of the CP decompositions and the mode-3 range finder (private to libbake/tensor).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sweep and contraction timing for the CP benchmark.
 #include <glintbake/bake/tensor/cp_profile.h>
 

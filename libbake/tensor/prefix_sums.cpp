@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-block summed-area tables of CP factor columns.
 #include <glintbake/bake/tensor/prefix_sums.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A small portable generator for the seeded parts of the CP decomposition (random starts and the
 // range finder): SplitMix64 (Steele et al. 2014), identical on every platform.
 #pragma once

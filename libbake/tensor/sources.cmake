@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # CP tensor decomposition of angular NDF block groups (Deng et al. 2022), factor prefix sums, and the
 # tensor-ndf packer that compresses a footprint pyramid group by group.
 list(APPEND GLINTBAKE_BAKE_SOURCES

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // NDF-like and exact low-rank group tensors for tests and benchmarks.
 #include <glintbake/bake/tensor/synthetic_groups.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Entry points of the tensor-ndf packer: option checks, packing while the pyramid is built from a
 // normal map, and packing an ndf-pyramid container chunk by chunk.
 #include <glintbake/bake/tensor/tensor_pack.h>

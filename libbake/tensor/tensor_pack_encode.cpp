@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Compression and encoding of one tensor-ndf group: CP decomposition, column rebalancing, storage
 // rounding, prefix sums of the stored values and the error of the stored model.
 #include "tensor/tensor_pack_internal.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Private pieces of the tensor-ndf packer (bake/tensor/tensor_pack.h): the compression and
 // encoding of one group, and the streaming sink that cuts regions into groups.
 #pragma once

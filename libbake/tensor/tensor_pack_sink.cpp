@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The streaming half of the tensor-ndf packer: cuts each region of the pyramid into blocks, drops
 // the blank ones, compresses the rest as one group on the TBB pool and writes the finished groups,
 // the level indexes and the info record in a fixed order.

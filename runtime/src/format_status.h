@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Maps container reader and record-check status codes onto runtime status codes (internal to the
 // runtime).
 #pragma once

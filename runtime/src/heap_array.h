@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Owning heap array of the runtime: allocation failure is reported, never thrown, and storage is
 // aligned to a cache line (a rank-16 float row of a CP factor then spans exactly one line instead
 // of straddling two). Internal to the runtime.

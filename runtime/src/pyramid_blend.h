@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Query helpers shared by every pyramid-shaped asset (ndf-pyramid, tensor-ndf; formats/SPEC.md
 // 10.1), internal to the runtime: the footprint argument check, the bin of an s-plane point, and
 // the trilinear footprint blend (glintbake/format/kinds/ndf_pyramid_blend.h).

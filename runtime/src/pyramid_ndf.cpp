@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The shared surface of pyramid-shaped NDF assets: opening, level records, footprint range and
 // map geometry, and the argument checks of every query (pyramid_ndf.h).
 #include <glintbake/runtime/pyramid_ndf.h>

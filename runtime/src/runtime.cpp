@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/runtime/runtime.h>
 
 namespace glintbake::runtime {

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared helpers for the command-line tests: run a tool, check its exit code and stderr, validate
 --json output against the schemas in schemas/, and check that failures leave no output behind.
 

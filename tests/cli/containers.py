@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Containers written directly from formats/SPEC.md by a second, independent writer (if these
 files validate, the spec is complete), including hostile ones: any codec, any declared raw size,
 and zstd frames built by hand from RLE blocks (RFC 8878) that record any content size. XXH3-64

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The command-line contract every tool keeps: --help, --version, bad arguments, exit codes,
 depfiles driving make, and determinism across thread counts."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintinfo: info, validate, diff and export on containers written here directly from
 formats/SPEC.md (a second, independent writer: if these files validate, the spec is complete),
 on the frozen 1.0 files, and on damaged copies."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintquery: point, image and batch queries on ndf-pyramid and tensor-ndf assets through the runtime."""
 
 import json

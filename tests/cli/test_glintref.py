@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintref: the reference P-NDF evaluator. Schema-valid --json for ndf, image and sample; the flat
 map's analytic Gaussian; images consistent with point values and byte-identical for every thread
 count; seeded samples; the documented exit codes for bad files and arguments, with nothing left

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Procedural glitter: glintref glitter and tensorpack --procedural glitter (schema-valid --json, hierarchy equal to explicit
 enumeration, D near the smooth NDF for large N, the same answer twice) and ndfgen --procedural
 glitter (a pyramid glintinfo validates and glintquery reads, a glitter asset, byte-identical for

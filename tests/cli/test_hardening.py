@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Hostile conditions a studio's unattended CI meets: a file-size limit (ulimit -f) on every writer,
 a depfile that cannot be written, containers whose declared sizes would cost gigabytes, deeply
 nested metadata and batch lines holding NUL bytes. Each must give a one-line error, the documented

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ltcfit: table/eval/multiscale/roughness outputs, --json against the schemas, exit codes,
 atomic failures and byte-identical outputs for any -j. Tables are small here (--size 8/16) to keep
 CI fast; the full 64 x 64 timing lives in bench/bench_ltc.cpp."""

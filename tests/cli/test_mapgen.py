@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """mapgen: every kind writes a readable map, --json follows its schema, output bytes are
 reproducible (two runs, -j1 vs -j2), and bad arguments or unwritable outputs fail cleanly."""
 

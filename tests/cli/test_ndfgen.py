@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ndfgen: the footprint pyramid of NDF images. Schema-valid --json, the container it writes, the
 documented exit codes for bad input with nothing left behind, and byte-identical output for
 every thread count."""

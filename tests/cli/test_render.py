@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintref render and compare: the --json summaries against their schemas, the asset against the
 reference at the pyramid's centres, a white furnace in every mode, determinism for a seed and any
 -j, every object and light type, and the documented errors."""

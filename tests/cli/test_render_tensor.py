@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """glintref render on tensor-ndf assets (tensorpack): the renders approach the reference as the CP
 rank rises (rank 32 closer than 16, 16 closer than 8), both against the reference P-NDF and against
 the uncompressed pyramid the tensors compress."""

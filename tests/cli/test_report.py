@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The HTML report (scripts/make-report.py) on a small example map, checked in a real headless
 browser: the page loads and every <img> decodes (the page's script records the counts on <body>),
 including the NDF images side by side and the SVG plots of NDF error against the footprint."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """tensorpack: tensor-ndf assets from normal maps and ndf-pyramid containers. Schema-valid --json,
 the default output name, byte-identical output for every thread count and run, and the documented
 exit codes for bad arguments and bad input with nothing left behind."""
@@ -173,9 +174,12 @@ class TensorPack(ToolTestCase):
         self.assertEqual(len(lines), 1)
         self.assertIn(doc["warnings"][0], lines[0])
         self.assertTrue(os.path.exists(bad))
-        # --quiet drops the stderr line (the reporter's convention for warnings); --json keeps it.
+        # --quiet keeps the warning on stderr; -qq drops it (the reporter's convention); --json keeps it.
         out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
                                "--quiet")
+        self.assertEqual(len(self.warnings_on_stderr(err)), 1)
+        out, err = self.run_ok("tensorpack", *NOEXACT, m, "-o", bad, *PYRAMID, "--rank", "1", "--block", "16", "--json",
+                               "-qq")
         self.assertEqual(self.warnings_on_stderr(err), [])
         self.assertEqual(len(json.loads(out)["warnings"]), 1)
         # A missed --error-target warns whatever the default bound says.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact content of the frozen version-1.0 containers in this directory. Shared by the
 // generator (run once, by hand, when the files were created) and by frozen_test.cpp.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact content of the frozen version-1.0 containers of every asset kind (one file per kind,
 // formats/SPEC.md section 10): their records are spelt out here byte by byte from the SPEC's
 // tables (offsets and widths), not from the structs, so a change of a record's layout fails the

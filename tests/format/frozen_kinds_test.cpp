@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reads the frozen 1.0 container of every asset kind and pins its SPEC section 10 records: the
 // section bytes equal the encodings of frozen_kinds.h (written from the SPEC's field tables), the
 // record structs of formats/include/glintbake/format/kinds/ read the same fields, and every

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The runtime reads the frozen 1.0 container of every kind it knows and answers from the frozen
 // records exactly (frozen_kinds.h).
 #include <glintbake/runtime/glitter_ndf.h>

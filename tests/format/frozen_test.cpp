@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reads the frozen 1.0 containers and checks their exact content (README.md: never regenerated).
 #include <glintbake/format/container.h>
 #include <glintbake/format/validate.h>

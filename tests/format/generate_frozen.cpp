@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes the frozen containers. Run ONCE per set, when the set is introduced; never to "update"
 // existing files (see README.md). Not part of the build:
 //   c++ -std=c++17 -I formats/include generate_frozen.cpp -L<build>/formats -lglintbake_format ...

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: the container validator and reader on arbitrary bytes. Calls the same
 // validate() as `glintinfo validate`, then the reader path a runtime uses (open, read every
 // section). Any crash, sanitizer report, or leak is a bug.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: the JSON inputs on arbitrary text, as the tools meet them: container metadata
 // through validateMetadata() (what `glintinfo validate` runs), and a glintquery batch line through
 // the same guards the batch command applies before parsing (NUL bytes, nesting depth), then

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: every runtime NDF asset open path (ndf-pyramid, tensor-ndf, with or without
 // flakes) on arbitrary, re-sealed container bytes, then every query on the opened asset at
 // footprints inside, at the edge of and far outside its map. Any crash, sanitizer report, leak or

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared by the container fuzz targets: recomputes the index, file and header checksums
 // (formats/SPEC.md 2.1) of mutated bytes, so that mutations reach the checks behind the checksums
 // instead of stopping at a checksum mismatch.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Pearson chi-square goodness-of-fit test of a sampler against its (bin-integrated) density, in the
 // style of Mitsuba 3's ChiSquareTest: histogram the samples into cells, compare with the expected
 // counts, pool the cells whose expected count is small, and turn the statistic into a p-value with

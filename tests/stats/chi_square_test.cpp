@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The chi-square helper itself: the incomplete gamma function against tabulated chi-square
 // quantiles, pooling of small cells, and the verdicts on known-good and known-bad histograms.
 #include "chi_square.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Chi-square tests of the reference P-NDF sampler (reference::samplePndf) against the reference
 // bin-averaged NDF image (reference::binAveragedImage): the two are written independently (mixture
 // sampling vs exact Gaussian rectangle integrals), so agreement checks both. Flat and rough

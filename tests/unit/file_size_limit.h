@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helper: lowers the soft file-size limit (RLIMIT_FSIZE) for a scope with SIGXFSZ ignored, so
 // writes past the limit fail with EFBIG as they do in a tool under `ulimit -f`.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A temporary directory private to this test process. CTest runs the tests of one program as
 // separate processes in parallel, so fixed file names under ::testing::TempDir() would collide.
 #pragma once

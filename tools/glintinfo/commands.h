@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo subcommands: inspect (info), check (validate), compare (diff) and extract (export)
 // glintbake containers. Each command registers its CLI11 subcommand and runs when selected.
 #pragma once

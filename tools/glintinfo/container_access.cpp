@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "container_access.h"
 #include <glintbake/cli/exit_codes.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Opening containers for glintinfo: status-to-exit-code mapping and one-line error messages that
 // name the file and the first problem the validator finds.
 #pragma once

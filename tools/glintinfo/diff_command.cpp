@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo diff: compares two containers section by section, matched by (type, key). Image-like
 // sections are compared by metrics against tolerances, metadata as JSON (ignoring the generator
 // version), everything else byte for byte.

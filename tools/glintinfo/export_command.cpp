@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo export: writes one layer of an image-like section as an EXR/PNG/... image.
 #include <glintbake/cli/exit_codes.h>
 #include "commands.h"

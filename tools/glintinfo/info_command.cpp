@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo info: header, section table and metadata of a container.
 #include "commands.h"
 #include "container_access.h"

@@ -1,9 +1,13 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo: inspects, validates, compares and exports glintbake containers.
 #include "commands.h"
 
 int main(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("glintinfo", "Inspects, validates, compares and exports glintbake containers (.gbk)");
+  tool.addExample("glintinfo info brushed.gbk", "Print the header, the sections and the metadata of an asset.");
+  tool.addExample("glintinfo validate --json brushed.gbk", "Check every rule of the specification; messages with stable ids as JSON.");
+  tool.addExample("glintinfo diff old.gbk new.gbk", "Compare two containers section by section (exit code 7 when they differ).");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();

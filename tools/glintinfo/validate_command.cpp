@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintinfo validate: every check of formats/SPEC.md with stable message ids.
 #include "commands.h"
 #include "container_access.h"

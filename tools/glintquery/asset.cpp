@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Opening the asset and parsing the footprint options shared by the glintquery commands.
 #include "commands.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery batch: JSON-lines queries on stdin, one JSON answer per line on stdout
 // (schemas/glintquery-batch.schema.json).
 #include "commands.h"

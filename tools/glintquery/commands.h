@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery subcommands: P-NDF queries on a baked NDF asset through the runtime (point, image,
 // batch). Each command registers its CLI11 subcommand and runs when selected.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery image: the blended NDF image the runtime sees for one footprint, as an image file.
 #include "commands.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery: answers P-NDF queries on a baked NDF asset (ndf-pyramid or tensor-ndf) through the
 // runtime-lite, exactly as a renderer would see them: point values, the blended image of a
 // footprint, and JSON-lines batches of point, range, sample, pdf and mass queries.
@@ -7,6 +8,8 @@ int main(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("glintquery",
                  "Queries baked NDF assets (ndf-pyramid, tensor-ndf) through the runtime (point, image, batch)");
+  tool.addExample("glintquery point brushed.gbk --at 64,64 --sigma 4 --s 0.1,0", "The P-NDF density of one footprint at one s-plane point.");
+  tool.addExample("glintquery image brushed.gbk --at 64,64 --sigma 4 -o ndf.exr", "The NDF image the runtime blends for that footprint.");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
   app.fallthrough();

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintquery point: the P-NDF value at one s-plane point.
 #include "commands.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref subcommands: the reference P-NDF of a normal map at one point (ndf), as a bin-averaged
 // image (image) and as samples (sample); a renderer of scenes with that P-NDF, a baked asset or a
 // smooth BRDF (render), and image comparison (compare). Each command registers its CLI11 subcommand and runs when

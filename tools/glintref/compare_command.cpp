@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref compare: error metrics of a render against a reference render, and an error heat map.
 #include "commands.h"
 

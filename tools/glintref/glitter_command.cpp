@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref glitter: the discrete microfacet NDF of a procedural glitter surface (Jakob et al.
 // 2014; formats/SPEC.md 10.6) for one uv box and one direction cone, by the counting hierarchy
 // with the paper's split rule for this query, or by explicit enumeration of every facet.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref image: the bin-averaged NDF image of a footprint (each bin the exact average of D over
 // the bin), written as a 1-channel float EXR or, for viewing, a PNG normalised by its maximum.
 #include <glintbake/cli/exit_codes.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref ndf: the reference P-NDF D(s) at one point of the s-plane.
 #include "commands.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared options, validation, loading and report fields of the glintref commands (query.h).
 #include "query.h"
 

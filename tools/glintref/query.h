@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every glintref command evaluates: a normal map, its flakes at a sub-sampling rate, a
 // Gaussian footprint and the intrinsic roughness. Parsing, validation (exit code 1 with a one-line
 // message) and the shared parts of the --json reports.

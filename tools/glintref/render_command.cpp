@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref render: a small CPU renderer of one object under direct lighting, with the P-NDF from
 // the reference evaluator, a baked asset through the runtime, or a smooth analytic BRDF
 // (libbake/render; scene format: schemas/scene.schema.json).

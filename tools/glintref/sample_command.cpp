@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintref sample: samples of a footprint's P-NDF (lobe by weight, then the lobe's normal
 // Gaussian), as CSV (file or stdout) or inside the --json document.
 #include "commands.h"

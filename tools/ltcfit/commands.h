@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ltcfit subcommands: each registers its options on a CLI11 subcommand and runs when selected.
 #pragma once
 

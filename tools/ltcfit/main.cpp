@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: Apache-2.0
 // ltcfit: LTC tables for area lights (Heitz et al. 2016), their fit error, multi-scale roughness
 // relations (Tao et al. 2021) and per-normal-map roughness mips.
 #include "commands.h"
 
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/ingest_options.h>
 
 #include <glintbake/format/container.h>
@@ -10,9 +12,11 @@
 
 namespace glintbake::ltcfit {}  // namespace glintbake::ltcfit
 
-int main(int argc, char** argv) {
+int glintbake::cli::ltcfitMain(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("ltcfit", "Fits LTC tables for area lights and bakes multi-scale roughness");
+  tool.addExample("ltcfit table --brdf ggx --size 64 -o ggx.gbk", "Fit a 64 x 64 GGX table for area lights.");
+  tool.addExample("ltcfit roughness map.png -o map-rough.exr", "Bake the per-texel roughness mips of a normal map (mipmapped EXR).");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
 

@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: Apache-2.0
 // ltcfit table and ltcfit eval.
 #include "commands.h"
 
+#include <glintbake/cli/embed.h>
 #include <glintbake/format/container.h>
 
 #include <algorithm>
@@ -36,7 +38,7 @@ int runTable(cli::Tool& tool, const TableArgs& args) {
   const bake::ltc::FittedTable fitted = unwrap(bake::ltc::fitTable(options, [&](int done) {
     std::lock_guard<std::mutex> lock(mutex);
     if (done > reported) progress->advance(uint64_t(done - reported)), reported = done;
-  }));
+  }, cli::cancelFlag()));
   progress->finish();
   const bake::ltc::PublishedTable published = bake::ltc::packPublished(fitted);
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mapgen: writes procedural microstructure normal maps with known statistics (flat, beckmann,
 // brushed, scratches, flakes), deterministic by seed; see libbake mapgen/mapgen.h for the models.
 #include <glintbake/bake/io/image_io.h>
@@ -64,6 +65,8 @@ int main(int argc, char** argv) {
   int max_size = kDefaultMaxSize;
   int png_bits = 16;
   bool half = false;
+  tool.addExample("mapgen brushed -o brushed.png --size 512", "A 512 x 512 brushed-metal normal map.");
+  tool.addExample("mapgen flakes -o flakes.exr --cone 15 --seed 7", "A flake map with normals within 15 degrees of the surface normal.");
   CLI::App& app = tool.app();
   app.add_option("kind", kind_name, "Map kind: " + bake::mapKindList())->required();
   app.add_option("-o,--output", output, "Output image: .exr (signed float RGB), .png or .tif ((n+1)/2, 16-bit)")
@@ -102,6 +105,8 @@ int main(int argc, char** argv) {
                                               std::to_string(params.size) +
                                               (params.size > max_size ? " (raise the limit with --max-size)" : ""));
     }
+    if (output == "-")
+      throw Error(cli::kExitBadArguments, "images cannot be written to standard output ('-'): name a .exr, .png or .tif file");
     const std::string ext = bake::imageExtension(output);
     if (ext != "exr" && ext != "png" && ext != "tif" && ext != "tiff") {
       throw Error(cli::kExitBadArguments, "output " + output + " must end in .exr, .png or .tif");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ndfgen: bakes the multi-level footprint pyramid of NDF images of a normal map into an
 // ndf-pyramid container (libbake/ndf/pyramid_builder.h; layout in formats/SPEC.md). With
 // --procedural glitter the images come from a procedural glitter surface instead of a map
@@ -6,6 +7,7 @@
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
@@ -67,7 +69,7 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
     const bake::glitter::GlitterImageSource source(model, opt.splat.ndf_res, opt.sigma0);
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback());
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     asset["ndf_res"] = opt.splat.ndf_res;
@@ -111,13 +113,16 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int glintbake::cli::ndfgenMain(int argc, char** argv) {
   cli::Tool tool("ndfgen", "Bakes the footprint pyramid of P-NDF images of a normal map (ndf-pyramid asset)");
   std::string input, output;
   bake::IngestOptions ingest;
   cli::PyramidCliOptions pyramid;
   const bake::ndf::PyramidOptions& opt = pyramid.options;
   int zstd_level = 3;
+  tool.addExample("ndfgen brushed.png -o brushed.gbk", "Bake the footprint pyramid of a normal map.");
+  tool.addExample("ndfgen brushed.png -o brushed.gbk --ndf-res 32 --depfile brushed.gbk.d -q", "Smaller NDF images, a depfile for make or ninja, warnings only.");
+  tool.addExample("ndfgen --procedural glitter -o glitter.gbk", "The pyramid of a procedural glitter surface instead of a map.");
   CLI::App& app = tool.app();
   app.add_option("map", input, "Normal map (or height field with --height); none with --procedural");
   app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();
@@ -146,7 +151,7 @@ int main(int argc, char** argv) {
 
     bake::ndf::PyramidReport report;
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback());
+    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tensorpack: compresses the footprint pyramid of NDF images of a normal map (built on the fly) or of
 // an ndf-pyramid container into a tensor-ndf asset: per region and level, the non-blank B x B
 // angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md
@@ -6,6 +7,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/cli/container_output.h>
+#include <glintbake/cli/embed.h>
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
@@ -310,13 +312,14 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
   if (in.source) {
     cli::LevelProgress progress(t);
     s = tensor::packTensorNdfFromSource(*in.source, o.pyramid.options, o.pack, out.writer(), &report,
-                                        progress.callback());
+                                        progress.callback(), cli::cancelFlag());
     progress.finish();
   } else if (in.from_container) {
-    s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report);
+    s = tensor::packTensorNdfFromPyramid(in.reader, o.pack, out.writer(), &report, cli::cancelFlag());
   } else {
     cli::LevelProgress progress(t);
-    s = tensor::packTensorNdfFromMap(in.map, o.pyramid.options, o.pack, out.writer(), &report, progress.callback());
+    s = tensor::packTensorNdfFromMap(in.map, o.pyramid.options, o.pack, out.writer(), &report, progress.callback(),
+                                     cli::cancelFlag());
     progress.finish();
   }
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
@@ -440,11 +443,13 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int glintbake::cli::tensorpackMain(int argc, char** argv) {
   cli::Tool tool(
       "tensorpack",
       "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
   Options o;
+  tool.addExample("tensorpack brushed.png -o brushed-t.gbk", "Bake and compress a normal map into a tensor-ndf asset in one step.");
+  tool.addExample("tensorpack brushed.gbk --rank 16 --strict", "Compress an ndf-pyramid asset; fail if the fit misses its error bound.");
   addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -101,6 +101,10 @@ Json recordJson(const format::TinyExampleRecord& r) {
 
 int main(int argc, char** argv) {
   cli::Tool tool("tinyexample", "Bakes a tiny example's multi-scale NDF maps and placement (tiny-example asset)");
+  tool.addExample("tinyexample brushed.exr --crop 64,64,32 --type tiled --rotate 90 -o tiled.gbk",
+                  "A 32 x 32 crop tiled over the plane, rotated by 90 degrees.");
+  tool.addExample("tinyexample flake.png --type stochastic --rotate-range 0,360 --density 0.3 --seed 5 -o sparse.gbk",
+                  "Randomly rotated copies of the example covering 30% of the plane.");
   std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G";
   double rotate = 0.0, density = 1.0, sigma_r = 0.005;
   bool rotate_given = false, mirror = false;

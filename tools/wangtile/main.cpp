@@ -138,6 +138,10 @@ void addTile(TileTotals& s, const wang::WangTileNdfReport& r, size_t bytes, bool
 int main(int argc, char** argv) {
   cli::Tool tool("wangtile",
                  "Bakes a Wang tile set from an example normal map into a wang-tiles asset for unbounded surfaces");
+  tool.addExample("wangtile scratches.png -o floor.gbk --atlas floor_tiles.exr",
+                  "A 16-tile set (two colours per edge) and an image of its tiles side by side.");
+  tool.addExample("wangtile scratches.png -o floor.gbk --tile-size 128 --colors 3 --json",
+                  "81 smaller tiles; the summary (seams, sizes, times) as JSON.");
   Options o;
   addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks of the flakes section record (see kinds/flakes.h).
 #include <glintbake/format/kinds/flakes.h>
 

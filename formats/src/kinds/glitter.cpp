@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks of the glitter records (see kinds/glitter.h).
 #include <glintbake/format/kinds/glitter.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The discrete stochastic microfacet surface of glitter assets (see kinds/glitter_model.h).
 #include <glintbake/format/kinds/glitter_model.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ndf-level record check (formats/SPEC.md 10.1).
 #include <glintbake/format/kinds/ndf_pyramid.h>
 

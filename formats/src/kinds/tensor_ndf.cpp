@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tensor-ndf record checks (formats/SPEC.md 10.4).
 #include <glintbake/format/kinds/tensor_ndf.h>
 

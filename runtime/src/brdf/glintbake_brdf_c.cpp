@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The C API over brdf.h and sg.h.
 #include <glintbake/runtime/brdf.h>
 #include <glintbake/runtime/glintbake_brdf_c.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Analytic microfacet distributions, Smith shadowing, Fresnel and the P-NDF microfacet BRDF.
 #include <glintbake/runtime/brdf.h>
 

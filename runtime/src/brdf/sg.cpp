@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spherical Gaussian lights: evaluation, integral, support, half-vector range and prefiltering.
 #include <glintbake/runtime/sg.h>
 

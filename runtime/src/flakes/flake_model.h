@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The flake model shared by the runtime's exact and clustered evaluators (formats/SPEC.md 10.5;
 // internal to the runtime): flake k at fine position u_k has normal n_k, the bilinear interpolation
 // of the texels' (n_x, n_y) at u_k, and Jacobian J_k, central differences of that interpolant one

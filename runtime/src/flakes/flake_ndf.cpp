@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact small-footprint P-NDF from a normal map's flakes (see flake_ndf.h).
 #include <glintbake/runtime/flake_ndf.h>
 

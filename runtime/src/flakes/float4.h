@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Four float lanes for the flake evaluator's inner loop (internal to the runtime): one SSE2
 // register where the target has it, a plain array elsewhere. Every operation is the same IEEE
 // single-precision operation lane by lane in both forms (no fused multiply-add, exp4 written out

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Integrals of a correlated 2D Gaussian over rectangles and grids of bins (internal to the
 // runtime's flake evaluator): analytic in x given y (the conditional is a 1D Gaussian), composite
 // 8-point Gauss-Legendre in y on panels no wider than the scale on which the integrand changes.

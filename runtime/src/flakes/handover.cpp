@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The flakes section loader and the flakes-to-pyramid hand-over (see handover.h).
 #include "handover.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Loading the flakes section of an NDF asset and answering footprints across the hand-overs from
 // the flakes to the clustered lobes and to the asset's pyramid (internal to the runtime;
 // formats/SPEC.md 10.5). With f = flakes_up_to, a = kLobesBand f, b = lobes_up_to, p = pyramid_from:

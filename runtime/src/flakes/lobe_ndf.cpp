@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Clustered position-normal lobes for mid-size footprints (see lobe_ndf.h).
 #include <glintbake/runtime/lobe_ndf.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/format/kinds/glitter.h>
 #include <glintbake/runtime/glitter_ndf.h>
 #include "../format_status.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // C API of the runtime-lite LTC area lights.
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ltc_c.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite LTC polygon integration: transform, clip to the horizon, integrate edge by edge.
 #include <glintbake/runtime/ltc.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite LTC table: loading an ltc-table container and bilinear lookups.
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ltc.h>

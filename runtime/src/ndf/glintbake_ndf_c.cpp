@@ -1,8 +1,13 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/runtime/glintbake_ndf_c.h>
+#include <glintbake/runtime/ndf_asset.h>
 #include <glintbake/runtime/ndf_source.h>
+#include <glintbake/runtime/version.h>
 
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string_view>
 
@@ -15,7 +20,8 @@ using glintbake::runtime::SPoint;
 using glintbake::runtime::SRect;
 
 struct gb_ndf_asset {
-  std::unique_ptr<glintbake::runtime::NdfSource> source;
+  glintbake::runtime::NdfAsset asset;
+  const glintbake::runtime::NdfSource* source = nullptr;  // asset.source()
   int32_t kind = 0;
 };
 
@@ -28,16 +34,42 @@ Footprint footprint(double x, double y, double sigma) {
   f.sigma = sigma;
   return f;
 }
-// Wraps an opened NDF source in a handle; the kind code is the source's container kind.
-int32_t wrapAsset(gb_ndf_asset** out, RuntimeStatus opened, std::unique_ptr<glintbake::runtime::NdfSource> source) {
-  if (opened != RuntimeStatus::kOk) return code(opened);
+// Opens an asset into a new handle, explaining a failure in *error when given.
+template <typename Open>
+int32_t openHandle(gb_ndf_asset** out, gb_open_error* error, Open open) {
+  if (error) {
+    error->status = GB_OK;
+    error->message_id = 0;
+    error->message[0] = '\0';
+  }
   gb_ndf_asset* a = new (std::nothrow) gb_ndf_asset();
-  if (!a) return GB_OUT_OF_MEMORY;
-  a->kind = int32_t(source->kind());
-  a->source = std::move(source);
+  if (!a) {
+    if (error) {
+      error->status = GB_OUT_OF_MEMORY;
+      std::snprintf(error->message, sizeof(error->message), "%s", "out of memory");
+    }
+    return GB_OUT_OF_MEMORY;
+  }
+  glintbake::runtime::OpenError detail;
+  const RuntimeStatus s = open(a->asset, &detail);
+  if (s != RuntimeStatus::kOk) {
+    delete a;
+    if (error) {
+      error->status = code(detail.status);
+      error->message_id = detail.message_id;
+      std::memcpy(error->message, detail.message, sizeof(error->message));
+      error->message[sizeof(error->message) - 1] = '\0';
+    }
+    return code(s);
+  }
+  a->source = a->asset.source();
+  a->kind = int32_t(a->asset.kind());
   *out = a;
   return GB_OK;
 }
+
+static_assert(sizeof(gb_open_error::message) == glintbake::runtime::OpenError::kMessageCapacity,
+              "gb_open_error and OpenError hold messages of one size");
 
 // The C kind codes are the registry's asset kinds (formats/include/glintbake/format/kinds.h).
 static_assert(GB_KIND_NDF_PYRAMID == int(glintbake::format::AssetKind::kNdfPyramid) &&
@@ -69,22 +101,51 @@ const char* gb_status_string(int32_t status) {
   return glintbake::runtime::statusString(RuntimeStatus(status));
 }
 
-int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) {
-  if (!out) return GB_INVALID_ARGUMENT;
-  *out = nullptr;
-  if (!path) return GB_INVALID_ARGUMENT;
-  std::unique_ptr<glintbake::runtime::NdfSource> source;
-  const RuntimeStatus opened = glintbake::runtime::openNdfAsset(path, &source);
-  return wrapAsset(out, opened, std::move(source));
+void gb_version(int32_t* major, int32_t* minor, int32_t* patch) {
+  const glintbake::runtime::Version v = glintbake::runtime::version();
+  if (major) *major = v.major;
+  if (minor) *minor = v.minor;
+  if (patch) *patch = v.patch;
 }
 
-int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out) {
+const char* gb_version_string(void) { return glintbake::runtime::versionString(); }
+
+const char* gb_kind_name(int32_t kind) {
+  if (kind < 0) return "unknown";
+  return glintbake::format::assetKindString(glintbake::format::AssetKind(uint32_t(kind)));
+}
+
+int32_t gb_ndf_asset_open_ex(const char* path, gb_ndf_asset** out, gb_open_error* error) {
   if (!out) return GB_INVALID_ARGUMENT;
   *out = nullptr;
-  if (!data) return GB_INVALID_ARGUMENT;
-  std::unique_ptr<glintbake::runtime::NdfSource> source;
-  const RuntimeStatus opened = glintbake::runtime::openNdfAssetMemory(data, size, &source);
-  return wrapAsset(out, opened, std::move(source));
+  return openHandle(out, error, [&](glintbake::runtime::NdfAsset& asset, glintbake::runtime::OpenError* detail) {
+    return asset.open(path, detail);
+  });
+}
+
+int32_t gb_ndf_asset_open_memory_ex(const void* data, size_t size, gb_ndf_asset** out, gb_open_error* error) {
+  if (!out) return GB_INVALID_ARGUMENT;
+  *out = nullptr;
+  return openHandle(out, error, [&](glintbake::runtime::NdfAsset& asset, glintbake::runtime::OpenError* detail) {
+    return asset.openMemory(data, size, detail);
+  });
+}
+
+int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out) { return gb_ndf_asset_open_ex(path, out, nullptr); }
+
+int32_t gb_ndf_asset_open_memory(const void* data, size_t size, gb_ndf_asset** out) {
+  return gb_ndf_asset_open_memory_ex(data, size, out, nullptr);
+}
+
+int32_t gb_ndf_asset_metadata(const gb_ndf_asset* a, char* buffer, size_t capacity, size_t* length) {
+  if (!a || (capacity > 0 && !buffer)) return GB_INVALID_ARGUMENT;
+  const size_t n = a->asset.metadataSize();
+  if (length) *length = n;
+  if (capacity == 0) return GB_OK;
+  const size_t copied = n < capacity ? n : capacity - 1;
+  std::memcpy(buffer, a->asset.metadataJson(), copied);
+  buffer[copied] = '\0';
+  return copied == n ? GB_OK : GB_INVALID_ARGUMENT;
 }
 
 void gb_ndf_asset_close(gb_ndf_asset* asset) { delete asset; }

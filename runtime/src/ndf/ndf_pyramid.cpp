@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/format/container.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include "../format_status.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Opening any NDF asset kind through the NdfSource interface, chosen by the container's kind; the
 // file is opened once and the chosen kind loads from the same reader.
 #include <glintbake/format/container.h>

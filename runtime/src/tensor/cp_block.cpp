@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Blended queries on CP-compressed blocks: rank-R products, prefix-sum range sums and the
 // quadtree sampler (Deng et al. 2022, sec. 4.3).
 #include <glintbake/runtime/cp_block.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Rank sums of the CP queries with four independent accumulators (term r goes to lane r % 4).
 // Float addition is not associative, so a plain loop is compiled as one chain of dependent scalar
 // additions; four lanes let the compiler keep the partial sums in one SIMD register. The order of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Queries of tensor-ndf assets: the NdfPyramid blend over centres and levels, reduced per block to
 // a CpMix (cp_block.h) of its (group, row, weight) terms.
 #include "tensor_ndf_impl.h"

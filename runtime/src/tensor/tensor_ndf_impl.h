@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal state of TensorNdf, shared by its loader (tensor_ndf_load.cpp) and its queries
 // (tensor_ndf.cpp). Not installed.
 #pragma once

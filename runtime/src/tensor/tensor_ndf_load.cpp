@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Loading and validation of tensor-ndf assets (formats/SPEC.md section 10.4): the info record,
 // the level records, every group (float16 factors widened), every index entry, and the raw block
 // masses the sampler chooses blocks by.

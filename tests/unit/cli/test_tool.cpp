@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tests of the shared command scaffolding: exit codes, atomic outputs, depfiles, metadata.
 #include <glintbake/cli/tool.h>
 

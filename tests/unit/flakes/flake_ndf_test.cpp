@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlakeNdf (runtime) against the reference evaluator: eval, image, mass and average equal the
 // reference to float rounding; samples follow their pdf (chi-square) and pdf == eval / mass.
 #include <glintbake/bake/mapgen/mapgen.h>

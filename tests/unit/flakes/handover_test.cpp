@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Assets with a flakes section (formats/SPEC.md 10.5) through openNdfAsset: the flakes answer small
 // footprints exactly, the pyramid large ones, and the band between blends them with sample, pdf,
 // eval and mass consistent; a flakes section of another map is refused.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LobeNdf (runtime) against the exact flakes: a lobe of one flake is that flake (so level 0, where
 // every flake keeps its own lobe, is exact but for the window), clustered levels stay close, a
 // flat map gives the intrinsic Gaussian, a rotated map rotates the NDF, samples follow their pdf

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // AtomicFile: nothing at the path before commit(), nothing left on failure, a failed write under a
 // file-size limit is an error (EFBIG) and keeps the previous file.
 #include <glintbake/format/atomic_file.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writer/Reader round trips, streaming, random access, codecs and temporary-file handling.
 #include <glintbake/format/container.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Hostile and damaged containers: every single-byte flip, every truncation, reader limits,
 // version rules and hand-crafted inconsistent indexes. Nothing may crash or read out of bounds,
 // and nothing damaged may read back as different data without an error.

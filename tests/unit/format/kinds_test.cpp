@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The kind and section-type registry (kinds.h): names, ranges and the rules derived from it, and
 // its agreement with the tables of formats/SPEC.md sections 3 and 4.
 #include <glintbake/format/container.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers of the container tests: a scratch directory per test, whole-file reads and writes, and
 // a small container built in memory.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // validate(): message ids for each family, metadata hand checks, image-section checks.
 #include <glintbake/format/container.h>
 #include <glintbake/format/validate.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The counting hierarchy of glitter surfaces (format/kinds/glitter_model.h): conservation at every
 // split, agreement with explicit enumeration, additivity, determinism, the integral table, and
 // convergence to the smooth NDF as N grows.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The glitter asset through the runtime (GlitterNdf, openNdfAsset): record checks, pdf / eval /
 // mass consistency, a chi-square test of its sampler, and glitter pyramids baked by the pyramid
 // builder passing the tests normal-map pyramids pass (integral 1, chi-square of the sampler).

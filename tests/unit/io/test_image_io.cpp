@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image output: values survive a round trip, files appear atomically, bytes are reproducible.
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/io/normal_map.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Normal-map ingest: every file encoding, channel layouts, height fields, wrap modes, repairs and
 // failures. Inputs are written with OIIO directly into a scratch directory.
 #include <glintbake/bake/io/normal_map.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The shared ingest options: parsing, range checks (bad values are argument errors, exit 1),
 // canonical JSON, and the loader's mapping of library errors to exit codes.
 #include <glintbake/bake/io/image_io.h>

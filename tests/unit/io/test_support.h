@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers of the io tests: a scratch directory per test, and raw image writing through OIIO so the
 // inputs do not depend on the code under test.
 #pragma once

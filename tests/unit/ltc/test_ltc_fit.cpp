@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LTC table fitting: the LTC integrates to the tabulated norm, the runtime's polygon integral of a
 // hemisphere-sized light equals it, rectangles match a Monte Carlo integral of the BRDF, and the
 // fit is deterministic for any thread count.

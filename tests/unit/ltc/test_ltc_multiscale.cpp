@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Multi-scale roughness relations (Tao et al. 2021): eq. 4 against quadrature, the limits and the
 // clamp of alpha_me(|b|), and the refits against the paper's formula on the same ground truth.
 #include <glintbake/bake/ltc/multiscale.h>

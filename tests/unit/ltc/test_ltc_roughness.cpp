@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Roughness mips: a flat map keeps alpha_micro at every level, a bumpy map gets rougher at coarser
 // levels, the bake is deterministic, and the EXR holds every mip level.
 #include <glintbake/bake/ltc/roughness.h>

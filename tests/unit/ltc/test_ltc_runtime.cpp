@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite LTC: polygon integration against quadrature, winding, clipping, lookups, loading
 // from containers (including malformed ones) and the C API.
 #include <glintbake/format/container.h>

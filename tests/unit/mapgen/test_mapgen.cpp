@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural maps: determinism, the statistics each kind promises, and parameter validation.
 #include <glintbake/bake/mapgen/mapgen.h>
 

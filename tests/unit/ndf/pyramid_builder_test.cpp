@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The streamed pyramid: geometry, section layout, determinism across thread counts.
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>

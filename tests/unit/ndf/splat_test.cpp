@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The fast splatted NDF images against the reference evaluator and against the physical
 // invariants: flat map = bin-averaged Gaussian, unit mass on wrapped maps, rotation/mirror
 // equivariance.

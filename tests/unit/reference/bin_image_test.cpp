@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bin-averaged NDF images of the reference: the rectangle integral, the flat-map Gaussian,
 // normalisation, orientation under rotation and mirroring, and agreement with point evaluation.
 #include <glintbake/reference/pndf.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flake construction: positions, normals and Jacobians exactly per the flake model (SPEC.md).
 #include <glintbake/reference/flakes.h>
 

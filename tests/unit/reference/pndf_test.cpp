@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The per-flake closed form and the point evaluation of the reference P-NDF.
 #include <glintbake/reference/pndf.h>
 

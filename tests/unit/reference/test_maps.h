@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Small procedural normal maps for the reference tests (built in memory, no files).
 #pragma once
 

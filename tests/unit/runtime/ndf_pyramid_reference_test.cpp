@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A baked pyramid read back through the runtime, against the reference evaluator: exact at the
 // centres, and the interpolation error between centres measured and printed.
 #include <glintbake/bake/mapgen/mapgen.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // NdfPyramid on hand-made containers: exact centre values, trilinear weights, range averages,
 // sampling (pdf consistency and a chi-square test), the C API, and malformed assets.
 #include <glintbake/format/container.h>

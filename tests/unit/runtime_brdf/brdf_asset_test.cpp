@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The microfacet BRDF on a baked P-NDF (ndf-pyramid assets through NdfSource): the s-plane to
 // solid-angle conversion against the flat map's analytic lobe, a white furnace of a flat-map
 // asset, reciprocity, and sampling (chi-square, sample pdf == pdf()).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The analytic parts of the microfacet BRDF: normalisation of D, the weak white furnace, energy,
 // reciprocity, Fresnel limits, and sampling (chi-square and pdf agreement).
 #include <glintbake/runtime/brdf.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spherical Gaussian lights: integral, support cone, half-vector rectangle, sampling and the
 // prefiltered shading against a Monte Carlo reference.
 #include <glintbake/runtime/sg.h>

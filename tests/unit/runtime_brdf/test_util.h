@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared helpers of the BRDF tests: a counter-based generator and a chi-square test of a
 // direction sampler against its density on the sphere (Mitsuba 3's ChiSquareTest, simplified).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Chi-square tests of the CP block sampler (the runtime's counterpart of tests/stats): binned
 // sample counts against the (clamped) model values and against pdf(); a deliberately mismatched
 // sampler must fail.

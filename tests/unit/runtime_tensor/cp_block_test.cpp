@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime CP block queries: point values, prefix-sum range averages, and the exact agreement of
 // sample() and pdf(); the departures of plain (signed) CP from the identities are measured.
 #include <glintbake/runtime/cp_block.h>

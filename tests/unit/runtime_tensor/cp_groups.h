@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test fixtures for the runtime CP queries: compressed groups decomposed from NDF-like tensors,
 // with their prefix sums and runtime views.
 #pragma once

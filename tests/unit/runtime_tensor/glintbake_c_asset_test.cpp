@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The C API's generic NDF asset handle: the same answers as the C++ classes for both asset kinds,
 // kinds reported, and errors for missing files, other kinds and bad arguments.
 #include <glintbake/runtime/glintbake_ndf_c.h>

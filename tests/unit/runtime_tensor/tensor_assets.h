@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test fixtures for the tensor-ndf runtime: small assets packed from procedural maps (built once
 // per test program and kept in memory), reconstruction of a centre's image straight from the
 // factors, and an ndf-pyramid holding those reconstructions (to compare blending with NdfPyramid).

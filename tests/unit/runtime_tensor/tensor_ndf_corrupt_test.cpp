@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TensorNdf on malformed assets: truncated files, bad records, out-of-range index entries, wrong
 // section sizes, non-finite factors, plus a mutation loop over the tensor sections. Every case
 // must give an error status (or, for harmless mutations, an asset whose queries stay sane), never

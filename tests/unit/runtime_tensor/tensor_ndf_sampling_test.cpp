@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TensorNdf sampling: the density sample() reports equals pdf() bit for bit, a chi-square test of
 // the samples against pdf(), and a histogram of 10^6 samples against the eval() image.
 #include "../../stats/chi_square.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TensorNdf queries: values at pyramid centres against the factors, trilinear blending against
 // NdfPyramid on the reconstructed images, range averages against the mean of eval(), and the
 // agreement of pdf * mass with eval() (non-negative assets) or its measured gap (plain CP).

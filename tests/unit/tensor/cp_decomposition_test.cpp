@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CP decomposition: recovery, error identities, rank behaviour, determinism, the fast default
 // against 500 plain sweeps, non-negativity and the error-target rank search.
 #include <glintbake/bake/tensor/cp_decomposition.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Prefix sums of factor columns: entries are the nearest floats to the exact partial sums, and
 // range sums of rank-1 terms factorise.
 #include <glintbake/bake/tensor/prefix_sums.h>

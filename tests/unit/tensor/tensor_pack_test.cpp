@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tensor-ndf packer: error against the uncompressed pyramid per map kind and rank, blank
 // dropping, index consistency, float16 factors, error-target mode, identical bytes from a map and
 // from an ndf-pyramid container, and for any thread count.

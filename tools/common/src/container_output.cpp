@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/cli/container_output.h>
 
 #include <cstring>
@@ -7,6 +8,9 @@ namespace glintbake::cli {
 
 ContainerOutput::ContainerOutput(Tool& tool, const std::string& path, format::AssetKind kind, int zstd_level)
     : tool_(tool), kind_(kind), path_(path) {
+  // A container is written with seeks (index, checksums): no stream can hold it.
+  if (path == "-")
+    throw Error(kExitBadArguments, "a container cannot be written to standard output ('-'): name a .gbk file");
   const format::ContainerStatus status = writer_.open(path, kind, zstd_level);
   if (status != format::ContainerStatus::kOk) {
     throw Error(kExitIo, "cannot create " + path + ": " + reason(status));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The normal-map ingest options shared by every tool that reads a normal map, their canonical JSON
 // form, and the loader that maps library errors to exit codes.
 #include <glintbake/cli/exit_codes.h>
@@ -18,7 +19,8 @@ void addIngestOptions(CLI::App& app, bake::IngestOptions& options) {
   app.add_option("--encoding", options.encoding,
                  "How stored values map to normals: auto (float files with negative values are signed, "
                  "everything else is (n+1)/2), unorm ((n+1)/2), snorm (values are n)")
-      ->transform(CLI::CheckedTransformer(kEncodings))
+      ->transform(CLI::CheckedTransformer(kEncodings).description(""))
+      ->type_name("auto|unorm|snorm")
       ->default_str(bake::encodingString(options.encoding))
       ->group(group);
   app.add_flag("--flip-green", options.flip_green, "Negate n_y (DirectX maps, green down)")->group(group);
@@ -29,7 +31,8 @@ void addIngestOptions(CLI::App& app, bake::IngestOptions& options) {
       ->check(CLI::PositiveNumber)
       ->group(group);
   app.add_option("--wrap", options.wrap, "How the map continues beyond its edges: repeat or clamp")
-      ->transform(CLI::CheckedTransformer(kWraps))
+      ->transform(CLI::CheckedTransformer(kWraps).description(""))
+      ->type_name("repeat|clamp")
       ->default_str(bake::wrapString(options.wrap))
       ->group(group);
   app.add_option("--part", options.part, "Part (subimage) of a multi-part file to read (>= 0)")

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/pyramid_options.h>
 

@@ -37,7 +37,10 @@ void addTensorPackOptions(CLI::App& app, TensorCliOptions& o, const std::string&
                  "Store the levels above the finest whose NDF images take at most this many MiB (and 16 x 16 centres) "
                  "(float32) exactly instead of compressed (0..1024; 0: compress every level)")
       ->capture_default_str();
-  app.add_option(seed_name, opt.cp.seed, "Seed of the randomised steps of the CP methods")->capture_default_str();
+  app.add_option(seed_name, opt.cp.seed,
+                 "Seed of the randomised steps of the CP methods (any integer; equal seeds give identical files)")
+      ->default_str("fixed")
+      ->type_name("INT");
   app.add_option("--zstd-level", o.zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Output files that appear at their path only when complete: the one write path of every glintbake
 // writer (containers, images, tables, depfiles).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // IEEE 754 binary16 ("half") conversion, the one codec every writer and reader of float16 section
 // data uses (tensor-ndf factors, formats/SPEC.md 10.4).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // glintbake container: reading and writing versioned, sectioned asset files (.gbk).
 //
 // The byte layout is normative in formats/SPEC.md. This header is the whole public API of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Nesting depth of untrusted JSON text, measured before it is parsed: every JSON input of glintbake
 // (container metadata, scenes, batch query lines) is refused when nested deeper than
 // kMaxJsonDepth (container.h), because parsing, printing and destroying a document recurse once

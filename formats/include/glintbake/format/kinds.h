@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The registry of asset kinds and section types: the one table every name, range, validator rule,
 // C API kind code and metadata string derives from (formats/SPEC.md sections 3 and 4 list the same
 // rows; tests/unit/format/kinds_test.cpp checks that they agree).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the record checks of formats/include/glintbake/format/kinds/*.h report: one status type for
 // every kind's records, and the text of the rule that failed.
 #pragma once

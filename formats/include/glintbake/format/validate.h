@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Full validation of a container: every structural rule of formats/SPEC.md, every section's
 // checksum and decoding, image-section headers, the whole-file checksum and the metadata section.
 // The same function serves `glintinfo validate` and the fuzzer (tests/fuzz/fuzz_container.cpp).

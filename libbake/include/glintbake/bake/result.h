@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Error reporting of the baking library: functions that can fail on input data return
 // Result<T> (a value or an Error); programmer errors are caught by GLINTBAKE_CHECK.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flakes of the reference evaluator: the per-texel (or per sub-sample) 4D Gaussian elements of a
 // normal map, built exactly as the "Flake model" of formats/SPEC.md defines them (Yan et al. 2016,
 // "Position-Normal Distributions for Efficient Rendering of Specular Microstructure", section 4).

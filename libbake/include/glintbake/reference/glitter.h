@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Brute-force glitter (formats/SPEC.md 10.6): every facet of a small surface generated explicitly
 // from the hierarchy down to its leaves, and the smooth distribution it converges to. The checks
 // of the counting queries (format::glitterCount) against explicit enumeration.

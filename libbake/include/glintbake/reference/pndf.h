@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference P-NDF: the position-normal distribution of a normal map seen through a Gaussian
 // pixel footprint, evaluated by summing the closed-form contribution of every flake
 // (Yan et al. 2016, section 5; the closed form is written out below).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Importance sampling of the reference P-NDF, for chi-square tests of the evaluator and of every
 // fast sampler.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A microfacet reflection BRDF whose normal distribution D is the P-NDF of a pixel footprint (any
 // NdfSource: ndf-pyramid, tensor-ndf, ...), or, for the look without glints, an analytic GGX or
 // Beckmann distribution (Walter et al. 2007, "Microfacet Models for Refraction through Rough

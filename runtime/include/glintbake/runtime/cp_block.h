@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Constant-cost queries on CP-compressed angular NDF blocks (Deng et al. 2022, "Constant-Cost
 // Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG, sec. 4.3), the core that the
 // tensor-ndf asset wraps.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact P-NDF of small footprints, evaluated from the flakes of a normal map (Yan et al. 2016,
 // "Position-Normal Distributions for Efficient Rendering of Specular Microstructure", sections 4-5).
 //

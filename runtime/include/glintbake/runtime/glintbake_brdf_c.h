@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 /* C API of the glintbake microfacet BRDF and spherical Gaussian environment prefiltering
  * (brdf.h, sg.h), for engines that do not link C++ directly.
  *
@@ -12,6 +13,8 @@
 
 #include <stdint.h>
 
+#include <glintbake/runtime/c_api.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -19,8 +22,8 @@ extern "C" {
 /* The P-NDF a BRDF uses as D: any NDF asset kind the runtime reads (ndf-pyramid, tensor-ndf),
  * opened by its container kind. A handle of its own, so that this header stands alone. */
 typedef struct gb_brdf_ndf gb_brdf_ndf;
-int32_t gb_brdf_ndf_open(const char* path, gb_brdf_ndf** out);
-void gb_brdf_ndf_close(gb_brdf_ndf* ndf); /* NULL is allowed */
+GLINTBAKE_C_API int32_t gb_brdf_ndf_open(const char* path, gb_brdf_ndf** out);
+GLINTBAKE_C_API void gb_brdf_ndf_close(gb_brdf_ndf* ndf); /* NULL is allowed */
 
 enum { GB_MODEL_GGX = 0, GB_MODEL_BECKMANN = 1 };
 enum { GB_FRESNEL_NONE = 0, GB_FRESNEL_SCHLICK = 1, GB_FRESNEL_CONDUCTOR = 2 };
@@ -39,12 +42,12 @@ typedef struct gb_brdf_params {
   double k[3];     /* conductor IOR, imaginary part */
 } gb_brdf_params;
 
-int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]);
+GLINTBAKE_C_API int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]);
 /* Samples wi (via the NDF) from two uniforms in [0, 1). *pdf = 0 marks a discarded sample;
  * weight = f cos(theta_i) / pdf. */
-int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double u1, double u2, double wi[3],
+GLINTBAKE_C_API int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double u1, double u2, double wi[3],
                        double* pdf, double weight[3]);
-int32_t gb_brdf_pdf(const gb_brdf_params* params, const double wi[3], const double wo[3], double* pdf);
+GLINTBAKE_C_API int32_t gb_brdf_pdf(const gb_brdf_params* params, const double wi[3], const double wo[3], double* pdf);
 
 /* A spherical Gaussian light a exp(lambda (mu . v - 1)), mu unit, lambda > 0, a per channel. */
 typedef struct gb_sg {
@@ -54,11 +57,11 @@ typedef struct gb_sg {
 } gb_sg;
 
 /* cos(theta_max) of the cone where G >= eps (-1: whole sphere); *empty = 1 when eps > max(a). */
-int32_t gb_sg_support(const gb_sg* sg, double eps, double* cos_theta_max, int32_t* empty);
+GLINTBAKE_C_API int32_t gb_sg_support(const gb_sg* sg, double eps, double* cos_theta_max, int32_t* empty);
 /* Integral of G over the sphere per channel. */
-int32_t gb_sg_integral(const gb_sg* sg, double integral[3]);
+GLINTBAKE_C_API int32_t gb_sg_integral(const gb_sg* sg, double integral[3]);
 /* The prefiltered radiance towards wo of the SG light reflected by the BRDF (sg.h). */
-int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps, const double wo[3],
+GLINTBAKE_C_API int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps, const double wo[3],
                                   double radiance[3]);
 
 #ifdef __cplusplus

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite reader of glitter assets (formats/SPEC.md 10.6): a procedural surface of N discrete
 // microfacets (Jakob et al. 2014) answering NDF queries through NdfSource, with no stored facets.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The P-NDF of mid-size footprints from clustered position-normal lobes: a hierarchy over tiles
 // of a normal map's flakes in which every tile keeps a few 4D Gaussians in (position, normal) that
 // stand for all of its flakes (formats/SPEC.md 10.5).

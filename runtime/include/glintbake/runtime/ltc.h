@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite LTC area lights: lookup of a linearly transformed cosine from a fitted table and the
 // integral of that LTC over a polygonal light (Heitz, Dupuy, Hill and Neubelt 2016).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite reader of ndf-pyramid assets (written by ndfgen): NDF images of Gaussian footprints
 // on a multi-level grid of footprint centres (Deng et al. 2022, section 3), queried with the
 // Gaussian footprint blend of formats/SPEC.md 10.1 (glintbake/format/kinds/ndf_pyramid_blend.h).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The query interface every NDF asset kind implements (ndf-pyramid, tensor-ndf, and the kinds that
 // follow), so that a renderer or a tool can work with any of them through one pointer.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The shared surface of pyramid-shaped NDF assets (ndf-pyramid, tensor-ndf, and kinds built on
 // the same footprint pyramid, formats/SPEC.md 10.1): opening a container once, the level records,
 // the footprint range and map geometry, and the argument checks of every query. A kind implements

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite: constant-cost queries on baked glintbake assets. Built without exceptions and
 // RTTI; no allocation per query; const queries are thread-safe.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spherical Gaussian (SG) environment lights and their prefiltered shading with a P-NDF
 // (Deng et al. 2022, environment prefiltering; Wang et al. 2009 for SG lighting).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite reader of tensor-ndf assets (written by tensorpack): the footprint pyramid of
 // ndf-pyramid assets with every NDF image cut into B x B angular blocks stored as rank-R CP models
 // per group (Deng et al. 2022, "Constant-Cost Spatio-Angular Prefiltering of Glinty Appearance

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the exact small-footprint evaluator needs of a surface: the (n_x, n_y) of every texel of a
 // grid, and how the grid continues beyond its edges. A normal map implements it today; a Wang-tile
 // grid or a transformed tiny example supplies its texels through the same interface, so every asset

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The flakes section of NDF assets (formats/SPEC.md 10.5): the normal map a pyramid was baked from,
 // stored so that the runtime evaluates small footprints exactly from its flakes (Yan et al. 2016)
 // instead of from the finest pyramid level.

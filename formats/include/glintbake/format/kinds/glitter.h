@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The glitter asset kind (formats/SPEC.md 10.6): a procedural surface of N discrete microfacets
 // (Jakob et al. 2014, "Discrete Stochastic Microfacet Models") defined by a handful of numbers and
 // the cached integrals of its smooth NDF over the spherical triangles of the direction hierarchy.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The discrete stochastic microfacet surface of glitter assets (formats/SPEC.md 10.6; Jakob et al.
 // 2014): N facets on the unit uv square whose normals follow D(h) cos(theta_h), never stored but
 // generated on demand by a counting hierarchy. The one implementation used by the runtime's

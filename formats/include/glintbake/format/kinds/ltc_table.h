@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sections of ltc-table assets (formats/SPEC.md section 10.2), written by libbake's LTC table
 // writer (ltcfit table), read by the runtime's LtcTable: two image sections of type 48.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Records of ndf-pyramid assets (formats/SPEC.md section 10.1), written by ndfgen and by the
 // tensor-ndf packer, read by the runtime and by the packer. Stored as the raw little-endian bytes
 // of the structs.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The footprint blend of pyramid-shaped assets (formats/SPEC.md 10.1, "Queries"): which stored
 // centres a footprint mixes, and with which weights. The one implementation used by the runtime's
 // queries and by the baker's convergence probe (which predicts what the runtime will answer).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Records of tensor-ndf assets (formats/SPEC.md section 10.4), written by the tensor-ndf packer
 // (libbake, tensorpack), read by the runtime. Stored as the raw little-endian bytes of the structs.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural glitter (discrete stochastic microfacets, Jakob et al. 2014) for the baker: the
 // adaptive table of triangle integrals of the smooth NDF, the surface it defines
 // (format::GlitterSurface, formats/SPEC.md 10.6), the glitter asset writer and the footprint

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image output through OpenImageIO, atomically (format::AtomicFile).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Normal-map ingest: reads tangent-space normal maps (or height fields) through OpenImageIO and
 // turns them into unit normals with a report of what was repaired.
 //

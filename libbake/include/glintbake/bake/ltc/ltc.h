@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Linearly transformed cosines (Heitz, Dupuy, Hill and Neubelt 2016, "Real-Time Polygonal-Light
 // Shading with Linearly Transformed Cosines") and the microfacet BRDFs they approximate.
 //

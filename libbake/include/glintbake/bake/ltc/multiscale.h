@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Multi-scale roughness with LTCs (Tao et al. 2021): the meso-scale roughness of a filtered normal
 // map from the length of its averaged normals, and the overall roughness of micro- and meso-scale
 // roughness combined. Roughness values here are the isotropic LTC / GGX alpha in [0, 1].

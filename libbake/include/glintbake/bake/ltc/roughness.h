@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-texel roughness mips of a normal map for LTC shading (Tao et al. 2021): each mip level holds
 // the overall alpha of the micro-scale alpha and the meso-scale alpha implied by the length |b| of
 // that level's unnormalised averaged normal.

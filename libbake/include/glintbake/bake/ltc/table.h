@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // LTC tables: fitting one linearly transformed cosine per (roughness, view angle) cell, the
 // published texture layout real-time renderers use, and a fit-error measure for any table in that
 // layout (Heitz et al. 2016).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural microstructure normal maps with known statistics, for tests, benchmarks and examples.
 //
 // Every map is periodic (tileable: wrap mode repeat) and a pure function of (kind, params): the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flakes of a normal map: the 4D Gaussian elements of Yan et al. 2016 ("Position-Normal
 // Distributions for Efficient Rendering of Specular Microstructure"), built for the fast NDF path.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The flakes section of NDF assets (formats/SPEC.md 10.5): the normal map a pyramid is baked from,
 // at float32 precision, so that the runtime answers small footprints exactly from its flakes
 // (Yan et al. 2016) and hands over to the pyramid above them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Streams a multi-level pyramid of footprint NDF images (Deng et al. 2022, "Constant-Cost
 // Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition", ACM TOG) into an ndf-pyramid container,
 // or into any PyramidSink.

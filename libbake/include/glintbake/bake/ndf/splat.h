@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fast P-NDF images of Gaussian footprints by splatting flakes into bins (Yan et al. 2016, the
 // per-element closed form of glintbake/reference/pndf.h).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera rays with differentials, ray-object intersection, the shading frame and the texel
 // footprint of a pixel (Igehy 1999, "Tracing Ray Differentials"; pbrt-v4 section 10.1).
 #pragma once

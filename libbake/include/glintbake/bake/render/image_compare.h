@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image comparison for renders (glintref compare) and PNG previews for reports.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The reference renderer of glintref render: direct lighting of one object with a glinty
 // microfacet BRDF (runtime/brdf.h) whose D comes from one of three sources:
 //  - kReference: the exact P-NDF of the normal map (glintbake::reference: the ground truth, slow;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Scenes of the reference renderer (glintref render): one camera, one object, one material and a
 // list of lights, read from a JSON file that follows schemas/scene.schema.json.
 //

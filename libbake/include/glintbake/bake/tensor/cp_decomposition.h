@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CP (CANDECOMP/PARAFAC) compression of groups of angular NDF blocks (Deng et al. 2022,
 // "Constant-Cost Spatio-Angular Prefiltering of Glinty Appearance Using Tensor Decomposition",
 // ACM TOG, sec. 4; algorithms after Kolda & Bader 2009, "Tensor Decompositions and Applications",

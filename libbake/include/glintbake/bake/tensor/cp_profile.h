@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Kernel timing of the CP sweep, for benchmarks: how close a full ALS sweep comes to the cost of
 // its two large contractions (W = C^T X and X (B kr A)), the GEMM-bound floor of a sweep.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // 1D summed-area tables of CP factor columns: the range sum of a rank-1 term over a rectangle of
 // bins is the product of two 1D range sums, so a B x B rectangle average of a CP block costs O(R)
 // (Deng et al. 2022, sec. 4.3).

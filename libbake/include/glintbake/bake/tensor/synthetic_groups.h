@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural group tensors for tests and benchmarks of the CP compression: NDF-like blocks
 // (sparse, peaky, non-negative) and exact low-rank tensors. Seeded and portable: the same seed
 // gives the same floats on every platform with IEEE arithmetic and a correctly rounded exp.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Packs a footprint pyramid of NDF images into a tensor-ndf asset (formats/SPEC.md section 10.4):
 // every image is cut into B x B angular blocks, the non-blank blocks of all centres of one region
 // of one level are stacked into a B x B x K group tensor, and each group is stored as a rank-R CP

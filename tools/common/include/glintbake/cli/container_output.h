@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A container file written by a tool: the format::Writer's temporary file is registered for
 // removal on SIGINT/SIGTERM, removed on any failure, and renamed into place only by finish().
 // Errors become cli::Error with the I/O exit code.

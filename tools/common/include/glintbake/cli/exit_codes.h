@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exit codes (tool.h: kExit*) of the libraries' results, one conversion per layer, and the two
 // helpers every command uses to turn a failed bake result into a cli::Error.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The procedural-surface options of the tools that bake a pyramid (ndfgen, tensorpack), with the
 // same names and defaults: --procedural glitter, --particles, --alpha, --distribution, --glitter-seed,
 // --size, --gamma. A procedural surface replaces the normal map as the source of the NDF images

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The normal-map ingest options every tool that reads a normal map takes, with the same names:
 // --encoding, --flip-green, --height, --height-scale, --wrap, --part, --fix-nonfinite, --max-size.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The NDF pyramid options every tool that bakes a pyramid from a normal map takes, with the same
 // names and defaults (ndfgen, tensorpack): --ndf-res, --sigma-r, --stride, --sigma0, --levels,
 // --converge-mse, --rate, --region; plus the per-level progress bar of a pyramid build.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exit codes of runtime-library failures when a tool opens an asset through the runtime: the
 // conversion lives in exit_codes.h with those of the other layers.
 #pragma once

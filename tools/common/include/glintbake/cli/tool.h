@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared scaffolding of every glintbake command-line tool: exit codes, common options, the
 // reporter, progress, depfiles and atomic outputs. Tools are thin main()s over the libraries:
 //
@@ -23,6 +24,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace glintbake::cli {
@@ -35,6 +37,7 @@ enum ExitCode : int {
   kExitInvalidInput = 3,  // an input file is malformed, corrupt or holds invalid data (NaN, ...)
   kExitRuntime = 4,       // the computation failed (out of memory, did not converge, ...)
   kExitUnsupported = 5,   // valid input this version does not support (newer container major, ...)
+  kExitWarnings = 6,      // --strict: the run gave warnings (its outputs are removed)
   kExitDifferences = 7,   // glintinfo diff / compare found differences beyond tolerance
 };
 
@@ -53,6 +56,8 @@ using Json = nlohmann::ordered_json;
 struct CommonOptions {
   bool json = false;    // --json: machine-readable summary on stdout
   bool quiet = false;   // --quiet: no progress, no informational messages
+  int quiet_level = 0;  // how many times -q/--quiet was given: 2 or more also hides warnings
+  bool strict = false;  // --strict: warnings are errors (exit code 6)
   int threads = 0;      // -j/--threads: 0 = all cores
   std::string depfile;  // --depfile FILE
 };
@@ -72,7 +77,7 @@ class Progress {
 };
 
 // An output file written atomically (format::AtomicFile): write() the bytes, then commit() puts
-// the file in place. Nothing is left behind if commit() is not reached, on a failed write (full
+// the file in place. The path "-" is standard output (the bytes are written on commit()). Nothing is left behind if commit() is not reached, on a failed write (full
 // disk, file-size limit) or on SIGINT/SIGTERM/SIGHUP. Failures throw Error(kExitIo) naming the
 // path and the reason ("File too large").
 class AtomicOutput {
@@ -89,6 +94,8 @@ class AtomicOutput {
  private:
   std::string final_, registered_;
   format::AtomicFile file_;
+  bool to_stdout_ = false;  // "-": standard output
+  std::string buffered_;
 };
 
 // Writes bytes to path through an AtomicOutput (throws Error(kExitIo) on failure).
@@ -117,8 +124,11 @@ class Tool {
 
   // Informational message on stderr (suppressed by --quiet and --json).
   void info(const std::string& message) const;
-  // Warning on stderr (suppressed by --quiet only).
+  // Warning on stderr (printed under --quiet, suppressed by -qq); with --strict the run then
+  // fails with kExitWarnings.
   void warning(const std::string& message) const;
+  // Example command lines shown at the end of --help and in the man page, each with a sentence.
+  void addExample(const std::string& command, const std::string& explanation);
   // Progress bar honouring the terminal check, --quiet and --json.
   std::unique_ptr<Progress> progress(const std::string& label, uint64_t total) const;
   // Prints a JSON document to stdout (indent 2, trailing newline).
@@ -145,6 +155,11 @@ class Tool {
   CLI::App app_;
   CommonOptions common_;
   std::vector<std::string> inputs_, outputs_, input_hashes_;
+  std::vector<std::pair<std::string, std::string>> examples_;
+  mutable size_t warning_count_ = 0;
+  void updateFooter();
+  std::string manPage() const;
+  std::string suggestion(int argc, char** argv) const;
   std::unique_ptr<struct ThreadLimit> thread_limit_;
   mutable bool depfile_written_ = false;
 };

@@ -1,7 +1,11 @@
-// A renderer-side consumer of an installed glintbake: writes a container, reads it back through
-// the installed format library, and links the runtime.
+// SPDX-License-Identifier: Apache-2.0
+// A renderer-side consumer of an installed glintbake (COMPONENTS runtime): writes a container,
+// reads it back through the installed format library, and asks the runtime about it.
 #include <glintbake/format/container.h>
+#include <glintbake/runtime/ndf_asset.h>
 #include <glintbake/runtime/runtime.h>
+#include <glintbake/runtime/version.h>
+#include <glintbake/version.h>
 
 #include <cstdio>
 #include <string>
@@ -27,6 +31,12 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> bytes;
   if (index < 0 || reader.readSection(size_t(index), &bytes) != fmt::ContainerStatus::kOk) return 3;
   if (bytes.size() != payload.size() * sizeof(float)) return 3;
+  // The library linked is the one the headers describe.
+  if (std::string(glintbake::runtime::versionString()) != GLINTBAKE_VERSION_STRING) return 4;
+  // A test container is no NDF asset: the open fails and says why.
+  glintbake::runtime::NdfAsset asset;
+  glintbake::runtime::OpenError error;
+  if (asset.open(argv[1], &error) != glintbake::runtime::RuntimeStatus::kWrongKind || error.message[0] == '\0') return 5;
   std::printf("consumer ok: %s, runtime says '%s'\n", fmt::assetKindString(reader.kind()),
               glintbake::runtime::statusString(glintbake::runtime::RuntimeStatus::kOk));
   return 0;
