@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tiny examples (Xing et al.): the precompute of a 32 x 32 example's tile NDFs at R = 128 (the
 // issue's target: at most 1 s; the paper reports 2.3-72 s), the memory of a 16 x 16 example at
 // R = 128 (raw float32, as the paper's 5.32 MB, and zstd-compressed in the asset), and the cost of

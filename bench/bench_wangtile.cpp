@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wang-tiles assets (formats/SPEC.md 10.7): eval and sample cost for footprints covering 1, 4 and 9
 // tiles of the implicit grid. The asset is GLINTBAKE_WANG_ASSET when set (e.g. a 16-tile set from
 // a 1024^2 example at tile size 256, README "Figures"), otherwise a small set baked here (T = 32).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tiny examples: records, tile images and the asset's sections (see bake/tiny/tiny_example.h).
 #include <glintbake/bake/tiny/tiny_example.h>
 #include <glintbake/runtime/tiny_example_ndf.h>

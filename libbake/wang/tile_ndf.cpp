@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One tile's NDF asset: the footprint pyramid over the tile's square extended by a margin, each
 // image splatting only the tile's own flakes (a clamped map has none outside it), compressed as
 // tensorpack compresses a map's pyramid or stored as an ndf-pyramid.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Wang tile set of an exemplar: edge samples, the four-triangle assembly with minimum-error
 // cuts along the diagonals, and the exact outer rings (see wang/wang.h).
 #include <glintbake/bake/wang/wang.h>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """tinyexample: a schema-valid --json summary, assets glintinfo validates and glintquery reads,
 byte-identical output for -j1 and -j2, and one-line errors with documented exit codes and nothing
 left behind for bad examples and options."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """wangtile: a small tile set baked from a generated example (schema-valid --json, an asset
 glintinfo validates and glintquery answers anywhere on the plane, an atlas image, seams no worse
 than straight cuts, byte-identical output for -j1 and -j2) and one-line errors with documented exit

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tinyexample: bakes the multi-scale tile NDFs of a small normal-map example and its placement
 // (tiled or stochastic) into a tiny-example asset (formats/SPEC.md 10.8; Xing et al., "Tiny
 // example-based procedural microstructures").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // wangtile: bakes an edge-coloured Wang tile set from an example normal map (Cohen et al. 2003)
 // into a wang-tiles asset (formats/SPEC.md 10.7): the tiles' texels, their edge colours and the
 // edge-code-to-tile map, and every tile's NDF pyramid over the tile extended by a margin,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks and placement rules of the tiny-example records (see kinds/tiny_example.h).
 #include <glintbake/format/kinds/tiny_example.h>
 

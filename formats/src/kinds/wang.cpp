@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The wang-tiles records, their checks and the implicit grid rule (see kinds/wang.h).
 #include <glintbake/format/kinds/wang.h>
 

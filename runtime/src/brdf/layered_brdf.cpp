@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Two microfacet layers, f = f_base (1 - F_coat) + f_coat (see layered_brdf.h).
 #include <glintbake/runtime/layered_brdf.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tiny-example assets (formats/SPEC.md 10.8): loading, the tile images, the traversal of the
 // examples a footprint reaches and the NdfSource queries over the tiles it keeps.
 #include <glintbake/runtime/tiny_example_ndf.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wang-tiles assets: loading the tile set and each tile's NDF asset, and answering footprints as
 // sums over the tiles they cover (see wang_ndf.h).
 #include <glintbake/runtime/wang_ndf.h>

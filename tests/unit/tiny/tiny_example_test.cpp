@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tiny-example assets (formats/SPEC.md 10.8): tile NDFs against the reference evaluator, the
 // tiled surface against the reference on the materialised map, the physics of the transforms,
 // the stochastic layout, sampling against eval, and the record checks.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wang tiles: exact shared edges, the clamped tiles continuing as the grid does, the implicit grid
 // against the same region materialised as one map (reference evaluator and splatter), tile
 // frequencies, the sampler (chi-square, footprints straddling a corner), the clamp of large

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The CP compression options shared by tensorpack and wangtile (see tensor_options.h).
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/tensor_options.h>

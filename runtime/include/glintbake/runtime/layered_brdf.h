@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A layered material of two microfacet BRDFs (brdf.h), each with its own NDF.
 #pragma once
 

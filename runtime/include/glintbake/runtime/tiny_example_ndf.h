@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runtime-lite reader of tiny-example assets (formats/SPEC.md 10.8): one small example with its
 // multi-scale tile NDFs, placed over the unbounded plane, after Xing et al., "Tiny example-based
 // procedural microstructures".

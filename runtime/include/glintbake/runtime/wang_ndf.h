@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The NDF of an unbounded surface tiled by Wang tiles on an implicit hashed grid (formats/SPEC.md
 // 10.7; Cohen et al. 2003, Lagae and Dutre 2005, Deng et al. 2022 section 5.5).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tiny-example asset kind (formats/SPEC.md 10.8): one small normal-map example with its
 // multi-scale tile NDFs, placed procedurally over the unbounded plane (Xing et al., "Tiny
 // example-based procedural microstructures"). The records, their checks and the placement rules

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The wang-tiles asset kind (formats/SPEC.md 10.7): an edge-coloured Wang tile set (Cohen et al.
 // 2003, "Wang Tiles for Image and Texture Generation") laid on an implicit, hashed grid covering the
 // unbounded plane (the corner-hash variant of Lagae and Dutre 2005, "A Procedural Object

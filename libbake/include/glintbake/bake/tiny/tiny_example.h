@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tiny examples (Xing et al., "Tiny example-based procedural microstructures"): the multi-scale
 // tile NDFs of one small normal-map example and the records of its tiny-example asset
 // (formats/SPEC.md 10.8).

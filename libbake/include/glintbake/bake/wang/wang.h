@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wang tiles from an example normal map (Cohen et al. 2003, "Wang Tiles for Image and Texture
 // Generation", section 3) and the per-tile NDF assets of a wang-tiles container (formats/SPEC.md
 // 10.7; Deng et al. 2022 section 5.5).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The compression options of the tools that pack NDF pyramids into CP tensors (tensorpack,
 // wangtile), with the same names and defaults: --rank, --block, --method, --nonneg, --tol,
 // --max-iters, --error-target, --blank-threshold, --precision, --exact-levels, --seed, --zstd-level.
