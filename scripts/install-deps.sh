@@ -10,6 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang  # libFuzzer targets (scripts/fuzz.sh)
+  slurm-wlm slurmctld slurmd slurm-client munge  # the one-node Slurm cluster of tests/slurm
 )
 if [[ "${1:-}" == "--browser" ]]; then
   packages+=(chromium)

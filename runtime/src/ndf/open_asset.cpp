@@ -31,6 +31,8 @@ RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>*
       return loadAs<TensorNdf>(reader, out);
     case format::AssetKind::kGlitter:
       return loadAs<GlitterNdf>(reader, out);
+    case format::AssetKind::kPartial:
+      return RuntimeStatus::kPartialBake;
     default:
       return RuntimeStatus::kWrongKind;
   }
