@@ -14,6 +14,11 @@ SMALL_ARGS = ["--ndf-res", "16", "--region", "2", "--sigma0", "2", "--stride", "
 RUNTIME = 4
 
 
+def read(path):
+    with open(path) as f:
+        return f.read()
+
+
 class GlintBake(ToolTestCase):
     def write_manifest(self, assets, name="m.json", defaults=None):
         doc = {"schema": "glintbake.manifest/1", "defaults": defaults or {"tool": "ndfgen", "options": SMALL},
@@ -88,7 +93,7 @@ class GlintBake(ToolTestCase):
         m = self.write_manifest([{"inputs": ["a.png"], "output": "a.gbk"}])
         dep = self.path("bake.d")
         self.run_ok("glintbake", "bake", m, "--depfile", dep, "--quiet")
-        text = open(dep).read()
+        text = read(dep)
         self.assertIn("a.gbk:", text)
         self.assertIn("m.json", text)
         self.assertIn("a.png", text)
@@ -116,15 +121,15 @@ class GlintBake(ToolTestCase):
         doc = self.run_json("glintbake", "bake", m, "--emit", "slurm", "--emit-dir", jobs,
                             schema="glintbake-bake.schema.json")
         self.assertEqual(doc["tasks"], 5)
-        tasks = open(os.path.join(jobs, "tasks.txt")).read().splitlines()
+        tasks = read(os.path.join(jobs, "tasks.txt")).splitlines()
         self.assertEqual(len(tasks), 5)
         self.assertEqual(sum("--shard" in t for t in tasks), 4)
-        sbatch = open(os.path.join(jobs, "bake.sbatch")).read()
+        sbatch = read(os.path.join(jobs, "bake.sbatch"))
         self.assertIn("#SBATCH --array=0-4", sbatch)
         self.assertIn("logs/task-%a.log", sbatch)
-        merge = open(os.path.join(jobs, "merge.sbatch")).read()
+        merge = read(os.path.join(jobs, "merge.sbatch"))
         self.assertIn("glintinfo merge", merge.replace(os.path.dirname(clitest.tool_path("glintinfo")) + "/", ""))
-        self.assertIn("--dependency=afterok", open(os.path.join(jobs, "submit.sh")).read())
+        self.assertIn("--dependency=afterok", read(os.path.join(jobs, "submit.sh")))
         # Nothing is baked here.
         self.assertFalse(os.path.exists(self.path("a.gbk")))
 

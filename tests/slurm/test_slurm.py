@@ -89,9 +89,9 @@ PartitionName=test Nodes=localhost Default=YES MaxTime=INFINITE State=UP
         self.wait_for(self.node_idle, "the node to be idle")
 
     def spawn(self, argv):
-        log = open(os.path.join(self.root, "log", os.path.basename(argv[0]) + ".out"), "w")
-        self.procs.append(subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, env=self.env,
-                                           start_new_session=True))
+        with open(os.path.join(self.root, "log", os.path.basename(argv[0]) + ".out"), "w") as log:
+            self.procs.append(subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, env=self.env,
+                                               start_new_session=True))
 
     def node_idle(self):
         out = subprocess.run([find("sinfo"), "-h", "-o", "%t"], env=self.env, capture_output=True, text=True)
@@ -181,8 +181,10 @@ class SlurmBake(ToolTestCase):
                                      clitest.file_hash(os.path.join(self.path("local"), name)), name)
             self.assertFalse(os.path.exists(self.path("farm/sharded.gbk.shards")), "parts left behind")
             if killed:
-                logs = "".join(open(os.path.join(self.path("jobs"), "logs", f)).read()
-                               for f in os.listdir(os.path.join(self.path("jobs"), "logs")))
+                logs = ""
+                for name in os.listdir(os.path.join(self.path("jobs"), "logs")):
+                    with open(os.path.join(self.path("jobs"), "logs", name)) as f:
+                        logs += f.read()
                 self.assertIn("attempt 1 failed (exit 137)", logs)
             else:
                 self.fail("the shard finished before it could be killed")
