@@ -5,6 +5,7 @@
 #include <glintbake/format/binary16.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/glitter.h>
+#include <glintbake/format/kinds/partial.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
 #include <glintbake/format/validate.h>
@@ -154,6 +155,19 @@ TEST(FrozenKindsV1_0, Glitter) {
   std::vector<GlitterIntegral> entries(table.size() / sizeof(GlitterIntegral));
   std::memcpy(static_cast<void*>(entries.data()), table.data(), table.size());
   EXPECT_EQ(checkGlitterIntegrals(entries.data(), entries.size()), nullptr);
+}
+
+TEST(FrozenKindsV1_0, Partial) {
+  Reader reader;
+  openFrozen("v1_0_partial.gbk", AssetKind::kPartial, &reader);
+  ASSERT_EQ(reader.sections().size(), 3u);
+  const std::vector<uint8_t> held = section(reader, kSectionShardSection, 1);
+  EXPECT_EQ(held, frozen::shardSection());
+  ShardSectionHeader h;
+  ASSERT_GE(held.size(), sizeof(h));
+  std::memcpy(&h, held.data(), sizeof(h));
+  EXPECT_EQ(checkShardSectionHeader(h, held.size()), nullptr);
+  EXPECT_EQ(section(reader, kSectionShardMetadata, 0), frozen::shardMetadata());
 }
 
 }  // namespace

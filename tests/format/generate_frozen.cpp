@@ -4,6 +4,7 @@
 //   ./a.out v1_0        v1_0_minimal.gbk, v1_0_image.gbk
 //   ./a.out v1_0_kinds  one container per asset kind (frozen_kinds.h)
 //   ./a.out v1_0_glitter  the glitter container (frozen_kinds.h), added with the kind
+//   ./a.out v1_0_partial  the partial container (frozen_kinds.h), added with the kind
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
@@ -65,6 +66,15 @@ int writeGlitter() {
   return 0;
 }
 
+int writePartial() {
+  if (!writeKind("v1_0_partial.gbk", AssetKind::kPartial, "partial", "ndfgen",
+                 {{kSectionShardSection, 1, frozen::shardSection(), Codec::kRaw},
+                  {kSectionShardMetadata, 0, frozen::shardMetadata(), Codec::kZstd}}))
+    return 1;
+  std::puts("wrote v1_0_partial.gbk");
+  return 0;
+}
+
 int writeV1_0() {
   {
     Writer writer;
@@ -96,6 +106,7 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0") == 0) return writeV1_0();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_kinds") == 0) return writeKinds();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_glitter") == 0) return writeGlitter();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_partial") == 0) return writePartial();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_partial\n", stderr);
   return 2;
 }
