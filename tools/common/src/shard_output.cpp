@@ -37,9 +37,37 @@ PyramidShardPlan::PyramidShardPlan(const bake::NormalMap& map, const bake::ndf::
     }
     if (options.levels == 0 && g.grid_width == 1 && g.grid_height == 1) break;
   }
-  if (flakes) costs_.push_back(map_w * map_h);  // one copy of the map, compressed
-  owners_ = bake::shard::assignShards(costs_, shards);
-  if (flakes) flakes_owner_ = owners_.back();
+  // Each level is dealt out on its own (longest first), and its busiest share goes to the shard
+  // with the least work so far: the automatic level count may stop at any level, so every level
+  // the bake reaches must be balanced, not just the sum over the levels it might reach.
+  owners_.assign(costs_.size(), 0);
+  std::vector<double> total(size_t(shards), 0.0);
+  for (size_t l = 0; l < level_base_.size(); ++l) {
+    const std::vector<double> costs(costs_.begin() + long(level_base_[l]),
+                                    costs_.begin() + long(level_base_[l] + level_regions_[l]));
+    const std::vector<int> local = bake::shard::assignShards(costs, shards);
+    std::vector<double> level_load(size_t(shards), 0.0);
+    for (size_t u = 0; u < local.size(); ++u) level_load[size_t(local[u])] += costs[u];
+    std::vector<int> by_level(size_t(shards)), by_total(size_t(shards));
+    for (int i = 0; i < shards; ++i) by_level[size_t(i)] = by_total[size_t(i)] = i;
+    std::stable_sort(by_level.begin(), by_level.end(),
+                     [&](int a, int b) { return level_load[size_t(a)] > level_load[size_t(b)]; });
+    std::stable_sort(by_total.begin(), by_total.end(),
+                     [&](int a, int b) { return total[size_t(a)] < total[size_t(b)]; });
+    std::vector<int> to_global(size_t(shards));
+    for (int k = 0; k < shards; ++k) to_global[size_t(by_level[size_t(k)])] = by_total[size_t(k)];
+    for (size_t u = 0; u < local.size(); ++u) {
+      const int g = to_global[size_t(local[u])];
+      owners_[level_base_[l] + u] = g;
+      total[size_t(g)] += costs[u];
+    }
+  }
+  if (flakes) {  // one copy of the map, compressed: to the least loaded shard
+    costs_.push_back(map_w * map_h);
+    const int least = int(std::min_element(total.begin(), total.end()) - total.begin());
+    owners_.push_back(least);
+    flakes_owner_ = least;
+  }
 }
 
 int PyramidShardPlan::owner(int level, int region) const {

@@ -28,7 +28,9 @@ void resolveShardOption(ShardCliOptions& shard);
 
 // The units of a pyramid bake: every region of every level the bake may reach (levels it stops
 // before hold no sections; every shard knows which), then the flakes section when written. Cost:
-// centres x flakes under one footprint (its truncated extent clipped to the map).
+// centres x flakes under one footprint (its truncated extent clipped to the map). Each level is
+// dealt out longest first on its own (the automatic level count may stop at any level), its
+// busiest share to the shard with the least work so far; the flakes unit to the least loaded.
 class PyramidShardPlan {
  public:
   PyramidShardPlan(const bake::NormalMap& map, const bake::ndf::PyramidOptions& options, bool flakes, int shards);
