@@ -41,20 +41,21 @@ PyramidShardPlan::PyramidShardPlan(const bake::NormalMap& map, const bake::ndf::
   // with the least work so far: the automatic level count may stop at any level, so every level
   // the bake reaches must be balanced, not just the sum over the levels it might reach.
   owners_.assign(costs_.size(), 0);
-  std::vector<double> total(size_t(shards), 0.0);
+  std::vector<double> total(static_cast<size_t>(shards), 0.0);
   for (size_t l = 0; l < level_base_.size(); ++l) {
     const std::vector<double> costs(costs_.begin() + long(level_base_[l]),
                                     costs_.begin() + long(level_base_[l] + level_regions_[l]));
     const std::vector<int> local = bake::shard::assignShards(costs, shards);
-    std::vector<double> level_load(size_t(shards), 0.0);
+    std::vector<double> level_load(static_cast<size_t>(shards), 0.0);
     for (size_t u = 0; u < local.size(); ++u) level_load[size_t(local[u])] += costs[u];
-    std::vector<int> by_level(size_t(shards)), by_total(size_t(shards));
+    const size_t n = static_cast<size_t>(shards);
+    std::vector<int> by_level(n), by_total(n);
     for (int i = 0; i < shards; ++i) by_level[size_t(i)] = by_total[size_t(i)] = i;
     std::stable_sort(by_level.begin(), by_level.end(),
                      [&](int a, int b) { return level_load[size_t(a)] > level_load[size_t(b)]; });
     std::stable_sort(by_total.begin(), by_total.end(),
                      [&](int a, int b) { return total[size_t(a)] < total[size_t(b)]; });
-    std::vector<int> to_global(size_t(shards));
+    std::vector<int> to_global(n);
     for (int k = 0; k < shards; ++k) to_global[size_t(by_level[size_t(k)])] = by_total[size_t(k)];
     for (size_t u = 0; u < local.size(); ++u) {
       const int g = to_global[size_t(local[u])];
