@@ -12,6 +12,7 @@ packages=(
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libgtest-dev libgmock-dev libbenchmark-dev
   clang  # libFuzzer targets (scripts/fuzz.sh)
+  slurm-wlm slurmctld slurmd slurm-client munge  # the one-node Slurm cluster of tests/slurm
 )
 if [[ "${1:-}" == "--browser" ]]; then
   packages+=(chromium)

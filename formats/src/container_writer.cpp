@@ -8,6 +8,7 @@
 
 #include <zstd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +23,38 @@
 namespace glintbake::format {
 
 using namespace layout;
+
+namespace {
+
+// The frame parameters every stored zstd section uses: fixed level, content size recorded, no
+// checksum (the index has one), no dictionary id, single-threaded.
+void setFrameParameters(ZSTD_CCtx* cctx, int zstd_level) {
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, zstd_level);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_dictIDFlag, 0);
+}
+
+// Compresses into `compressed` and returns true when zstd shrinks the data (the stored form is
+// then compressed[0, *stored_size)); false means store the raw bytes. kInvalidArgument on a zstd
+// failure.
+ContainerStatus compressSection(ZSTD_CCtx* cctx, const void* data, size_t size, std::vector<uint8_t>& compressed,
+                                bool* shrinks, size_t* stored_size) {
+  *shrinks = false;
+  *stored_size = size;
+  if (size == 0) return ContainerStatus::kOk;
+  compressed.resize(ZSTD_compressBound(size));
+  const size_t n = ZSTD_compress2(cctx, compressed.data(), compressed.size(), data, size);
+  if (ZSTD_isError(n)) return ContainerStatus::kInvalidArgument;
+  if (n < size) {  // keep zstd only when it shrinks the section
+    *shrinks = true;
+    *stored_size = n;
+  }
+  return ContainerStatus::kOk;
+}
+
+}  // namespace
+
 
 struct Writer::Impl {
   std::string final_path;
@@ -80,12 +113,7 @@ ContainerStatus Writer::open(const std::string& path, AssetKind kind, int zstd_l
   w.open = true;
   w.cctx = ZSTD_createCCtx();
   if (!w.cctx || !w.file_hash.ok()) return w.fail(ContainerStatus::kIoError);
-  // Deterministic frames: fixed level, content size recorded, no checksum (the index has one),
-  // no dictionary id, single-threaded.
-  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_compressionLevel, zstd_level);
-  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_contentSizeFlag, 1);
-  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_checksumFlag, 0);
-  ZSTD_CCtx_setParameter(w.cctx, ZSTD_c_dictIDFlag, 0);
+  setFrameParameters(w.cctx, zstd_level);  // deterministic frames
   // The header is written last; reserve its bytes now (they are not part of the file hash).
   static const uint8_t kZeroHeader[kHeaderSize] = {};
   if (w.file.write(kZeroHeader, kHeaderSize) != ContainerStatus::kOk) return w.fail(ContainerStatus::kIoError);
@@ -98,37 +126,83 @@ ContainerStatus Writer::addSection(uint32_t type, uint64_t key, const void* data
   if (!w.open || w.failed || w.finished) return ContainerStatus::kInvalidArgument;
   if (data == nullptr && size != 0) return ContainerStatus::kInvalidArgument;
   if (codec != Codec::kRaw && codec != Codec::kZstd) return ContainerStatus::kInvalidArgument;
-  if (w.sections.size() >= kMaxSectionCount) return ContainerStatus::kTooLarge;
   if (uint64_t(size) > kDefaultMaxRawSectionSize) return ContainerStatus::kTooLarge;
+  const void* stored = data;
+  size_t stored_size = size;
+  Codec used = Codec::kRaw;
+  if (codec == Codec::kZstd) {
+    bool shrinks = false;
+    if (compressSection(w.cctx, data, size, w.compressed, &shrinks, &stored_size) != ContainerStatus::kOk)
+      return w.fail(ContainerStatus::kInvalidArgument);
+    if (shrinks) {
+      used = Codec::kZstd;
+      stored = w.compressed.data();
+    }
+  }
+  const ContainerStatus st = addStoredSection(type, key, used, size, stored, stored_size);
+  // Release a large compression buffer rather than keep it for the writer's lifetime.
+  if (w.compressed.capacity() > (size_t(64) << 20)) std::vector<uint8_t>().swap(w.compressed);
+  return st;
+}
+
+ContainerStatus Writer::addStoredSection(uint32_t type, uint64_t key, Codec codec, uint64_t raw_size,
+                                         const void* stored, size_t stored_size) {
+  Impl& w = *impl_;
+  if (!w.open || w.failed || w.finished) return ContainerStatus::kInvalidArgument;
+  if (stored == nullptr && stored_size != 0) return ContainerStatus::kInvalidArgument;
+  if (codec != Codec::kRaw && codec != Codec::kZstd) return ContainerStatus::kInvalidArgument;
+  if (codec == Codec::kRaw && raw_size != stored_size) return ContainerStatus::kInvalidArgument;
+  if (w.sections.size() >= kMaxSectionCount) return ContainerStatus::kTooLarge;
+  if (raw_size > kDefaultMaxRawSectionSize) return ContainerStatus::kTooLarge;
   if (type == kSectionMetadata && w.has_metadata) return ContainerStatus::kInvalidArgument;
   if (!w.keys.insert({type, key}).second) return ContainerStatus::kInvalidArgument;  // (type, key) is unique
 
   SectionInfo info;
   info.type = type;
   info.key = key;
-  info.raw_size = size;
-  const void* stored = data;
-  size_t stored_size = size;
-  info.codec = uint32_t(Codec::kRaw);
-  if (codec == Codec::kZstd && size > 0) {
-    w.compressed.resize(ZSTD_compressBound(size));
-    const size_t n = ZSTD_compress2(w.cctx, w.compressed.data(), w.compressed.size(), data, size);
-    if (ZSTD_isError(n)) return w.fail(ContainerStatus::kInvalidArgument);
-    if (n < size) {  // keep zstd only when it shrinks the section
-      info.codec = uint32_t(Codec::kZstd);
-      stored = w.compressed.data();
-      stored_size = n;
-    }
-  }
+  info.raw_size = raw_size;
+  info.codec = uint32_t(codec);
   if (!w.padTo(kSectionAlignment)) return w.fail(ContainerStatus::kIoError);
   info.offset = w.position;
   info.stored_size = stored_size;
   info.checksum = hash64(stored, stored_size);
   if (!w.append(stored, stored_size)) return w.fail(ContainerStatus::kIoError);
-  // Release a large compression buffer rather than keep it for the writer's lifetime.
-  if (w.compressed.capacity() > (size_t(64) << 20)) std::vector<uint8_t>().swap(w.compressed);
   w.sections.push_back(info);
   if (type == kSectionMetadata) w.has_metadata = true;
+  return ContainerStatus::kOk;
+}
+
+SectionEncoder::SectionEncoder(int zstd_level) : level_(std::clamp(zstd_level, 1, 19)) {
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  if (cctx) setFrameParameters(cctx, level_);
+  cctx_ = cctx;
+}
+
+SectionEncoder::~SectionEncoder() {
+  if (cctx_) ZSTD_freeCCtx(static_cast<ZSTD_CCtx*>(cctx_));
+}
+
+ContainerStatus SectionEncoder::encode(const void* data, size_t size, Codec codec, std::vector<uint8_t>* stored,
+                                       Codec* used) {
+  if (!cctx_ || !stored || !used || (data == nullptr && size != 0)) return ContainerStatus::kInvalidArgument;
+  if (codec != Codec::kRaw && codec != Codec::kZstd) return ContainerStatus::kInvalidArgument;
+  if (uint64_t(size) > kDefaultMaxRawSectionSize) return ContainerStatus::kTooLarge;
+  *used = Codec::kRaw;
+  if (codec == Codec::kZstd) {
+    bool shrinks = false;
+    size_t stored_size = size;
+    if (ContainerStatus st =
+            compressSection(static_cast<ZSTD_CCtx*>(cctx_), data, size, *stored, &shrinks, &stored_size);
+        st != ContainerStatus::kOk)
+      return st;
+    if (shrinks) {
+      stored->resize(stored_size);
+      *used = Codec::kZstd;
+      return ContainerStatus::kOk;
+    }
+  }
+  const uint8_t* bytes = static_cast<const uint8_t*>(data);
+  stored->assign(bytes, bytes + size);
   return ContainerStatus::kOk;
 }
 

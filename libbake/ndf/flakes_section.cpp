@@ -60,8 +60,8 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   return h;
 }
 
-BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
-                              const FlakesHandover& handover, uint64_t* bytes) {
+Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
+                                                const FlakesHandover& handover) {
   format::FlakesRecord rec;
   rec.map_width = uint32_t(std::max(map.width, 0));
   rec.map_height = uint32_t(std::max(map.height, 0));
@@ -87,10 +87,18 @@ BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int 
     normals[t * 2 + 0] = map.normals[t * 3 + 0];
     normals[t * 2 + 1] = map.normals[t * 3 + 1];
   }
-  if (format::ContainerStatus s = writer.addSection(format::kSectionFlakes, 0, section.data(), section.size());
+  return section;
+}
+
+BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
+                              const FlakesHandover& handover, uint64_t* bytes) {
+  Result<std::vector<uint8_t>> section = flakesSectionBytes(map, rate, sigma_r, handover);
+  if (!section) return section.error();
+  if (format::ContainerStatus s =
+          writer.addSection(format::kSectionFlakes, 0, section.value().data(), section.value().size());
       s != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, std::string("cannot write the flakes section: ") + format::statusString(s));
-  if (bytes) *bytes = size;
+  if (bytes) *bytes = section.value().size();
   return okStatus();
 }
 

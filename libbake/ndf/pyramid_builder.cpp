@@ -161,6 +161,25 @@ BakeStatus WriterPyramidSink::addChunk(const PyramidChunk& chunk) {
   return okStatus();
 }
 
+BakeStatus ShardPyramidSink::addLevel(const format::NdfLevelRecord& record) {
+  if (format::RecordCheck c = format::checkNdfLevelRecord(record, record.level, record.level > 0 ? &below_ : nullptr);
+      !c) {
+    return makeError(ErrorCode::kRuntime, std::string("level descriptor fails its check: ") + c.detail);
+  }
+  below_ = record;
+  return partial_.add(format::kSectionNdfLevel, uint64_t(record.level), &record, sizeof(record), /*common=*/true);
+}
+
+BakeStatus ShardPyramidSink::addChunk(const PyramidChunk& chunk) {
+  const uint64_t key = format::ndfChunkKey(uint32_t(chunk.level), uint64_t(chunk.region));
+  return partial_.add(format::kSectionNdfChunk, key, chunk.section, chunk.section_bytes);
+}
+
+BakeStatus ShardPyramidSink::skipChunk(int, int) {
+  partial_.skip();
+  return okStatus();
+}
+
 BakeStatus buildNdfPyramid(const NormalMap& map, const PyramidOptions& options, format::Writer& writer,
                            PyramidReport* report, const PyramidProgress& progress, const std::atomic<bool>* cancel) {
   WriterPyramidSink sink(writer);
@@ -220,6 +239,11 @@ class PyramidBuild {
   const float* probedImage(const Level& lv, int centre) const;
   PyramidChunk chunkOf(const Level& lv, int r, std::vector<float>& buf) const;
   void collectSamples(Level& lv, const PyramidChunk& chunk, double* mse_sum) const;
+  bool ownsRegion(const Level& lv, int r) const {
+    return !options_.region_filter || options_.region_filter(lv.level, r);
+  }
+  bool probesNext(const Level& lv) const;
+  void sampleRegion(Level& lv, int r);
 
   const NormalMap& map_;  // geometry only (no normals) when source_ is set
   const FootprintImageSource* source_;
@@ -428,6 +452,46 @@ void PyramidBuild::collectSamples(Level& lv, const PyramidChunk& chunk, double* 
 }
 
 // The region pipeline of one level: region r + 1 is computed while region r is in the sink.
+// Whether probe() will run for the level above lv (the same tests, from the geometry alone).
+bool PyramidBuild::probesNext(const Level& lv) const {
+  if (options_.levels != 0 || lv.next.empty()) return false;
+  if (lv.level < options_.converge_from_level) return false;
+  if (options_.converge_from_grid > 0 && std::max(lv.geo.grid_width, lv.geo.grid_height) > options_.converge_from_grid)
+    return false;
+  return true;
+}
+
+// A region another shard computes: only the images of its centres that the next level's probe
+// predicts from, added to the predictions in the order collectSamples adds them (so the sums are
+// those of the whole bake, bit for bit). Sequential: split footprints share part_acc_.
+void PyramidBuild::sampleRegion(Level& lv, int r) {
+  if (!probesNext(lv)) return;
+  int cx0, cy0, cw, ch;
+  regionExtent(lv, r, &cx0, &cy0, &cw, &ch);
+  std::vector<float> image;
+  for (int k = 0; k < cw * ch; ++k) {
+    const int i = cx0 + k % cw, j = cy0 + k / cw;
+    const int centre = j * lv.geo.grid_width + i;
+    bool needed = false;
+    for (const Sample& smp : lv.next) {
+      for (int q = 0; q < 4; ++q) needed = needed || (smp.below[q] == centre && smp.weight[q] != 0.0);
+    }
+    if (!needed) continue;
+    const float* img = probedImage(lv, centre);
+    if (!img) {
+      image.resize(image_floats_);
+      computeImage(lv, i, j, image.data());
+      img = image.data();
+    }
+    for (Sample& smp : lv.next) {
+      for (int q = 0; q < 4; ++q) {
+        if (smp.below[q] != centre || smp.weight[q] == 0.0) continue;
+        for (size_t b = 0; b < image_floats_; ++b) smp.prediction[b] += smp.weight[q] * double(img[b]);
+      }
+    }
+  }
+}
+
 BakeStatus PyramidBuild::buildLevel(Level& lv) {
   PyramidLevelReport lrep;
   lrep.level = lv.level;
@@ -438,11 +502,18 @@ BakeStatus PyramidBuild::buildLevel(Level& lv) {
   const uint64_t level_images = uint64_t(lv.geo.grid_width) * uint64_t(lv.geo.grid_height);
   uint64_t done = 0;
   double mse_sum = 0.0;
-  computeRegion(lv, 0, 0);
+  if (ownsRegion(lv, 0)) computeRegion(lv, 0, 0);
   for (int r = 0; r < region_count; ++r) {
     if (cancelled()) return cancelError();
+    const bool owns_next = r + 1 < region_count && ownsRegion(lv, r + 1);
+    if (!ownsRegion(lv, r)) {
+      if (BakeStatus s = sink_.skipChunk(lv.level, r); !s) return s;
+      sampleRegion(lv, r);
+      if (owns_next) computeRegion(lv, r + 1, (r + 1) % 2);
+      continue;
+    }
     tbb::task_group next;
-    if (r + 1 < region_count) next.run([&, r] { computeRegion(lv, r + 1, (r + 1) % 2); });
+    if (owns_next) next.run([&, r] { computeRegion(lv, r + 1, (r + 1) % 2); });
     const PyramidChunk chunk = chunkOf(lv, r, buffers_[r % 2]);
     BakeStatus sunk = sink_.addChunk(chunk);
     next.wait();

@@ -24,6 +24,7 @@ bool validRect(const SRect& r) {
 
 RuntimeStatus PyramidNdf::load(const format::Reader& reader) {
   reset();
+  if (reader.kind() == format::AssetKind::kPartial) return RuntimeStatus::kPartialBake;
   if (reader.kind() != kind()) return RuntimeStatus::kWrongKind;
   const RuntimeStatus status = loadKind(reader);
   if (status != RuntimeStatus::kOk) reset();

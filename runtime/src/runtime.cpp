@@ -19,6 +19,8 @@ const char* statusString(RuntimeStatus status) {
       return "invalid argument";
     case RuntimeStatus::kOutOfMemory:
       return "out of memory";
+    case RuntimeStatus::kPartialBake:
+      return "a partial bake (one shard), not an asset: join the shards with glintinfo merge";
   }
   return "unknown status";
 }

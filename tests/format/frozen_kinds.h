@@ -22,6 +22,7 @@ class Bytes {
   Bytes& u32(size_t at, uint32_t v) { return put(at, &v, 4); }
   Bytes& f32(size_t at, float v) { return put(at, &v, 4); }
   Bytes& f64(size_t at, double v) { return put(at, &v, 8); }
+  Bytes& u64(size_t at, uint64_t v) { return put(at, &v, 8); }
   const std::vector<uint8_t>& bytes() const { return bytes_; }
 
  private:
@@ -260,6 +261,22 @@ inline std::vector<uint8_t> wangTileLevel() {
 
 inline std::vector<uint8_t> wangTileChunk() {
   return imageSection(kWangRes, kWangRes, 1, 1, [](uint32_t, uint32_t, uint32_t, uint32_t) { return 0.25f; });
+}
+
+// partial (SPEC 10.9): shard 0 of 2 of a test asset; it holds position 1, an image-typed raw
+// section (key 7) of 8 bytes (two float32: 1, 2).
+inline std::vector<uint8_t> shardSection() {
+  Bytes b(40 + 8);
+  b.u32(0, 0x53484753).u32(4, 0).u32(8, 256).u32(12, 0);
+  b.u64(16, 7).u64(24, 8).u64(32, 8);
+  b.f32(40, 1.0f).f32(44, 2.0f);
+  return b.bytes();
+}
+
+// The merged asset's metadata text the partial carries (section 144).
+inline std::vector<uint8_t> shardMetadata() {
+  const std::string text = kindMetadata("test", "frozen");
+  return std::vector<uint8_t>(text.begin(), text.end());
 }
 
 }  // namespace glintbake::format::frozen

@@ -6,6 +6,7 @@
 #include <glintbake/format/binary16.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/glitter.h>
+#include <glintbake/format/kinds/partial.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
 #include <glintbake/format/kinds/wang.h>
@@ -204,6 +205,19 @@ TEST(FrozenKindsV1_0, TinyExample) {
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 0), frozen::tinyLevel(0));
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1), frozen::tinyLevel(1));
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1).size(), tinyLevelSectionSize(r, 1));
+}
+
+TEST(FrozenKindsV1_0, Partial) {
+  Reader reader;
+  openFrozen("v1_0_partial.gbk", AssetKind::kPartial, &reader);
+  ASSERT_EQ(reader.sections().size(), 3u);
+  const std::vector<uint8_t> held = section(reader, kSectionShardSection, 1);
+  EXPECT_EQ(held, frozen::shardSection());
+  ShardSectionHeader h;
+  ASSERT_GE(held.size(), sizeof(h));
+  std::memcpy(&h, held.data(), sizeof(h));
+  EXPECT_EQ(checkShardSectionHeader(h, held.size()), nullptr);
+  EXPECT_EQ(section(reader, kSectionShardMetadata, 0), frozen::shardMetadata());
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 //   ./a.out v1_0_glitter  the glitter container (frozen_kinds.h), added with the kind
 //   ./a.out v1_0_wang  the wang-tiles container (frozen_kinds.h), added with the kind
 //   ./a.out v1_0_tiny_example  the tiny-example container (frozen_kinds.h), added with the kind
+//   ./a.out v1_0_partial  the partial container (frozen_kinds.h), added with the kind
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
@@ -104,6 +105,15 @@ int writeTinyExample() {
   return 0;
 }
 
+int writePartial() {
+  if (!writeKind("v1_0_partial.gbk", AssetKind::kPartial, "partial", "ndfgen",
+                 {{kSectionShardSection, 1, frozen::shardSection(), Codec::kRaw},
+                  {kSectionShardMetadata, 0, frozen::shardMetadata(), Codec::kZstd}}))
+    return 1;
+  std::puts("wrote v1_0_partial.gbk");
+  return 0;
+}
+
 int writeV1_0() {
   {
     Writer writer;
@@ -137,6 +147,7 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0_glitter") == 0) return writeGlitter();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_wang") == 0) return writeWang();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_tiny_example") == 0) return writeTinyExample();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang | v1_0_tiny_example\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_partial") == 0) return writePartial();
+  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang | v1_0_tiny_example | v1_0_partial\n", stderr);
   return 2;
 }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// glintinfo: inspects, validates, compares and exports glintbake containers.
+// glintinfo: inspects, validates, compares and exports glintbake containers, and merges shards.
 #include "commands.h"
 
 int main(int argc, char** argv) {
@@ -17,16 +17,19 @@ int main(int argc, char** argv) {
   glintinfo::ValidateOptions validate;
   glintinfo::DiffOptions diff;
   glintinfo::ExportOptions exported;
+  glintinfo::MergeOptions merge;
   CLI::App* info_cmd = glintinfo::addInfoCommand(app, info);
   CLI::App* validate_cmd = glintinfo::addValidateCommand(app, validate);
   CLI::App* diff_cmd = glintinfo::addDiffCommand(app, diff);
   CLI::App* export_cmd = glintinfo::addExportCommand(app, exported);
+  CLI::App* merge_cmd = glintinfo::addMergeCommand(app, merge);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     if (info_cmd->parsed()) return glintinfo::runInfo(t, info);
     if (validate_cmd->parsed()) return glintinfo::runValidate(t, validate);
     if (diff_cmd->parsed()) return glintinfo::runDiff(t, diff);
     if (export_cmd->parsed()) return glintinfo::runExport(t, exported);
-    throw cli::Error(cli::kExitBadArguments, "no command given: use info, validate, diff or export (see --help)");
+    if (merge_cmd->parsed()) return glintinfo::runMerge(t, merge);
+    throw cli::Error(cli::kExitBadArguments, "no command given: use info, validate, diff, export or merge (see --help)");
   });
 }

@@ -12,12 +12,16 @@
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/shard_output.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/flakes.h>
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -111,6 +115,67 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
   return cli::kExitOk;
 }
 
+// ndfgen --shard I/N: the regions (and maybe the flakes section) the plan gives this shard, into a
+// partial container that glintinfo merge joins with the other shards.
+template <typename AssetMetadata>
+cli::ExitCode bakeShard(cli::Tool& t, const bake::NormalMap& map, const cli::PyramidCliOptions& pyramid,
+                        const bake::shard::ShardSpec& spec, const std::string& output, int zstd_level,
+                        const bake::ndf::FlakesHandover& handover, const AssetMetadata& assetMetadata,
+                        std::chrono::steady_clock::time_point t0) {
+  const cli::PyramidShardPlan plan(map, pyramid.options, pyramid.flakes, spec.count);
+  bake::ndf::PyramidOptions opt = pyramid.options;
+  opt.region_filter = plan.filter(spec.index);
+  cli::ShardOutput out(t, output, spec, zstd_level);
+  bake::ndf::ShardPyramidSink sink(out.partial());
+  bake::ndf::PyramidReport report;
+  cli::LevelProgress progress(t);
+  const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, sink, &report, progress.callback());
+  progress.finish();
+  cli::check(built);
+  uint64_t flake_bytes = 0;
+  if (pyramid.flakes) {
+    if (plan.flakesOwner() == spec.index) {
+      std::vector<uint8_t> section = cli::unwrap(
+          bake::ndf::flakesSectionBytes(map, pyramid.options.rate, pyramid.options.splat.sigma_r, handover));
+      flake_bytes = section.size();
+      cli::check(out.partial().add(format::kSectionFlakes, 0, section.data(), section.size()));
+    } else {
+      format::FlakesRecord rec;
+      rec.map_width = uint32_t(map.width);
+      rec.map_height = uint32_t(map.height);
+      flake_bytes = format::flakesSectionSize(rec);
+      out.partial().skip();
+    }
+  }
+  const uint64_t units = plan.unitsOf(spec.index);
+  out.finish(assetMetadata(report, flake_bytes), format::AssetKind::kNdfPyramid, units, plan.units());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string which = std::to_string(spec.index) + "/" + std::to_string(spec.count);
+  if (t.common().json) {
+    Json doc;
+    doc["tool"] = "ndfgen";
+    doc["output"] = cli::baseName(output);
+    doc["kind"] = "partial";
+    doc["shard"] = {{"index", spec.index}, {"count", spec.count}};
+    doc["units"] = units;
+    doc["units_total"] = plan.units();
+    double total = 0.0;
+    for (int i = 0; i < spec.count; ++i) total += plan.costOf(i);
+    doc["estimated_cost_share"] = total > 0.0 ? plan.costOf(spec.index) / total : 0.0;
+    doc["sections_held"] = out.partial().held();
+    doc["positions"] = out.partial().positions();
+    doc["file_bytes"] = out.bytesWritten();
+    doc["seconds"] = seconds;
+    t.printJson(doc);
+  } else {
+    t.info("wrote " + output + ": shard " + which + " of an ndf-pyramid, " + std::to_string(units) + " of " +
+           std::to_string(plan.units()) + " units, " + std::to_string(out.partial().held()) + " of " +
+           std::to_string(out.partial().positions()) + " sections, " + std::to_string(out.bytesWritten()) +
+           " bytes in " + std::to_string(seconds) + " s");
+  }
+  return cli::kExitOk;
+}
+
 }  // namespace
 
 int glintbake::cli::ndfgenMain(int argc, char** argv) {
@@ -133,11 +198,16 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
   bool glitter_asset = false;
   cli::addGlitterOptions(app, glitter);
   app.add_flag("--glitter-asset", glitter_asset, "With --procedural glitter: write the surface as a glitter asset");
+  cli::ShardCliOptions shard;
+  cli::addShardOption(app, shard);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
     cli::resolvePyramidOptions(pyramid);
+    cli::resolveShardOption(shard);
+    if (shard.active() && !glitter.procedural.empty())
+      throw Error(cli::kExitUnsupported, "--shard bakes normal maps only (not --procedural)");
     if (!glitter.procedural.empty()) return bakeProcedural(t, glitter, glitter_asset, pyramid, output, zstd_level, t0);
     if (input.empty()) throw Error(cli::kExitBadArguments, "a normal map (or --procedural glitter) is required");
     if (glitter_asset) throw Error(cli::kExitBadArguments, "--glitter-asset needs --procedural glitter");
@@ -147,6 +217,30 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
     cli::requireBakeableMap(map, input);
     cli::checkMemoryBudget(pyramid, map, t.threadCount(), /*tensor=*/false);
 
+    const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);
+    // The asset's metadata, the same whether one machine bakes it or a shard does.
+    auto assetMetadata = [&](const bake::ndf::PyramidReport& report, uint64_t flake_bytes) {
+      Json params = cli::pyramidOptionsJson(pyramid);
+      params["zstd_level"] = zstd_level;
+      params["ingest"] = cli::ingestOptionsJson(ingest);
+      Json meta = t.makeMetadata(format::AssetKind::kNdfPyramid, params);
+      Json asset;
+      asset["ndf_res"] = opt.splat.ndf_res;
+      asset["sigma_r"] = opt.splat.sigma_r;
+      asset["map_size"] = {map.width, map.height};
+      asset["wrap"] = bake::wrapString(map.wrap);
+      asset["rate"] = opt.rate;
+      asset["centre_grid"] = "centre (i, j) of level l at ((i + 0.5) stride_x, (j + 0.5) stride_y) texels";
+      asset["levels"] = Json::array();
+      for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
+      asset["stop_reason"] = report.stop_reason;
+      if (report.next_level_mse >= 0) asset["converged_mse"] = report.next_level_mse;
+      if (pyramid.flakes) asset["flakes"] = cli::flakesJson(handover, flake_bytes);
+      meta["asset"] = asset;
+      return meta;
+    };
+    if (shard.active()) return bakeShard(t, map, pyramid, shard.spec, output, zstd_level, handover, assetMetadata, t0);
+
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
 
     bake::ndf::PyramidReport report;
@@ -154,26 +248,9 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
     const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
-    const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);
     const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid, handover);
-
-    Json params = cli::pyramidOptionsJson(pyramid);
-    params["zstd_level"] = zstd_level;
-    params["ingest"] = cli::ingestOptionsJson(ingest);
-    Json meta = out.makeMetadata(params);
-    Json asset;
-    asset["ndf_res"] = opt.splat.ndf_res;
-    asset["sigma_r"] = opt.splat.sigma_r;
-    asset["map_size"] = {map.width, map.height};
-    asset["wrap"] = bake::wrapString(map.wrap);
-    asset["rate"] = opt.rate;
-    asset["centre_grid"] = "centre (i, j) of level l at ((i + 0.5) stride_x, (j + 0.5) stride_y) texels";
-    asset["levels"] = Json::array();
-    for (const auto& l : report.levels) asset["levels"].push_back(levelJson(l, opt.region_size));
-    asset["stop_reason"] = report.stop_reason;
-    if (report.next_level_mse >= 0) asset["converged_mse"] = report.next_level_mse;
-    if (pyramid.flakes) asset["flakes"] = cli::flakesJson(handover, flake_bytes);
-    meta["asset"] = asset;
+    const Json meta = assetMetadata(report, flake_bytes);
+    const Json& params = meta["parameters"];
     out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 

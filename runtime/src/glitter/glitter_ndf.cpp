@@ -48,6 +48,7 @@ RuntimeStatus GlitterNdf::openMemory(const void* data, size_t size) {
 RuntimeStatus GlitterNdf::load(const format::Reader& reader) {
   open_ = false;
   table_.reset();
+  if (reader.kind() == format::AssetKind::kPartial) return RuntimeStatus::kPartialBake;
   if (reader.kind() != format::AssetKind::kGlitter) return RuntimeStatus::kWrongKind;
   format::GlitterRecord rec;
   if (RuntimeStatus s = readExact(reader, format::kSectionGlitterInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)

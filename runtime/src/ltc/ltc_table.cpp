@@ -46,6 +46,7 @@ RuntimeStatus readImage(const format::Reader& reader, uint64_t key, int* size, s
 }
 
 RuntimeStatus load(format::Reader& reader, LtcTable* table) {
+  if (reader.kind() == format::AssetKind::kPartial) return RuntimeStatus::kPartialBake;
   if (reader.kind() != format::AssetKind::kLtcTable) return RuntimeStatus::kWrongKind;
   int size = 0;
   std::vector<float> ltc1, ltc2;

@@ -97,7 +97,7 @@ static_assert(GB_KIND_GLITTER == int(glintbake::format::AssetKind::kGlitter) &&
 extern "C" {
 
 const char* gb_status_string(int32_t status) {
-  if (status < 0 || status > GB_OUT_OF_MEMORY) return "unknown status";
+  if (status < 0 || status > GB_PARTIAL_BAKE) return "unknown status";
   return glintbake::runtime::statusString(RuntimeStatus(status));
 }
 

@@ -38,6 +38,8 @@ RuntimeStatus loadKind(const format::Reader& reader, std::unique_ptr<NdfSource>*
       return loadAs<WangNdf>(reader, out);
     case format::AssetKind::kTinyExample:
       return loadAs<TinyExampleNdf>(reader, out);
+    case format::AssetKind::kPartial:
+      return RuntimeStatus::kPartialBake;
     default:
       return RuntimeStatus::kWrongKind;
   }

@@ -49,8 +49,10 @@ void ContainerOutput::addImageSection(uint32_t type, uint64_t key, int width, in
   addSection(type, key, bytes.data(), bytes.size());
 }
 
-void ContainerOutput::finish(const Json& metadata) {
-  format::ContainerStatus status = writer_.addMetadata(metadata.dump());
+void ContainerOutput::finish(const Json& metadata) { finishText(metadata.dump()); }
+
+void ContainerOutput::finishText(const std::string& metadata_json) {
+  format::ContainerStatus status = writer_.addMetadata(metadata_json);
   if (status == format::ContainerStatus::kOk) status = writer_.finish();
   if (status != format::ContainerStatus::kOk) throw Error(kExitIo, "cannot write " + path_ + ": " + reason(status));
   finished_ = true;

@@ -60,6 +60,7 @@ enum class AssetKind : uint32_t {
   kWangTiles = 5,    // wangtile
   kTinyExample = 6,  // tinyexample
   kGlitter = 7,      // procedural discrete microfacets
+  kPartial = 8,      // one shard of a sharded bake (glintinfo merge); never an asset (SPEC.md 10.9)
   kTest = 0x7fff,    // containers made by tests and fuzzers
 };
 // True when data (size bytes, >= 8 needed) starts with the container's 8-byte magic: a cheap test
@@ -94,13 +95,15 @@ enum SectionType : uint32_t {
   kSectionWangTileNdf = 99,        // wang-tiles: one tile's NDF asset, an embedded container (key = tile)
   kSectionGlitterInfo = 128,       // glitter: the surface record (key = 0)
   kSectionGlitterIntegrals = 129,  // glitter: the cached triangle integrals of the smooth NDF (key = 0)
+  kSectionShardMetadata = 144,     // partial: the metadata text of the merged asset (key = 0)
+  kSectionShardSection = 145,      // partial: one section of the merged asset (key = its position)
   kSectionImage = 0x100,           // generic float image (key = user-defined), see ImageSectionHeader
   kSectionFirstPrivate = 0x10000,  // 0x10000 and up: application-defined, never interpreted here
 };
 
 // Registered name of a section type ("metadata", "ndf-level", "ndf-chunk", "tensor-index",
 // "tensor-info", "tensor-group", "ltc-table", "roughness", "flakes", "wang-info", "wang-edges", "wang-texels",
-// "wang-tile-ndf", "glitter-info", "glitter-integrals",
+// "wang-tile-ndf", "glitter-info", "glitter-integrals", "shard-metadata", "shard-section",
 // "image"); "private" for types >= kSectionFirstPrivate,
 // "unknown" otherwise. sectionTypeFromString accepts the registered names and decimal or 0x-hex numbers.
 const char* sectionTypeString(uint32_t type);
@@ -156,6 +159,11 @@ class Writer {
   ContainerStatus open(const std::string& path, AssetKind kind, int zstd_level = 9);
   // Appends one section. codec kZstd falls back to kRaw when compression does not shrink the data.
   ContainerStatus addSection(uint32_t type, uint64_t key, const void* data, size_t size, Codec codec = Codec::kZstd);
+  // Appends one section whose stored bytes are already encoded (codec, raw_size as in the index;
+  // e.g. copied from another container, or made by encodeSection()). The bytes are not decoded:
+  // the caller vouches for them. Same rules on (type, key) and metadata as addSection.
+  ContainerStatus addStoredSection(uint32_t type, uint64_t key, Codec codec, uint64_t raw_size, const void* stored,
+                                   size_t stored_size);
   // Convenience for the JSON metadata section (must be added exactly once before finish()).
   ContainerStatus addMetadata(const std::string& json_utf8);
   // Writes index and header, flushes, renames to the final path.
@@ -175,6 +183,22 @@ class Writer {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// Encodes section bytes exactly as Writer::addSection stores them at zstd_level (1..19): the
+// same frame parameters, and raw when zstd does not shrink the data. *stored receives the stored
+// bytes, *used the codec. Not thread-safe per encoder; one encoder per thread.
+class SectionEncoder {
+ public:
+  explicit SectionEncoder(int zstd_level);
+  ~SectionEncoder();
+  SectionEncoder(const SectionEncoder&) = delete;
+  SectionEncoder& operator=(const SectionEncoder&) = delete;
+  ContainerStatus encode(const void* data, size_t size, Codec codec, std::vector<uint8_t>* stored, Codec* used);
+
+ private:
+  void* cctx_ = nullptr;
+  int level_ = 9;
 };
 
 // Options of a reader. All limits apply before any allocation, so untrusted files cannot make the

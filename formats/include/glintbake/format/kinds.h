@@ -56,6 +56,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, "wangtile"},
     {AssetKind::kTinyExample, "tiny-example", 112, 127, "tinyexample"},
     {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
+    {AssetKind::kPartial, "partial", 144, 159, "ndfgen --shard"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
 
@@ -65,7 +66,7 @@ constexpr SectionRange kSectionRanges[] = {
     {1, 15, "container", false},    {16, 31, "ndf-pyramid", false},    {32, 47, "tensor-ndf", true},
     {48, 63, "ltc-table", true},    {64, 79, "roughness", true},       {80, 95, "flakes", false},
     {96, 111, "wang-tiles", false}, {112, 127, "tiny-example", false}, {128, 143, "glitter", false},
-    {256, 256, "image", false},
+    {144, 159, "partial", false},   {256, 256, "image", false},
 };
 
 constexpr SectionTypeInfo kSectionTypeRegistry[] = {
@@ -87,6 +88,8 @@ constexpr SectionTypeInfo kSectionTypeRegistry[] = {
     {kSectionTinyExampleLevel, "tiny-example-level"},
     {kSectionGlitterInfo, "glitter-info"},
     {kSectionGlitterIntegrals, "glitter-integrals"},
+    {kSectionShardMetadata, "shard-metadata"},
+    {kSectionShardSection, "shard-section"},
     {kSectionImage, "image"},
 };
 

@@ -28,7 +28,8 @@ enum {
   GB_WRONG_KIND = 3,
   GB_UNSUPPORTED_VERSION = 4,
   GB_INVALID_ARGUMENT = 5,
-  GB_OUT_OF_MEMORY = 6
+  GB_OUT_OF_MEMORY = 6,
+  GB_PARTIAL_BAKE = 7 /* one shard of a sharded bake: join the shards with glintinfo merge */
 };
 
 /* Stable text of a status code; never NULL. */

@@ -15,6 +15,7 @@ enum class RuntimeStatus : int32_t {
   kUnsupportedVersion = 4,  // newer container major version
   kInvalidArgument = 5,
   kOutOfMemory = 6,
+  kPartialBake = 7,  // a partial container (one shard of a sharded bake): merge the shards first
 };
 
 // The former name of RuntimeStatus, kept for one minor version.

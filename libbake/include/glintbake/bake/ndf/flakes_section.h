@@ -4,6 +4,8 @@
 // (Yan et al. 2016) and hands over to the pyramid above them.
 #pragma once
 
+#include <vector>
+
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/result.h>
 #include <glintbake/format/container.h>
@@ -51,5 +53,9 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
 // range), kIo (the writer failed).
 BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
                               const FlakesHandover& handover, uint64_t* bytes);
+// The raw bytes of that section (record and normals), for writers that place it themselves
+// (sharded bakes). Same errors, kIo aside.
+Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
+                                                const FlakesHandover& handover);
 
 }  // namespace glintbake::bake::ndf

@@ -35,6 +35,7 @@
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/ndf/splat.h>
 #include <glintbake/bake/result.h>
+#include <glintbake/bake/shard/shard.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 
@@ -62,6 +63,11 @@ struct PyramidOptions {
   // small levels it stores exactly before it may stop.
   int converge_from_grid = 0;
   int converge_from_level = 0;  // ... and only above this level
+  // Sharded bakes (bake/shard/shard.h): when set, only the regions it accepts are computed and
+  // handed to the sink (addChunk); the others are announced with skipChunk, and of their centres
+  // only those the automatic level count samples are computed, so that every shard takes the same
+  // level-count decision as the whole bake. Called from the building thread only.
+  std::function<bool(int level, int region)> region_filter;
 };
 
 // Validates the options (kBadArgument with a message naming the option).
@@ -123,6 +129,8 @@ class PyramidSink {
   virtual BakeStatus addLevel(const format::NdfLevelRecord& record) = 0;
   virtual BakeStatus addChunk(const PyramidChunk& chunk) = 0;
   virtual BakeStatus endLevel(int level) { return (void)level, okStatus(); }
+  // A region PyramidOptions::region_filter refused, in its place in the region order.
+  virtual BakeStatus skipChunk(int level, int region) { return (void)level, (void)region, okStatus(); }
   // Bytes the sink has written so far (for PyramidLevelReport::stored_bytes; 0 if it writes none).
   virtual uint64_t storedBytes() const { return 0; }
 };
@@ -140,6 +148,21 @@ class WriterPyramidSink final : public PyramidSink {
  private:
   format::Writer& writer_;
   format::NdfLevelRecord below_;  // the last level added
+};
+
+// The sink of one shard of an ndf-pyramid bake: the sections WriterPyramidSink would write, at
+// their positions in the asset, through a shard::PartialWriter: level records common to every
+// shard, the chunks of the regions the shard computes, a skipped position for every other region.
+class ShardPyramidSink final : public PyramidSink {
+ public:
+  explicit ShardPyramidSink(shard::PartialWriter& partial) : partial_(partial) {}
+  BakeStatus addLevel(const format::NdfLevelRecord& record) override;
+  BakeStatus addChunk(const PyramidChunk& chunk) override;
+  BakeStatus skipChunk(int level, int region) override;
+
+ private:
+  shard::PartialWriter& partial_;
+  format::NdfLevelRecord below_;
 };
 
 // Where a pyramid's images come from when they are not a normal map's flakes (procedural surfaces:

@@ -29,6 +29,8 @@ class ContainerOutput {
   Json makeMetadata(const Json& parameters) const { return tool_.makeMetadata(kind_, parameters); }
   // Adds the metadata section, writes index and header, renames into place.
   void finish(const Json& metadata);
+  // The same with the metadata as text (kept byte for byte; sharded bakes' merge).
+  void finishText(const std::string& metadata_json);
 
   // The underlying writer, for producers that stream sections themselves.
   format::Writer& writer() { return writer_; }

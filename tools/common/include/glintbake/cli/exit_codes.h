@@ -35,7 +35,7 @@ inline int exitCodeOf(format::ContainerStatus status) {
   }
 }
 
-// Runtime opens: kIoError -> 2, kWrongKind and kUnsupportedVersion -> 5, kOutOfMemory -> 4,
+// Runtime opens: kIoError -> 2, kWrongKind, kPartialBake and kUnsupportedVersion -> 5, kOutOfMemory -> 4,
 // anything else (malformed asset) -> 3.
 inline int exitCodeOf(runtime::RuntimeStatus status) {
   switch (status) {
@@ -44,6 +44,7 @@ inline int exitCodeOf(runtime::RuntimeStatus status) {
     case runtime::RuntimeStatus::kIoError:
       return kExitIo;
     case runtime::RuntimeStatus::kWrongKind:
+    case runtime::RuntimeStatus::kPartialBake:
     case runtime::RuntimeStatus::kUnsupportedVersion:
       return kExitUnsupported;
     case runtime::RuntimeStatus::kOutOfMemory:
