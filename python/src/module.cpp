@@ -48,6 +48,7 @@ int exitCodeOf(rt::RuntimeStatus s) {
     case rt::RuntimeStatus::kOutOfMemory:
       return 4;
     case rt::RuntimeStatus::kUnsupportedVersion:
+    case rt::RuntimeStatus::kPartialBake:
       return 5;
   }
   return 4;
