@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Sanitizer builds (Debug, so the DCHECKs run too):
-#   build-asan/  the whole project under ASan+UBSan; runs the unit tests (and the CLI tests with
-#                --cli), every finding failing its test;
+#   build-asan/  the project under ASan+UBSan: the GoogleTest programs and their libraries (the
+#                whole project with --cli); runs the unit tests (and the CLI tests with --cli),
+#                every finding failing its test;
 #   build-tsan/  runtime-only under TSan; runs the runtime's concurrency tests (threads hammering
 #                eval, average, sample, pdf and mass on one shared asset).
 #   scripts/sanitize.sh [--cli]
