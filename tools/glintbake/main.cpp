@@ -170,6 +170,9 @@ int runBake(cli::Tool& t, const BakeOptions& o) {
 
 int main(int argc, char** argv) {
   cli::Tool tool("glintbake", "Bakes a manifest of assets with the glintbake tools, here or as Slurm jobs");
+  tool.addExample("glintbake bake assets.json -j 8 --json", "Bake every stale asset of a manifest, eight tools at a time.");
+  tool.addExample("glintbake bake assets.json --emit slurm --emit-dir farm/",
+                  "Write the same work as a Slurm job array and a merge job (farm/submit.sh submits them).");
   CLI::App& app = tool.app();
   app.fallthrough();
   app.require_subcommand(0, 1);
