@@ -26,6 +26,13 @@ constexpr double kMinSigma = 1e-3;                    // tile path: smaller foot
 constexpr double kNegligible = 1e-15;                 // tiles with less probability are skipped
 
 bool finitePoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+
+// Whether the window [c - r, c + r] in units of `unit` stays well inside the int64 range (false
+// for NaN and infinities too).
+bool windowInRange(double c, double r, double unit) {
+  const double lo = (c - r) / unit, hi = (c + r) / unit;
+  return std::fabs(lo) < 1e15 && std::fabs(hi) < 1e15;
+}
 bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
 
 // Bin (column, row) of an s-plane point of [-1, 1]^2 in an R x R image.
@@ -424,8 +431,13 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
       return true;
     }
     const double rx = kTinyWindowSigmas * g.sx, ry = kTinyWindowSigmas * g.sy;
+    // Extreme transforms or positions (a damaged asset, a footprint far out) leave the int range:
+    // not answered, as a window of too many cells.
+    if (!windowInRange(mx, rx, n) || !windowInRange(my, ry, n)) return false;
     const int64_t cx0 = int64_t(std::floor((mx - rx) / n)), cx1 = int64_t(std::floor((mx + rx) / n));
     const int64_t cy0 = int64_t(std::floor((my - ry) / n)), cy1 = int64_t(std::floor((my + ry) / n));
+    if (cx1 - cx0 >= kTinyMaxCells || cy1 - cy0 >= kTinyMaxCells || (cx1 - cx0 + 1) * (cy1 - cy0 + 1) > kTinyMaxCells)
+      return false;
     for (int64_t cy = cy0; cy <= cy1; ++cy) {
       for (int64_t cx = cx0; cx <= cx1; ++cx) {
         if (entered) ++*entered;
@@ -438,9 +450,11 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
   // Stochastic: the cells of the window, each example in its own frame, then the flat base.
   const double cell = r.cell_size;
   const double reach = kTinyWindowSigmas * sigma;
+  if (!windowInRange(fp.x, reach, cell) || !windowInRange(fp.y, reach, cell)) return false;
   const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)), i1 = int64_t(std::floor((fp.x + reach) / cell));
   const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)), j1 = int64_t(std::floor((fp.y + reach) / cell));
-  if ((i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells) return false;
+  if (i1 - i0 >= kTinyMaxCells || j1 - j0 >= kTinyMaxCells || (i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells)
+    return false;
   double covered = 0.0;
   for (int64_t j = j0; j <= j1; ++j) {
     for (int64_t i = i0; i <= i1; ++i) {
