@@ -11,7 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libzstd-dev libxxhash-dev
   python3-dev pybind11-dev python3-numpy python3-pytest  # the Python module and its tests
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang  # libFuzzer targets (scripts/fuzz.sh)
+  clang libclang-rt-dev  # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime is not a dependency of clang
   slurm-wlm slurmctld slurmd slurm-client munge  # the one-node Slurm cluster of tests/slurm
 )
 if [[ "${1:-}" == "--browser" ]]; then
