@@ -12,11 +12,11 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <sys/stat.h>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
-#include <sys/stat.h>
 
 namespace {
 
@@ -98,9 +98,8 @@ const runtime::TinyExampleNdf& asset(bool stochastic) {
 // sigma whose 4-sigma square holds `examples` examples of the layout.
 double sigmaFor(const runtime::TinyExampleNdf& a, double examples) {
   const format::TinyExampleRecord& r = a.record();
-  const double area = r.type == uint32_t(format::TinyExampleType::kTiled)
-                          ? double(r.example_size) * r.example_size
-                          : r.cell_size * r.cell_size / r.occupancy;
+  const double area = r.type == uint32_t(format::TinyExampleType::kTiled) ? double(r.example_size) * r.example_size
+                                                                          : r.cell_size * r.cell_size / r.occupancy;
   return std::sqrt(examples * area) / 4.0;
 }
 

@@ -79,8 +79,8 @@ rt::Footprint footprint(int tiles, int i) {
 }
 
 void label(benchmark::State& state, int tiles) {
-  state.SetLabel(std::to_string(asset().coveredTiles(footprint(tiles, 0))) + " tiles, T = " +
-                 std::to_string(asset().record().tile_size));
+  state.SetLabel(std::to_string(asset().coveredTiles(footprint(tiles, 0))) +
+                 " tiles, T = " + std::to_string(asset().record().tile_size));
 }
 
 void BM_WangEval(benchmark::State& state) {

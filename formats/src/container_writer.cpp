@@ -55,7 +55,6 @@ ContainerStatus compressSection(ZSTD_CCtx* cctx, const void* data, size_t size, 
 
 }  // namespace
 
-
 struct Writer::Impl {
   std::string final_path;
   AtomicFile file;

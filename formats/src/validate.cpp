@@ -4,8 +4,8 @@
 #include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/format/kinds/flakes.h>
-#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/validate.h>
 
 #include "byte_source.h"
@@ -204,7 +204,8 @@ void noteTinyExamplePayload(size_t index, const SectionInfo& s, const std::vecto
 void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const TinyExampleSeen& seen,
                             std::vector<ValidationMessage>* messages) {
   if (seen.info != 1) {
-    addError(messages, 6006, "a tiny-example asset holds " + std::to_string(seen.info) + " info sections (type 112), not one");
+    addError(messages, 6006,
+             "a tiny-example asset holds " + std::to_string(seen.info) + " info sections (type 112), not one");
     return;
   }
   if (!seen.record_ok) return;
@@ -218,7 +219,8 @@ void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const Tiny
     auto level = std::find_if(sections.begin(), sections.end(),
                               [&](const SectionInfo& s) { return s.type == kSectionTinyExampleLevel && s.key == l; });
     if (level == sections.end() || level->raw_size != tinyLevelSectionSize(r, l)) {
-      addError(messages, 6006, "tiny-example level " + std::to_string(l) + " (type 114) is missing or has the wrong size");
+      addError(messages, 6006,
+               "tiny-example level " + std::to_string(l) + " (type 114) is missing or has the wrong size");
       continue;
     }
     const uint64_t m = tinyTilesPerSide(r.example_size, l);

@@ -51,7 +51,8 @@ const char* checkWangRecord(const WangRecord& r) {
     return "wang record: max_sigma out of range";
   if (!(std::isfinite(r.flakes_up_to) && r.flakes_up_to >= 0.0 && r.flakes_up_to <= r.max_sigma))
     return "wang record: flakes_up_to out of range";
-  if (!(std::isfinite(r.pyramid_from) && r.pyramid_from >= r.flakes_up_to)) return "wang record: pyramid_from out of range";
+  if (!(std::isfinite(r.pyramid_from) && r.pyramid_from >= r.flakes_up_to))
+    return "wang record: pyramid_from out of range";
   // The exact path answers up to pyramid_from; its window (6 sqrt(sigma_h^2 + sigma^2), 1.5 cover
   // radii) must stay within one tile so that a footprint meets at most 3 x 3 tiles on that path too.
   if (r.pyramid_from > r.max_sigma || 1.5 * wangCoverRadius(r.pyramid_from) > double(r.tile_size))

@@ -29,7 +29,7 @@ struct TinyExampleRecord {
   uint32_t type = 0;          // TinyExampleType
   uint32_t flags = 0;         // 0 (reserved)
   uint32_t reserved = 0;
-  double sigma_r = 0.0;       // intrinsic roughness of the texels' lobes, (0, 1]
+  double sigma_r = 0.0;  // intrinsic roughness of the texels' lobes, (0, 1]
   // The 2x2 part of the example transform, row-major {m00, m01, m10, m11}, acting on positions
   // (texels, y down): tiled: the one transform; stochastic: the part every example shares (mirror),
   // applied after its own rotation, scale and shear. |det| in [kMinTinyDet, kMaxTinyDet].
@@ -37,9 +37,9 @@ struct TinyExampleRecord {
   double translate[2] = {0.0, 0.0};  // tiled: where the example's corner (0, 0) lands (texels)
   // Stochastic layout (ignored by the tiled type, 0 there).
   uint64_t seed = 0;
-  double density = 0.0;    // the covered fraction the layout was made for, (0, 1]
-  double cell_size = 0.0;  // L: side of the grid cells (texels), each holds at most one example
-  double occupancy = 0.0;  // probability that a cell holds an example, (0, 1]
+  double density = 0.0;                 // the covered fraction the layout was made for, (0, 1]
+  double cell_size = 0.0;               // L: side of the grid cells (texels), each holds at most one example
+  double occupancy = 0.0;               // probability that a cell holds an example, (0, 1]
   double rotate_range[2] = {0.0, 0.0};  // degrees, min <= max, |.| <= 3600
   double scale_range[2] = {1.0, 1.0};   // min <= max, both in [kMinTinyScale, kMaxTinyScale]
   double shear[2] = {0.0, 0.0};         // (hx, hy), |.| <= kMaxTinyShear, hx hy != 1
