@@ -69,6 +69,16 @@ SHOW_SIGMAS = [2, 8, 16]
 FLAKES_UP_TO = 8.0
 HANDOVER_UP_TO = 11.3
 EXPOSURE = "0.5"
+# Procedural glitter (Jakob et al. 2014): the example build's glitter asset (examples/Makefile),
+# rendered at three distances (scenes glitter_{near,mid,far}.json: the same framing, the camera,
+# plane and point light scaled by 0.1, 0.8 and 3.2) beside the smooth Beckmann BRDF of its
+# roughness. The footprint grows from 0.5 to 16 texels of its 64 x 64 texel surface (49 facets per
+# texel), that is from about 150 to 160,000 facets per pixel (over the Gaussian's effective area
+# 4 pi sigma^2).
+GLITTER_ARGS = ["--procedural", "glitter", "--glitter-asset", "--particles", "200000", "--alpha", "0.2",
+                "--size", "64,64"]
+GLITTER_VIEWS = ["near", "mid", "far"]
+GLITTER_FACETS_PER_TEXEL = 200000 / (64 * 64)
 
 _cache_lock = threading.Lock()
 
@@ -237,6 +247,7 @@ def main():
                         help="footprints (texels) of the NDF image comparison")
     parser.add_argument("--show-sigmas", default=",".join(f"{s:g}" for s in SHOW_SIGMAS),
                         help="footprints whose NDF images are shown side by side (a subset of --ndf-sigmas)")
+    parser.add_argument("--no-glitter", action="store_true", help="leave out the procedural glitter renders")
     parser.add_argument("-j", "--jobs", type=int, default=2, help="tool runs in parallel (each on one thread)")
     opts = parser.parse_args()
     views = [v for v in opts.views.split(",") if v]
@@ -425,7 +436,59 @@ def main():
             result["whole_png"] = os.path.relpath(png, out)
         return result
 
+    def glitter_asset():
+        """The example build's glitter asset when it is there, else the same surface baked here."""
+        made = os.path.join(assets_dir, "glitter", "glitter_asset.gbk")
+        if os.path.exists(made):
+            return made, "examples/Makefile"
+        path = os.path.join(work, "glitter_asset.gbk")
+        runner.run([tool("ndfgen")] + GLITTER_ARGS + ["-o", path, "--quiet"], outputs=[path])
+        return path, "make-report.py"
+
+    def render_glitter(asset, view):
+        """One distance: the glitter asset and the smooth Beckmann BRDF; the glitter render against the
+        smooth one (relative MSE) and the spread of their per-pixel ratio (sparkle contrast)."""
+        scene = os.path.join(opts.scenes, f"glitter_{view}.json")
+        if not os.path.exists(scene):
+            fail(f"{scene} not found")
+        renders = {}
+        for mode in ("glitter", "smooth"):
+            stem = f"glitter_{view}_{mode}"
+            exr = os.path.join(work, stem + ".exr")
+            png = os.path.join(img_dir, stem + ".png")
+            args = [tool("glintref"), "render", scene, "-o", exr, "--preview", png, "--exposure", EXPOSURE,
+                    "--asset", asset, "--ndf", "asset" if mode == "glitter" else "smooth", "--json",
+                    "--quiet"] + threads
+            if opts.image_size:
+                args += ["--image-size", opts.image_size]
+            doc, _ = runner.run(args, inputs=[scene, asset], outputs=[exr, png], capture_json=True)
+            renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
+                             "sigma_mean": doc["footprint_sigma_texels"]["mean"],
+                             "pixels_hit": doc["pixels_hit"], "mean_radiance": doc["mean_radiance"],
+                             "preview": os.path.relpath(png, out), "exr": exr}
+        doc, _ = runner.run([tool("glintref"), "compare", renders["glitter"]["exr"], renders["smooth"]["exr"],
+                             "--json"], inputs=[renders["glitter"]["exr"], renders["smooth"]["exr"]],
+                            capture_json=True)
+        glitter, smooth = read_exr(renders["glitter"]["exr"]), read_exr(renders["smooth"]["exr"])
+        floor = 0.05 * max(smooth) if smooth else 0.0
+        ratios = [g / s for g, s in zip(glitter, smooth) if s > floor]
+        mean = sum(ratios) / len(ratios) if ratios else None
+        contrast = (math.sqrt(sum((r - mean) ** 2 for r in ratios) / len(ratios)) / mean) if mean else None
+        result = {"view": view, "sigma_mean": renders["glitter"]["sigma_mean"],
+                  "pixels_hit": renders["glitter"]["pixels_hit"],
+                  "relative_mse_vs_smooth": doc["relative_mse"], "psnr_vs_smooth": doc["psnr"],
+                  "mean_ratio": mean, "sparkle_contrast": contrast,
+                  "facets_per_pixel": GLITTER_FACETS_PER_TEXEL * 4 * math.pi * renders["glitter"]["sigma_mean"] ** 2}
+        for mode, r in renders.items():
+            del r["exr"]
+            result[mode] = r
+        return result
+
     tasks = []
+    glitter_tasks = []
+    if not opts.no_glitter:
+        asset, glitter_by = glitter_asset()
+        glitter_tasks = [pool.submit(render_glitter, asset, view) for view in GLITTER_VIEWS]
     for info in infos:
         for view in views:
             tasks.append(("render", info, view, pool.submit(render_view, info, view)))
@@ -450,6 +513,11 @@ def main():
             print(f"make-report: {info['map']}: view {what}", file=sys.stderr)
         else:
             entry["ndf"].append(future.result())
+    if glitter_tasks:
+        report["glitter"] = {"baked_by": glitter_by, "bake": " ".join(GLITTER_ARGS),
+                             "views": [t.result() for t in glitter_tasks]}
+        print("make-report: glitter: " + " ".join(
+            f"{v['view']} contrast {fmt(v['sparkle_contrast'])}" for v in report["glitter"]["views"]), file=sys.stderr)
     pool.shutdown()
     runner.save()
 
@@ -549,6 +617,39 @@ def write_plot(path, entry):
     os.replace(path + ".tmp", path)
 
 
+def glitter_html(glitter):
+    """The glitter section: three distances, glitter beside smooth Beckmann, with the figures."""
+    e = html.escape
+    parts = [f"""<h2 id='glitter'>Procedural glitter at three distances</h2>
+<p>A glitter asset (<code>ndfgen {e(glitter['bake'])}</code>, baked by {e(glitter['baked_by'])}: discrete
+stochastic microfacets, Jakob et al. 2014, no normal map) rendered through the runtime on a plane seen
+from three distances, beside the smooth Beckmann BRDF of the same roughness. Near, a pixel sees a few
+hundred facets and only some of them reflect the lights: sparkles. Far, it sees tens of thousands and
+the glitter converges to the smooth BRDF. Sparkle contrast = standard deviation over the lit pixels of
+the ratio glitter / smooth (one colour channel, pixels above 5% of the smooth render's maximum),
+divided by its mean; the mean ratio stays near 1 (the facets carry the smooth NDF's energy).</p>
+<table>
+<tr><th class='l'>distance</th><th>footprint std (texels)</th><th>facets per pixel</th><th>pixels</th>
+<th>sparkle contrast</th><th>mean ratio glitter / smooth</th><th>relative MSE vs smooth</th>
+<th>render time glitter / smooth (s)</th></tr>
+"""]
+    for v in glitter["views"]:
+        parts.append(f"<tr><td class='l'>{e(v['view'])}</td><td>{fmt(v['sigma_mean'])}</td>"
+                     f"<td>{fmt(float(round(v['facets_per_pixel'])))}</td><td>{v['pixels_hit']}</td>"
+                     f"<td>{fmt(v['sparkle_contrast'])}</td><td>{fmt(v['mean_ratio'])}</td>"
+                     f"<td>{fmt(v['relative_mse_vs_smooth'])}</td><td>{fmt(v['glitter']['render_seconds'])} / "
+                     f"{fmt(v['smooth']['render_seconds'])}</td></tr>\n")
+    parts.append("</table>\n")
+    for mode, title in (("glitter", "glitter asset"), ("smooth", "smooth Beckmann")):
+        parts.append("<div class='row'>")
+        for v in glitter["views"]:
+            label = f"{title}, {v['view']} (footprint {fmt(v['sigma_mean'])} texels)"
+            parts.append(f"<figure><img src='{e(v[mode]['preview'])}' alt='{e(label)}'>"
+                         f"<figcaption>{e(label)}</figcaption></figure>\n")
+        parts.append("</div>\n")
+    return "".join(parts)
+
+
 def write_html(path, report):
     e = html.escape
     views = report["views"]
@@ -630,6 +731,9 @@ Images are shown on one linear scale per footprint: the reference's maximum is w
                  "<figcaption>median over the maps</figcaption></figure>\n")
     parts.append(f"<p>Report time: {fmt(report['total_seconds'])} s wall, {fmt(report['tool_cpu_seconds'])} s of "
                  f"tool CPU ({report['tool_runs']} tool runs, {report['cached_runs']} answered from the cache).</p>\n")
+
+    if report.get("glitter"):
+        parts.append(glitter_html(report["glitter"]))
 
     for entry in report["assets"]:
         t = entry["tensor16"]

@@ -4,6 +4,7 @@
 #include <glintbake/format/json_depth.h>
 #include <glintbake/format/kinds.h>
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/kinds/glitter.h>
 #include <glintbake/format/kinds/tiny_example.h>
 #include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/validate.h>
@@ -153,6 +154,24 @@ void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uin
   }
 }
 
+// A kind's fixed-size record: exactly sizeof(Record) bytes passing its check (null when valid);
+// otherwise error `id` naming the problem. True when the record is usable.
+template <typename Record>
+bool readCheckedRecord(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, int id, const char* what,
+                       const char* (*check)(const Record&), Record* record, std::vector<ValidationMessage>* messages) {
+  if (raw.size() != sizeof(Record)) {
+    addError(messages, id,
+             describe(index, s) + ": the " + what + " record is not " + std::to_string(sizeof(Record)) + " bytes");
+    return false;
+  }
+  std::memcpy(record, raw.data(), sizeof(Record));
+  if (const char* why = check(*record)) {
+    addError(messages, id, describe(index, s) + ": " + why);
+    return false;
+  }
+  return true;
+}
+
 // What the payload pass saw of a tiny-example asset's own sections (SPEC.md 10.8).
 struct TinyExampleSeen {
   int info = 0;  // info sections read
@@ -165,16 +184,8 @@ void noteTinyExamplePayload(size_t index, const SectionInfo& s, const std::vecto
                             std::vector<ValidationMessage>* messages) {
   if (s.type == kSectionTinyExampleInfo) {
     ++seen->info;
-    if (raw.size() != sizeof(TinyExampleRecord)) {
-      addError(messages, 6006, describe(index, s) + ": the tiny-example record is not 168 bytes");
-      return;
-    }
-    std::memcpy(&seen->record, raw.data(), sizeof(TinyExampleRecord));
-    if (const char* why = checkTinyExampleRecord(seen->record)) {
-      addError(messages, 6006, describe(index, s) + ": " + why);
-      return;
-    }
-    seen->record_ok = true;
+    seen->record_ok =
+        readCheckedRecord(index, s, raw, 6006, "tiny-example", checkTinyExampleRecord, &seen->record, messages);
   } else if (s.type == kSectionTinyExampleTexels) {
     for (size_t i = 0; i + 4 <= raw.size(); i += 4) {
       float v;
@@ -233,6 +244,62 @@ void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const Tiny
     if (s.type == kSectionTinyExampleLevel && s.key >= r.levels)
       addError(messages, 6006, "tiny-example level " + std::to_string(s.key) + " beyond the record's levels");
   }
+}
+
+// What the payload pass saw of a glitter asset's own sections (SPEC.md 10.6).
+struct GlitterSeen {
+  int info = 0;  // info sections read
+  bool record_ok = false;
+  GlitterRecord record;
+  int tables = 0;              // integral sections read
+  int64_t table_entries = -1;  // entries of a table that passed its checks
+};
+
+// The glitter record passes checkGlitterRecord and the integral table checkGlitterIntegrals, the
+// same checks the runtime's loader makes (one implementation, formats/kinds/glitter.h).
+void noteGlitterPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, GlitterSeen* seen,
+                        std::vector<ValidationMessage>* messages) {
+  if ((s.type == kSectionGlitterInfo || s.type == kSectionGlitterIntegrals) && s.key != 0) {
+    addError(messages, 6007, describe(index, s) + ": glitter sections have key 0");
+    return;
+  }
+  if (s.type == kSectionGlitterInfo) {
+    ++seen->info;
+    seen->record_ok = readCheckedRecord(index, s, raw, 6007, "glitter", checkGlitterRecord, &seen->record, messages);
+  } else if (s.type == kSectionGlitterIntegrals) {
+    ++seen->tables;
+    if (raw.size() % sizeof(GlitterIntegral) != 0) {
+      addError(messages, 6007, describe(index, s) + ": not a whole number of 16-byte integral entries");
+      return;
+    }
+    const size_t count = raw.size() / sizeof(GlitterIntegral);
+    std::vector<GlitterIntegral> table(count);
+    if (count > 0) std::memcpy(table.data(), raw.data(), raw.size());
+    if (const char* why = checkGlitterIntegrals(table.data(), count)) {
+      addError(messages, 6007, describe(index, s) + ": " + why);
+      return;
+    }
+    seen->table_entries = int64_t(count);
+  }
+}
+
+// The layout of a glitter asset: one valid record and one integral table of its integral_count.
+void checkGlitterLayout(const GlitterSeen& seen, std::vector<ValidationMessage>* messages) {
+  if (seen.info != 1) {
+    addError(messages, 6007,
+             "a glitter asset holds " + std::to_string(seen.info) + " glitter-info sections (type 128), not one");
+    return;
+  }
+  if (seen.tables != 1) {
+    addError(
+        messages, 6007,
+        "a glitter asset holds " + std::to_string(seen.tables) + " glitter-integrals sections (type 129), not one");
+    return;
+  }
+  if (seen.record_ok && seen.table_entries >= 0 && uint64_t(seen.table_entries) != seen.record.integral_count)
+    addError(messages, 6007,
+             "the glitter integral table holds " + std::to_string(seen.table_entries) + " entries, the record says " +
+                 std::to_string(seen.record.integral_count));
 }
 
 bool looksLikeAbsolutePath(const std::string& s) {
@@ -417,6 +484,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   WangRecord wang_record;  // the wang-tiles record, once seen and valid (its sections check against it)
   bool have_wang_record = false;
   TinyExampleSeen tiny;
+  GlitterSeen glitter;
   for (size_t i = 0; i < sections.size(); ++i) {
     const SectionInfo& s = sections[i];
     if (!isRegisteredSectionType(s.type)) {
@@ -450,11 +518,13 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       continue;
     }
     if (kind == AssetKind::kTinyExample) noteTinyExamplePayload(i, s, raw, &tiny, &report.messages);
+    if (kind == AssetKind::kGlitter) noteGlitterPayload(i, s, raw, &glitter, &report.messages);
     if (s.type == kSectionFlakes) {
       checkFlakesPayload(i, s, raw, &report.messages);
     } else if (s.type >= kSectionWangInfo && s.type <= kSectionWangTileNdf) {
       checkWangPayload(i, s, raw, &wang_record, &have_wang_record, &report.messages);
-    } else if (s.type == kSectionTinyExampleInfo || s.type == kSectionTinyExampleTexels) {
+    } else if (s.type == kSectionTinyExampleInfo || s.type == kSectionTinyExampleTexels ||
+               s.type == kSectionGlitterInfo || s.type == kSectionGlitterIntegrals) {
       // Records, not images.
     } else if (s.type != kSectionMetadata) {
       checkImagePayload(i, s, raw, &report.messages);
@@ -491,6 +561,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   }
   if (kind == AssetKind::kTinyExample && index_sound && options.check_payloads)
     checkTinyExampleLayout(sections, tiny, &report.messages);
+  if (kind == AssetKind::kGlitter && index_sound && options.check_payloads)
+    checkGlitterLayout(glitter, &report.messages);
   uint32_t first = 0, last = 0;
   if (kindTypeRange(kind, &first, &last) && std::none_of(sections.begin(), sections.end(), [&](const SectionInfo& s) {
         return s.type >= first && s.type <= last;

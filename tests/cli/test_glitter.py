@@ -4,10 +4,26 @@ enumeration, D near the smooth NDF for large N, the same answer twice) and ndfge
 glitter (a pyramid glintinfo validates and glintquery reads, a glitter asset, byte-identical for
 -j1 and -j2, one-line errors with exit 1 for bad parameters and nothing left behind)."""
 
+import math
 import os
+import struct
 
 import clitest
-from clitest import ToolTestCase
+from clitest import INVALID, ToolTestCase
+from containers import SECTION_METADATA, build_container, metadata
+
+KIND_GLITTER, SECTION_GLITTER_INFO, SECTION_GLITTER_INTEGRALS = 7, 128, 129
+
+
+def glitter_record(alpha=0.2, integral_count=4, particles=100000):
+    """A GlitterRecord (formats/SPEC.md 10.6, 80 bytes): Beckmann, depth 20, 64 x 64 texels, R 32."""
+    return struct.pack("<4I2Q2d4I2d", 0x544C4747, 1, 0, 20, particles, 7, alpha, math.radians(1.0), 64, 64, 32,
+                       integral_count, 1e-4, 9.5699e-4)
+
+
+def integral_table(entries=4):
+    """Root triangles only (no tabulated children): each a quarter of the isotropic NDF's mass."""
+    return b"".join(struct.pack("<dII", 1.0 / entries, 0, 0) for _ in range(entries))
 
 QUERY = ["--alpha", "0.3", "--at", "0.4,0.7", "--extent", "0.2", "--s", "0.1,-0.05", "--gamma", "4"]
 
@@ -62,6 +78,46 @@ class Glitter(ToolTestCase):
         self.run_ok("glintinfo", "validate", asset)
         q = self.run_json("glintquery", "point", asset, "--at", "20,30", "--sigma", "2", "--s", "0.1,0.1")
         self.assertGreaterEqual(q["value"], 0.0)
+
+    def test_validate_checks_the_glitter_layout(self):
+        """glintinfo validate runs the glitter record and table checks the runtime's loader runs (error
+        6007), and passes exactly the glitter files the runtime opens (6004 otherwise)."""
+        meta = (SECTION_METADATA, 0, metadata(asset_kind="glitter"))
+        def asset(name, *sections):
+            return self.write(name, build_container(list(sections) + [meta], kind=KIND_GLITTER))
+        good = asset("good.gbk", (SECTION_GLITTER_INFO, 0, glitter_record()),
+                     (SECTION_GLITTER_INTEGRALS, 0, integral_table()))
+        self.run_ok("glintinfo", "validate", good)
+        q = self.run_json("glintquery", "point", good, "--at", "20,30", "--sigma", "2", "--s", "0.1,0.1")
+        self.assertGreaterEqual(q["value"], 0.0)
+        cases = {
+            "nan_alpha": [(SECTION_GLITTER_INFO, 0, glitter_record(alpha=float("nan"))),
+                          (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "no_particles": [(SECTION_GLITTER_INFO, 0, glitter_record(particles=0)),
+                             (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "short_record": [(SECTION_GLITTER_INFO, 0, glitter_record()[:72]),
+                             (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "count_mismatch": [(SECTION_GLITTER_INFO, 0, glitter_record(integral_count=8)),
+                               (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "bad_table": [(SECTION_GLITTER_INFO, 0, glitter_record()),
+                          (SECTION_GLITTER_INTEGRALS, 0, struct.pack("<dII", -1.0, 0, 0) * 4)],
+            "ragged_table": [(SECTION_GLITTER_INFO, 0, glitter_record()),
+                             (SECTION_GLITTER_INTEGRALS, 0, integral_table() + b"\0" * 8)],
+            "record_key_1": [(SECTION_GLITTER_INFO, 1, glitter_record()),
+                             (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "no_table": [(SECTION_GLITTER_INFO, 0, glitter_record())],
+            "no_record": [(SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+            "two_records": [(SECTION_GLITTER_INFO, 0, glitter_record()), (SECTION_GLITTER_INFO, 1, glitter_record()),
+                            (SECTION_GLITTER_INTEGRALS, 0, integral_table())],
+        }
+        for name, sections in cases.items():
+            with self.subTest(name):
+                path = asset(name + ".gbk", *sections)
+                err = self.assert_fails(INVALID, "glintinfo", "validate", path)
+                self.assertIn("error-6007", err)
+                # The runtime refuses every one of them too.
+                code, _, _ = clitest.run("glintquery", "point", path, "--at", "1,1", "--sigma", "1", "--s", "0,0")
+                self.assertNotEqual(code, 0)
 
     def test_tensorpack_procedural(self):
         out = self.path("t.gbk")

@@ -41,8 +41,8 @@ class ReportTest(clitest.ToolTestCase):
             page = f.read()
         sources = re.findall(r"<img(?: class='[^']*')? src='([^']+)'", page)
         # 6 views x (4 renders + 3 heat maps) + 2 footprints x 4 NDF images + the map's plot and the
-        # median plot.
-        self.assertEqual(len(sources), 6 * 7 + 2 * 4 + 2)
+        # median plot + 3 glitter distances x (glitter, smooth Beckmann).
+        self.assertEqual(len(sources), 6 * 7 + 2 * 4 + 2 + 3 * 2)
         for src in sources:
             self.assertTrue(os.path.exists(os.path.join(out, src)), src)
         self.assertIn("No real maps in this report", page)
@@ -75,6 +75,20 @@ class ReportTest(clitest.ToolTestCase):
                 svg = f.read()
             self.assertTrue(svg.startswith("<svg"), plot)
             self.assertEqual(svg.count("<path "), 3, plot)
+
+        # Glitter: sparkles near, the smooth Beckmann BRDF far (the footprint holds ever more facets),
+        # with the smooth NDF's energy at every distance.
+        glitter = report["glitter"]["views"]
+        self.assertEqual([v["view"] for v in glitter], ["near", "mid", "far"])
+        contrast = [v["sparkle_contrast"] for v in glitter]
+        self.assertGreater(contrast[0], 0.3)
+        self.assertGreater(contrast[0], 3 * contrast[1])
+        self.assertGreater(contrast[1], contrast[2])
+        self.assertLess(contrast[2], 0.1)
+        self.assertLess(glitter[2]["relative_mse_vs_smooth"], 0.01)
+        for v in glitter:
+            self.assertAlmostEqual(v["mean_ratio"], 1.0, delta=0.15)
+        self.assertIn("Procedural glitter at three distances", page)
 
         browser = find_browser()
         self.assertIsNotNone(browser, "chromium is required (scripts/install-deps.sh --browser)")

@@ -25,7 +25,8 @@ void checkWithRuntime(const std::string& path, format::ValidationReport* report)
   runtime::RuntimeStatus status = runtime::RuntimeStatus::kOk;
   int id = 0;
   if (kind == format::AssetKind::kNdfPyramid || kind == format::AssetKind::kTensorNdf ||
-      kind == format::AssetKind::kWangTiles) {
+      kind == format::AssetKind::kWangTiles || kind == format::AssetKind::kTinyExample ||
+      kind == format::AssetKind::kGlitter) {
     std::unique_ptr<runtime::NdfSource> ndf;
     status = runtime::openNdfAsset(path.c_str(), &ndf);
     id = 6004;
