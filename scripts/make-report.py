@@ -79,6 +79,15 @@ GLITTER_ARGS = ["--procedural", "glitter", "--glitter-asset", "--particles", "20
                 "--size", "64,64"]
 GLITTER_VIEWS = ["near", "mid", "far"]
 GLITTER_FACETS_PER_TEXEL = 200000 / (64 * 64)
+# Wang tiles (Cohen et al. 2003): the example build's tile set cut from the scratches map (16 tiles of
+# 64 texels) on a plane far away, 32 x 32 tiles across (2048 texels), seen from straight above by a
+# distant narrow camera under one directional light, so that the half vector hardly changes over the
+# image and any repetition of the surface shows in the render (scenes wang_{tiled,repeated,
+# reference}.json): the tile set, the scratches example simply repeated 8 x 8 times (its tensor
+# asset) and the reference P-NDF of the materialised region (glintquery materialise).
+WANG_BAKE = ["--tile-size", "64", "--ndf-res", "64"]
+WANG_CELLS = "0,0,32,32"
+WANG_REPEATS = 8  # example periods across the image: the repeated render's period is width / 8
 
 _cache_lock = threading.Lock()
 
@@ -248,6 +257,7 @@ def main():
     parser.add_argument("--show-sigmas", default=",".join(f"{s:g}" for s in SHOW_SIGMAS),
                         help="footprints whose NDF images are shown side by side (a subset of --ndf-sigmas)")
     parser.add_argument("--no-glitter", action="store_true", help="leave out the procedural glitter renders")
+    parser.add_argument("--no-wang", action="store_true", help="leave out the Wang tile renders")
     parser.add_argument("-j", "--jobs", type=int, default=2, help="tool runs in parallel (each on one thread)")
     opts = parser.parse_args()
     views = [v for v in opts.views.split(",") if v]
@@ -258,7 +268,7 @@ def main():
 
     total_start = time.perf_counter()
     cpu_start = os.times()
-    for name in ("mapgen", "ndfgen", "tensorpack", "glintref", "glintquery", "glintinfo"):
+    for name in ("mapgen", "ndfgen", "tensorpack", "wangtile", "glintref", "glintquery", "glintinfo"):
         if not os.access(os.path.join(opts.bin, name), os.X_OK):
             fail(f"{os.path.join(opts.bin, name)} not found: build first (scripts/build.sh) or pass --bin")
     out = opts.out
@@ -484,7 +494,74 @@ def main():
             result[mode] = r
         return result
 
+    def wang_assets():
+        """The scratches map, its tensor asset and tile set (the example build's when up to date), and
+        the materialised grid region the tile set covers in the renders."""
+        map_path = os.path.join(opts.maps, "scratches.exr")
+        if not os.path.exists(map_path):
+            runner.run([tool("mapgen")] + MAPS["scratches"] + ["-o", map_path, "--quiet"], outputs=[map_path])
+        made = {"tensor": os.path.join(assets_dir, "tensor", "scratches.gbk"),
+                "wang": os.path.join(assets_dir, "wang", "scratches.gbk")}
+        paths, baked_by = {}, "examples/Makefile"
+        for key, path in made.items():
+            if os.path.exists(path) and os.path.getmtime(path) >= os.path.getmtime(map_path):
+                paths[key] = path
+                continue
+            baked_by = "make-report.py"
+            paths[key] = os.path.join(work, f"scratches_{key}.gbk")
+            args = ([tool("tensorpack"), "--rank", "16", map_path] if key == "tensor" else
+                    [tool("wangtile"), map_path] + WANG_BAKE)
+            runner.run(args + ["-o", paths[key], "--quiet"], inputs=[map_path], outputs=[paths[key]])
+        paths["map"] = map_path
+        paths["region"] = os.path.join(work, "wang_region.exr")
+        runner.run([tool("glintquery"), "materialise", paths["wang"], "--cells", WANG_CELLS, "-o", paths["region"],
+                    "--quiet"], inputs=[paths["wang"]], outputs=[paths["region"]])
+        return paths, baked_by
+
+    def render_wang(paths):
+        """The tile set, the repeated example and the reference on the materialised region; each against
+        the reference, and how strongly each render repeats at the example's period."""
+        renders = {}
+        for mode in ("tiled", "repeated", "reference"):
+            scene = os.path.join(opts.scenes, f"wang_{mode}.json")
+            if not os.path.exists(scene):
+                fail(f"{scene} not found")
+            exr = os.path.join(work, f"wang_{mode}.exr")
+            png = os.path.join(img_dir, f"wang_{mode}.png")
+            args = [tool("glintref"), "render", scene, "-o", exr, "--preview", png, "--exposure", EXPOSURE, "--json",
+                    "--quiet"] + threads
+            inputs = [scene]
+            if mode == "tiled":
+                args += ["--ndf", "asset", "--asset", paths["wang"]]
+                inputs.append(paths["wang"])
+            elif mode == "repeated":
+                args += ["--ndf", "asset", "--asset", paths["tensor"], "--normal-map", paths["map"]]
+                inputs += [paths["tensor"], paths["map"]]
+            else:
+                args += ["--ndf", "reference", "--normal-map", paths["region"]]
+                inputs.append(paths["region"])
+            if opts.image_size:
+                args += ["--image-size", opts.image_size]
+            doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
+            renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
+                             "sigma_mean": doc["footprint_sigma_texels"]["mean"], "width": doc["width"],
+                             "height": doc["height"], "preview": os.path.relpath(png, out), "exr": exr}
+        for mode in ("tiled", "repeated"):
+            doc, _ = runner.run([tool("glintref"), "compare", renders[mode]["exr"], renders["reference"]["exr"],
+                                 "--json"], inputs=[renders[mode]["exr"], renders["reference"]["exr"]],
+                                capture_json=True)
+            renders[mode]["relative_mse_vs_reference"] = doc["relative_mse"]
+        period = max(1, renders["tiled"]["width"] // WANG_REPEATS)
+        for r in renders.values():
+            r["repetition"] = period_correlation(read_exr(r["exr"]), r["width"], r["height"], period)
+            del r["exr"]
+        return {"period_pixels": period, "cells": WANG_CELLS, "renders": renders}
+
     tasks = []
+    wang_task = None
+    if not opts.no_wang:
+        wang_paths, wang_by = wang_assets()
+        wang_task = pool.submit(render_wang, wang_paths)
     glitter_tasks = []
     if not opts.no_glitter:
         asset, glitter_by = glitter_asset()
@@ -513,6 +590,11 @@ def main():
             print(f"make-report: {info['map']}: view {what}", file=sys.stderr)
         else:
             entry["ndf"].append(future.result())
+    if wang_task is not None:
+        report["wang"] = wang_task.result()
+        report["wang"]["baked_by"] = wang_by
+        print("make-report: wang tiles: repetition " + " ".join(
+            f"{m} {fmt(r['repetition'])}" for m, r in report["wang"]["renders"].items()), file=sys.stderr)
     if glitter_tasks:
         report["glitter"] = {"baked_by": glitter_by, "bake": " ".join(GLITTER_ARGS),
                              "views": [t.result() for t in glitter_tasks]}
@@ -556,6 +638,39 @@ def main():
                            f"{fmt(entry['renders'][v]['tensor16']['relative_mse'])}/"
                            f"{fmt(entry['renders'][v]['smooth']['relative_mse'])}" for v in views)
         print(f"  {entry['map']:22s} relative MSE pyramid/tensor16/smooth: {figures}", file=sys.stderr)
+
+
+def period_correlation(values, width, height, period):
+    """How much an image repeats at `period` pixels: the correlation of its detail (the image less its
+    local mean over a window of about period / 4) with itself shifted by the period, along x and y,
+    averaged. About 1 for a surface repeated at that period, small for one that does not repeat."""
+    r = max(1, period // 8)
+    sums = [[0.0] * (width + 1) for _ in range(height + 1)]
+    for y in range(height):
+        row = 0.0
+        for x in range(width):
+            row += values[y * width + x]
+            sums[y + 1][x + 1] = sums[y][x + 1] + row
+    detail = []
+    for y in range(height):
+        y0, y1 = max(0, y - r), min(height, y + r + 1)
+        for x in range(width):
+            x0, x1 = max(0, x - r), min(width, x + r + 1)
+            mean = (sums[y1][x1] - sums[y0][x1] - sums[y1][x0] + sums[y0][x0]) / ((y1 - y0) * (x1 - x0))
+            detail.append(values[y * width + x] - mean)
+    result = []
+    for dx, dy in ((period, 0), (0, period)):
+        a = [detail[y * width + x] for y in range(height - dy) for x in range(width - dx)]
+        b = [detail[(y + dy) * width + x + dx] for y in range(height - dy) for x in range(width - dx)]
+        if not a:
+            return None
+        ma, mb = sum(a) / len(a), sum(b) / len(b)
+        va = sum((p - ma) ** 2 for p in a)
+        vb = sum((q - mb) ** 2 for q in b)
+        if va <= 0 or vb <= 0:
+            return None
+        result.append(sum((p - ma) * (q - mb) for p, q in zip(a, b)) / math.sqrt(va * vb))
+    return sum(result) / len(result)
 
 
 def write_plot(path, entry):
@@ -615,6 +730,36 @@ def write_plot(path, entry):
     with open(path + ".tmp", "w") as f:
         f.write("".join(parts))
     os.replace(path + ".tmp", path)
+
+
+def wang_html(wang):
+    """The Wang tile section: the tiled plane beside the repeated example and the reference."""
+    e = html.escape
+    r = wang["renders"]
+    titles = {"tiled": "wang-tiles asset (runtime)", "repeated": "the example repeated (tensor asset)",
+              "reference": "reference P-NDF of the materialised region"}
+    parts = [f"""<h2 id='wang'>Wang tiles: an unbounded surface far away</h2>
+<p>A complete 16-tile Wang set cut from the scratches map (<code>wangtile {e(' '.join(WANG_BAKE))}</code>, baked by
+{e(wang['baked_by'])}) on a plane 32 x 32 tiles across, seen from straight above by a distant narrow camera
+under one directional light, beside the scratches example itself repeated 8 x 8 times over the same plane
+and the reference P-NDF of the same region of the implicit grid (<code>glintquery materialise --cells
+{e(wang['cells'])}</code>). Repetition = correlation of each render's detail with itself shifted by the
+example's period ({wang['period_pixels']} pixels), along x and y: near 1 when the surface visibly repeats.</p>
+<table>
+<tr><th class='l'>render</th><th>footprint std (texels)</th><th>repetition at the example's period</th>
+<th>relative MSE vs the reference</th><th>render time (s)</th></tr>
+"""]
+    for mode in ("tiled", "repeated", "reference"):
+        v = r[mode]
+        parts.append(f"<tr><td class='l'>{e(titles[mode])}</td><td>{fmt(v['sigma_mean'])}</td>"
+                     f"<td>{fmt(v['repetition'])}</td><td>{fmt(v.get('relative_mse_vs_reference'))}</td>"
+                     f"<td>{fmt(v['render_seconds'])}</td></tr>\n")
+    parts.append("</table>\n<div class='row'>")
+    for mode in ("tiled", "repeated", "reference"):
+        parts.append(f"<figure><img src='{e(r[mode]['preview'])}' alt='{e(titles[mode])}'>"
+                     f"<figcaption>{e(titles[mode])}</figcaption></figure>\n")
+    parts.append("</div>\n")
+    return "".join(parts)
 
 
 def glitter_html(glitter):
@@ -732,6 +877,8 @@ Images are shown on one linear scale per footprint: the reference's maximum is w
     parts.append(f"<p>Report time: {fmt(report['total_seconds'])} s wall, {fmt(report['tool_cpu_seconds'])} s of "
                  f"tool CPU ({report['tool_runs']} tool runs, {report['cached_runs']} answered from the cache).</p>\n")
 
+    if report.get("wang"):
+        parts.append(wang_html(report["wang"]))
     if report.get("glitter"):
         parts.append(glitter_html(report["glitter"]))
 

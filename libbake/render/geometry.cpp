@@ -166,7 +166,7 @@ bool ObjectModel::intersectCylinder(const Ray& ray, SurfaceHit* hit) const {
 }
 
 runtime::Footprint pixelFootprint(const RayWithDifferentials& rays, const SurfaceHit& hit, double pixel_sigma,
-                                  int map_width, int map_height, double uv_scale, double min_sigma) {
+                                  int map_width, int map_height, double uv_scale, double min_sigma, bool wrap) {
   // Offset rays meet the tangent plane of the hit (pbrt-v4 section 10.1.1).
   auto planePoint = [&](const Ray& r, Vec3* p) {
     const double denom = dot(hit.normal, r.direction);
@@ -197,8 +197,8 @@ runtime::Footprint pixelFootprint(const RayWithDifferentials& rays, const Surfac
   double sigma = pixel_sigma * std::sqrt(0.5 * (j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11));
   if (!std::isfinite(sigma)) sigma = 1e6;
   runtime::Footprint fp;
-  fp.x = wrap01(hit.u * uv_scale) * map_width;
-  fp.y = wrap01(hit.v * uv_scale) * map_height;
+  fp.x = (wrap ? wrap01(hit.u * uv_scale) : hit.u * uv_scale) * map_width;
+  fp.y = (wrap ? wrap01(hit.v * uv_scale) : hit.v * uv_scale) * map_height;
   fp.sigma = std::fmin(1e6, std::fmax(min_sigma, sigma));
   return fp;
 }

@@ -417,6 +417,11 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
   const runtime::MicrofacetModel model =
       mat.shadowing == ShadowingModel::kBeckmann ? runtime::MicrofacetModel::kBeckmann : runtime::MicrofacetModel::kGgx;
 
+  // Unbounded assets answer anywhere on the plane: their footprints are not wrapped into one map.
+  const bool unbounded = options.mode == NdfMode::kAsset && inputs.asset != nullptr &&
+                         (inputs.asset->kind() == format::AssetKind::kWangTiles ||
+                          inputs.asset->kind() == format::AssetKind::kTinyExample);
+
   RenderedImage image;
   image.width = cam.width;
   image.height = cam.height;
@@ -434,8 +439,9 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
             SurfaceHit hit;
             Rgb color = toRgb(scene.background);
             if (object.intersect(rays.ray, &hit)) {
-              const runtime::Footprint fp = pixelFootprint(rays, hit, cam.pixel_sigma, std::max(1, inputs.map_width),
-                                                           std::max(1, inputs.map_height), scene.object.uv_scale);
+              const runtime::Footprint fp =
+                  pixelFootprint(rays, hit, cam.pixel_sigma, std::max(1, inputs.map_width),
+                                 std::max(1, inputs.map_height), scene.object.uv_scale, 1e-3, !unbounded);
               sigmas[index] = float(fp.sigma);
               const Vec3 wo = -1.0 * rays.ray.direction;
               bool ok = true;

@@ -33,7 +33,7 @@ class ReportTest(clitest.ToolTestCase):
         # Real maps of ../shared are left out: the suite must not depend on that folder.
         proc = subprocess.run(["/usr/bin/python3", SCRIPT, "--bin", clitest.BIN_DIR, "--maps", maps, "--out", out,
                                "--only", "flakes", "--image-size", "32,32", "--no-real",
-                               "--ndf-sigmas", "0.5,2,16", "--show-sigmas", "2,16"],
+                               "--ndf-sigmas", "0.5,2,16", "--show-sigmas", "2,16", "--no-wang"],
                               capture_output=True, text=True, timeout=600)
         self.assertEqual(proc.returncode, 0, proc.stderr)
         index = os.path.join(out, "index.html")
@@ -104,6 +104,30 @@ class ReportTest(clitest.ToolTestCase):
         self.assertIsNotNone(total, "the page's load script did not run")
         self.assertEqual(int(total.group(1)), len(sources))
         self.assertEqual(int(loaded.group(1)), len(sources), "some images failed to load")
+
+    def test_wang_tiles_do_not_repeat_where_the_example_does(self):
+        """The Wang section at the scenes' own size: the tile set answers for its materialised region
+        (the reference renders it alike) and does not repeat at the example's period, where the
+        example simply repeated does."""
+        out = self.path("report")
+        proc = subprocess.run(["/usr/bin/python3", SCRIPT, "--bin", clitest.BIN_DIR, "--maps", self.path("maps"),
+                               "--out", out, "--only", "scratches", "--no-real", "--no-glitter", "--views", "s0.5",
+                               "--ndf-sigmas", "0.5", "--show-sigmas", "0.5"],
+                              capture_output=True, text=True, timeout=900)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        with open(os.path.join(out, "report.json")) as f:
+            wang = json.load(f)["wang"]
+        r = wang["renders"]
+        self.assertEqual(wang["period_pixels"], 32)
+        self.assertLess(r["tiled"]["relative_mse_vs_reference"], 0.01)
+        self.assertGreater(r["repeated"]["relative_mse_vs_reference"], 0.1)
+        self.assertGreater(r["repeated"]["repetition"], 0.7)
+        self.assertLess(r["tiled"]["repetition"], 0.5 * r["repeated"]["repetition"])
+        with open(os.path.join(out, "index.html")) as f:
+            page = f.read()
+        self.assertIn("Wang tiles: an unbounded surface far away", page)
+        for mode in ("tiled", "repeated", "reference"):
+            self.assertTrue(os.path.exists(os.path.join(out, r[mode]["preview"])), mode)
 
 
 if __name__ == "__main__":

@@ -37,6 +37,31 @@ class WangTile(ToolTestCase):
         self.run_ok("wangtile", ex, "-o", out1, *SMALL, "-j1")
         self.assertEqual(clitest.file_hash(out), clitest.file_hash(out1))
 
+    def test_materialise_a_grid_region(self):
+        """glintquery materialise writes the implicit grid's texels as a normal map: the reference
+        evaluator on it agrees with the asset (uncompressed) inside the region, and bad requests fail
+        with one line and nothing left behind."""
+        ex = self.example()
+        out = self.path("w.gbk")
+        self.run_ok("wangtile", ex, "-o", out, "--uncompressed", *SMALL)
+        region = self.path("region.exr")
+        doc = self.run_json("glintquery", "materialise", out, "--cells", "-2,3,4,4", "-o", region)
+        self.assertEqual(doc["size"], [64, 64])
+        # Cell (-2, 3) is texel (0, 0) of the region: texel (24.5, 40.5) of it is (-7.5, 88.5) on the plane.
+        for s in ("0.05,0.02", "-0.1,0.04"):
+            ref = self.run_json("glintref", "ndf", region, "--at", "24.5,40.5", "--sigma", "1", "--s", s)
+            q = self.run_json("glintquery", "point", out, "--at", "-7.5,88.5", "--sigma", "1", "--s", s)
+            self.assertAlmostEqual(q["value"], ref["value"], delta=1e-3 * max(1.0, ref["value"]))
+        bad = self.path("bad.exr")
+        for cells in ("0,0,0,4", "0,0,4", "a,b,c,d", "0,0,2000,2000"):
+            self.assert_fails(1, "glintquery", "materialise", out, "--cells", cells, "-o", bad, outputs=[bad])
+        self.assert_fails(1, "glintquery", "materialise", out, "--cells", "0,0,1,1", "-o", self.path("x.png"),
+                          outputs=[self.path("x.png")])
+        self.assert_fails(3, "glintquery", "materialise", ex, "--cells", "0,0,1,1", "-o", bad, outputs=[bad])
+        pyramid = self.path("p.gbk")
+        self.run_ok("ndfgen", ex, "-o", pyramid, "--ndf-res", "16", "--quiet")
+        self.assert_fails(5, "glintquery", "materialise", pyramid, "--cells", "0,0,1,1", "-o", bad, outputs=[bad])
+
     def test_uncompressed_and_plain_cut(self):
         ex = self.example()
         out = self.path("u.gbk")

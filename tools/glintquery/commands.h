@@ -33,14 +33,22 @@ struct BatchOptions {
   std::string asset;
 };
 
+struct MaterialiseOptions {
+  std::string asset;
+  std::string cells;  // "I0,J0,NX,NY"
+  std::string output;
+};
+
 CLI::App* addPointCommand(CLI::App& app, PointOptions& options);
 CLI::App* addImageCommand(CLI::App& app, ImageOptions& options);
 CLI::App* addBatchCommand(CLI::App& app, BatchOptions& options);
+CLI::App* addMaterialiseCommand(CLI::App& app, MaterialiseOptions& options);
 
 // Each returns a documented exit code or throws cli::Error.
 int runPoint(cli::Tool& tool, const PointOptions& options);
 int runImage(cli::Tool& tool, const ImageOptions& options);
 int runBatch(cli::Tool& tool, const BatchOptions& options);
+int runMaterialise(cli::Tool& tool, const MaterialiseOptions& options);
 
 // Shared by the commands (asset.cpp).
 // An opened NDF asset of any kind the runtime reads, opened once.

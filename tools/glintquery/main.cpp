@@ -6,10 +6,13 @@
 
 int main(int argc, char** argv) {
   using namespace glintbake;
-  cli::Tool tool("glintquery",
-                 "Queries baked NDF assets (ndf-pyramid, tensor-ndf) through the runtime (point, image, batch)");
-  tool.addExample("glintquery point brushed.gbk --at 64,64 --sigma 4 --s 0.1,0", "The P-NDF density of one footprint at one s-plane point.");
-  tool.addExample("glintquery image brushed.gbk --at 64,64 --sigma 4 -o ndf.exr", "The NDF image the runtime blends for that footprint.");
+  cli::Tool tool(
+      "glintquery",
+      "Queries baked NDF assets through the runtime (point, image, batch; materialise: a wang-tiles grid region)");
+  tool.addExample("glintquery point brushed.gbk --at 64,64 --sigma 4 --s 0.1,0",
+                  "The P-NDF density of one footprint at one s-plane point.");
+  tool.addExample("glintquery image brushed.gbk --at 64,64 --sigma 4 -o ndf.exr",
+                  "The NDF image the runtime blends for that footprint.");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
   app.fallthrough();
@@ -17,14 +20,17 @@ int main(int argc, char** argv) {
   glintquery::PointOptions point;
   glintquery::ImageOptions image;
   glintquery::BatchOptions batch;
+  glintquery::MaterialiseOptions materialise;
   CLI::App* point_cmd = glintquery::addPointCommand(app, point);
   CLI::App* image_cmd = glintquery::addImageCommand(app, image);
   CLI::App* batch_cmd = glintquery::addBatchCommand(app, batch);
+  CLI::App* materialise_cmd = glintquery::addMaterialiseCommand(app, materialise);
 
   return tool.run(argc, argv, [&](cli::Tool& t) {
     if (point_cmd->parsed()) return glintquery::runPoint(t, point);
     if (image_cmd->parsed()) return glintquery::runImage(t, image);
     if (batch_cmd->parsed()) return glintquery::runBatch(t, batch);
-    throw cli::Error(cli::kExitBadArguments, "no command given: use point, image or batch (see --help)");
+    if (materialise_cmd->parsed()) return glintquery::runMaterialise(t, materialise);
+    throw cli::Error(cli::kExitBadArguments, "no command given: use point, image, batch or materialise (see --help)");
   });
 }

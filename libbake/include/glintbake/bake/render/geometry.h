@@ -64,8 +64,11 @@ class ObjectModel {
 // The Gaussian footprint of the pixel in texels of the map (x, y, sigma), from the differentials
 // of `rays` on the tangent plane of `hit`: the pixel filter of std pixel_sigma (pixels) mapped by
 // the 2x2 Jacobian J = d(texel)/d(pixel), made isotropic with sigma^2 = pixel_sigma^2 tr(J J^T) / 2.
-// The centre wraps into [0, width) x [0, height) (maps are tileable). sigma >= min_sigma.
+// The centre wraps into [0, width) x [0, height) (maps are tileable), or with wrap = false runs over
+// the whole surface, uv_scale map sizes across (unbounded assets: Wang tiles, tiny examples).
+// sigma >= min_sigma.
 runtime::Footprint pixelFootprint(const RayWithDifferentials& rays, const SurfaceHit& hit, double pixel_sigma,
-                                  int map_width, int map_height, double uv_scale, double min_sigma = 1e-3);
+                                  int map_width, int map_height, double uv_scale, double min_sigma = 1e-3,
+                                  bool wrap = true);
 
 }  // namespace glintbake::bake::render
