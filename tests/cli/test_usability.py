@@ -40,6 +40,18 @@ class Help(ToolTestCase):
             self.assertNotIn("ENUM:", out, tool)
             self.assertNotIn("->", out, tool)
             self.assertNotIn("--help-man", out, tool)
+            # No CLI11 validator text or flag-value suffixes: values are N, X, TEXT or named choices.
+            for internal in ("INT:", "FLOAT:", "UINT", "{false}", "{true}", "POSITIVE", "NONNEGATIVE"):
+                self.assertNotIn(internal, out, f"{tool}: {internal!r} in --help")
+            self.assertIsNone(re.search(r" in \[\S+ - \S+\]", out), tool)
+            for sub in re.findall(r"^  ([a-z][a-z-]+) +[A-Z]", out.split("Subcommands:")[-1], re.M) \
+                    if "Subcommands:" in out else []:
+                sub_help, _ = self.run_ok(tool, sub, "--help")
+                for internal in ("INT:", "FLOAT:", "{false}", "POSITIVE"):
+                    self.assertNotIn(internal, sub_help, f"{tool} {sub}: {internal!r} in --help")
+                self.assertIsNone(re.search(r" in \[\S+ - \S+\]", sub_help), f"{tool} {sub}")
+                # A required option has no default worth showing.
+                self.assertIsNone(re.search(r"=\S* REQUIRED", sub_help), f"{tool} {sub}")
 
     def test_man_page_lists_every_option_of_help(self):
         for tool in TOOLS:

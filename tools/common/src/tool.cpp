@@ -257,7 +257,60 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+namespace {
+
+// An option's value in plain words: N for integers, X for reals, the choices of a set (8|16), or
+// the type name an option gave itself; never CLI11's validator text (INT:INT in [0 - 1024]).
+std::string plainTypeName(const CLI::Option* opt) {
+  const std::string full = opt->get_type_name();
+  const size_t colon = full.find(':');
+  const std::string base = full.substr(0, colon);
+  const std::string rest = colon == std::string::npos ? "" : full.substr(colon + 1);
+  const bool integer = base == "INT" || base == "UINT";
+  if (integer && rest.size() > 2 && rest.front() == '{' && rest.back() == '}' &&
+      rest.find_first_not_of("0123456789,-") == 1 && rest.find_first_not_of("0123456789,-", 1) == rest.size() - 1) {
+    std::string choices = rest.substr(1, rest.size() - 2);
+    for (char& c : choices)
+      if (c == ',') c = '|';
+    return choices;
+  }
+  if (integer) return "N";
+  if (base == "FLOAT") return "X";
+  return base;
+}
+
+// Option names without CLI11's flag-value suffixes ("--no-flakes{false}" -> "--no-flakes").
+std::string plainOptionName(std::string names) {
+  for (size_t open = names.find('{'); open != std::string::npos; open = names.find('{', open)) {
+    const size_t close = names.find('}', open);
+    if (close == std::string::npos) break;
+    names.erase(open, close - open + 1);
+  }
+  return names;
+}
+
+// --help in plain words: value names from plainTypeName, names from plainOptionName.
+class PlainFormatter final : public CLI::Formatter {
+ public:
+  std::string make_option_name(const CLI::Option* opt, bool is_positional) const override {
+    return plainOptionName(CLI::Formatter::make_option_name(opt, is_positional));
+  }
+  std::string make_option_opts(const CLI::Option* opt) const override {
+    if (!opt->get_option_text().empty() || opt->get_type_size() == 0) return CLI::Formatter::make_option_opts(opt);
+    std::string out;
+    const std::string type = plainTypeName(opt);
+    if (!type.empty()) out += " " + type;
+    if (!opt->get_default_str().empty() && !opt->get_required()) out += "=" + opt->get_default_str();
+    if (opt->get_expected_max() == CLI::detail::expected_max_vector_size) out += " ...";
+    if (opt->get_required()) out += " REQUIRED";
+    return out;
+  }
+};
+
+}  // namespace
+
 Tool::Tool(std::string name, std::string description) : name_(std::move(name)), app_(description, name_) {
+  app_.formatter(std::make_shared<PlainFormatter>());
   app_.set_version_flag("--version", versionString(name_));
   app_.option_defaults()->always_capture_default();
   app_.add_flag("--json", common_.json, "Print a machine-readable summary on stdout (see schemas/)");
@@ -314,7 +367,7 @@ void manOptions(std::string& page, const CLI::App& app) {
     for (const std::string& l : opt->get_lnames()) names += (names.empty() ? "--" : ", --") + l;
     if (names.empty()) names = opt->get_name();  // positional
     page += ".TP\n.B " + roff(names);
-    if (opt->get_type_size() != 0 && !opt->get_type_name().empty()) page += " \\fI" + roff(opt->get_type_name()) + "\\fR";
+    if (opt->get_type_size() != 0 && !plainTypeName(opt).empty()) page += " \\fI" + roff(plainTypeName(opt)) + "\\fR";
     page += "\n" + roff(opt->get_description());
     if (!opt->get_default_str().empty() && opt->get_type_size() != 0) page += " (default: " + roff(opt->get_default_str()) + ")";
     page += "\n";
@@ -410,7 +463,7 @@ int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
   std::string global = "Options of every " + name_ + " command (before or after the subcommand):\n";
   for (const CLI::Option* opt : app_.get_options()) {
     if (opt->get_group().empty() || opt->get_name() == "--help") continue;
-    global += "  " + opt->get_name(false, true) + "\n      " + opt->get_description() + "\n";
+    global += "  " + plainOptionName(opt->get_name(false, true)) + "\n      " + opt->get_description() + "\n";
   }
   for (CLI::App* sub : app_.get_subcommands([](CLI::App*) { return true; })) sub->footer(global + "\n" + app_.get_footer());
   for (int i = 1; i < argc; ++i)
