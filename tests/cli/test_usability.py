@@ -2,6 +2,7 @@
 """Help, manual pages and everyday usability of every tool: examples at the end of --help, help in
 plain words, man pages generated from the same option definitions, "did you mean" suggestions,
 '-' as standard output where a stream makes sense, warnings under --quiet, and --strict."""
+import json
 import os
 import re
 import struct
@@ -88,6 +89,42 @@ class Suggestions(ToolTestCase):
 
 
 class Streams(ToolTestCase):
+    def test_inputs_from_standard_input(self):
+        """'-' reads a normal map or a container from standard input: the same asset as from the file
+        (its input named '-' in the metadata, left out of the depfile), and clear refusals where a
+        stream cannot work."""
+        m = self.mapgen("beckmann", "m.png", "--size", "16")
+        with open(m, "rb") as f:
+            png = f.read()
+        from_file, from_stdin = self.path("file.gbk"), self.path("stdin.gbk")
+        self.run_ok("ndfgen", m, "-o", from_file, *SMALL, "--quiet")
+        code, _, err = clitest.run("ndfgen", "-", "-o", from_stdin, *SMALL, "--quiet", "--depfile",
+                                   self.path("stdin.d"), stdin=png)
+        self.assertEqual(code, 0, err)
+        info = self.run_json("glintinfo", "info", from_stdin)
+        self.assertEqual([i["name"] for i in info["metadata"]["inputs"]], ["-"])
+        with open(self.path("stdin.d")) as f:
+            self.assertNotIn("-", f.read().split(":", 1)[1].split())
+        query = ["--at", "5.5,7.5", "--sigma", "2", "--s", "0.05,0.02"]
+        a = self.run_json("glintquery", "point", from_file, *query)
+        with open(from_stdin, "rb") as f:
+            asset = f.read()
+        code, out, err = clitest.run("glintquery", "point", "-", *query, "--json", stdin=asset)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(json.loads(out)["value"], a["value"])
+        code, out, _ = clitest.run("glintinfo", "validate", "-", stdin=asset)
+        self.assertEqual(code, 0)
+        self.assertIn("-: valid", out)
+        # Refusals: one line, the documented code, nothing left behind.
+        out = self.path("x.gbk")
+        self.assert_fails(clitest.BAD_ARGS, "tensorpack", "-", *SMALL, stdin=png)
+        self.assert_fails(clitest.INVALID, "ndfgen", "-", "-o", out, *SMALL, stdin=b"", outputs=[out])
+        self.assert_fails(clitest.INVALID, "ndfgen", "-", "-o", out, *SMALL, stdin=b"not an image", outputs=[out])
+        self.assert_fails(clitest.BAD_ARGS, "glintinfo", "diff", "-", "-", stdin=asset)
+        err = self.assert_fails(clitest.BAD_ARGS, "glintref", "render", "-", "-o", self.path("r.exr"), stdin=b"{}")
+        self.assertIn("standard input", err)
+        self.assert_fails(clitest.BAD_ARGS, "glintbake", "bake", "-", stdin=b"{}")
+
     def test_containers_and_images_refuse_stdout(self):
         m = self.mapgen("beckmann", "m.png", "--size", "16")
         err = self.assert_fails(clitest.BAD_ARGS, "ndfgen", m, "-o", "-", *SMALL)

@@ -55,6 +55,9 @@ class TempDir {
 
 int runBake(cli::Tool& t, const BakeOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (o.manifest == "-")
+    throw Error(cli::kExitBadArguments,
+                "a manifest cannot be read from standard input ('-'): its relative paths need the manifest's folder");
   batch::Manifest m = batch::readManifest(o.manifest);
   t.addInput(o.manifest);
   for (const batch::Asset& a : m.assets) {
@@ -136,7 +139,8 @@ int runBake(cli::Tool& t, const BakeOptions& o) {
   }
   // Entries of assets no longer in the manifest are dropped.
   for (auto it = new_state.begin(); it != new_state.end();) {
-    const bool known = std::any_of(m.assets.begin(), m.assets.end(), [&](const batch::Asset& a) { return a.name == it->first; });
+    const bool known =
+        std::any_of(m.assets.begin(), m.assets.end(), [&](const batch::Asset& a) { return a.name == it->first; });
     it = known ? std::next(it) : new_state.erase(it);
   }
   batch::writeState(m.state_path, new_state);
@@ -170,7 +174,8 @@ int runBake(cli::Tool& t, const BakeOptions& o) {
 
 int main(int argc, char** argv) {
   cli::Tool tool("glintbake", "Bakes a manifest of assets with the glintbake tools, here or as Slurm jobs");
-  tool.addExample("glintbake bake assets.json -j 8 --json", "Bake every stale asset of a manifest, eight tools at a time.");
+  tool.addExample("glintbake bake assets.json -j 8 --json",
+                  "Bake every stale asset of a manifest, eight tools at a time.");
   tool.addExample("glintbake bake assets.json --emit slurm --emit-dir farm/",
                   "Write the same work as a Slurm job array and a merge job (farm/submit.sh submits them).");
   CLI::App& app = tool.app();

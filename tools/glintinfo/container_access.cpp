@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "container_access.h"
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/stdin_input.h>
 
 #include <glintbake/format/json_depth.h>
 #include <glintbake/format/validate.h>
@@ -10,7 +11,8 @@
 
 namespace glintbake::glintinfo {
 
-std::unique_ptr<format::Reader> openContainer(const std::string& path) {
+std::unique_ptr<format::Reader> openContainer(const std::string& argument) {
+  const std::string path = cli::resolveInput(argument);
   auto reader = std::make_unique<format::Reader>();
   const format::ContainerStatus status = reader->open(path);
   if (status == format::ContainerStatus::kOk) return reader;

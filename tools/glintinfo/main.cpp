@@ -6,8 +6,10 @@ int main(int argc, char** argv) {
   using namespace glintbake;
   cli::Tool tool("glintinfo", "Inspects, validates, compares and exports glintbake containers (.gbk)");
   tool.addExample("glintinfo info brushed.gbk", "Print the header, the sections and the metadata of an asset.");
-  tool.addExample("glintinfo validate --json brushed.gbk", "Check every rule of the specification; messages with stable ids as JSON.");
-  tool.addExample("glintinfo diff old.gbk new.gbk", "Compare two containers section by section (exit code 7 when they differ).");
+  tool.addExample("glintinfo validate --json brushed.gbk",
+                  "Check every rule of the specification; messages with stable ids as JSON.");
+  tool.addExample("glintinfo diff old.gbk new.gbk",
+                  "Compare two containers section by section (exit code 7 when they differ).");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();
@@ -30,6 +32,7 @@ int main(int argc, char** argv) {
     if (diff_cmd->parsed()) return glintinfo::runDiff(t, diff);
     if (export_cmd->parsed()) return glintinfo::runExport(t, exported);
     if (merge_cmd->parsed()) return glintinfo::runMerge(t, merge);
-    throw cli::Error(cli::kExitBadArguments, "no command given: use info, validate, diff, export or merge (see --help)");
+    throw cli::Error(cli::kExitBadArguments,
+                     "no command given: use info, validate, diff, export or merge (see --help)");
   });
 }

@@ -74,8 +74,7 @@ void checkSameBake(const Part& a, const Part& b) {
     throw invalid(both + " come from different tools or tool versions");
   if (a.meta.value("inputs", Json()) != b.meta.value("inputs", Json()))
     throw invalid(both + " are shards of bakes of different inputs (content hashes differ)");
-  if (sharedParameters(a) != sharedParameters(b))
-    throw invalid(both + " are shards of bakes with different options");
+  if (sharedParameters(a) != sharedParameters(b)) throw invalid(both + " are shards of bakes with different options");
   if (a.asset["shards"] != b.asset["shards"])
     throw invalid(both + " split the bake into different shard counts (" + a.asset["shards"].dump() + " and " +
                   b.asset["shards"].dump() + ")");

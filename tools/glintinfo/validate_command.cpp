@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "container_access.h"
 
+#include <glintbake/cli/stdin_input.h>
 #include <glintbake/format/validate.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -51,10 +52,12 @@ CLI::App* addValidateCommand(CLI::App& app, ValidateOptions& options) {
   return cmd;
 }
 
-int runValidate(cli::Tool& tool, const ValidateOptions& options) {
+int runValidate(cli::Tool& tool, const ValidateOptions& arguments) {
+  ValidateOptions options = arguments;
+  options.file = cli::resolveInput(arguments.file);
   format::ValidationReport report = format::validateFile(options.file);
   if (report.status == format::ContainerStatus::kIoError && !report.messages.empty() && report.messages[0].id == 1001) {
-    throw cli::Error(cli::kExitIo, "cannot read " + options.file);
+    throw cli::Error(cli::kExitIo, "cannot read " + arguments.file);
   }
   checkWithRuntime(options.file, &report);
 
@@ -63,7 +66,7 @@ int runValidate(cli::Tool& tool, const ValidateOptions& options) {
     for (const auto& m : report.messages) {
       messages.push_back({{"id", m.id}, {"severity", format::severityString(m.severity)}, {"message", m.message}});
     }
-    tool.printJson({{"file", cli::baseName(options.file)},
+    tool.printJson({{"file", cli::baseName(arguments.file)},
                     {"valid", report.valid()},
                     {"errors", report.errorCount()},
                     {"warnings", report.warningCount()},
@@ -72,7 +75,7 @@ int runValidate(cli::Tool& tool, const ValidateOptions& options) {
     for (const auto& m : report.messages) {
       std::printf("%s-%04d: %s\n", format::severityString(m.severity), m.id, m.message.c_str());
     }
-    std::printf("%s: %s (%zu errors, %zu warnings)\n", options.file.c_str(), report.valid() ? "valid" : "invalid",
+    std::printf("%s: %s (%zu errors, %zu warnings)\n", arguments.file.c_str(), report.valid() ? "valid" : "invalid",
                 report.errorCount(), report.warningCount());
   }
 
@@ -87,7 +90,7 @@ int runValidate(cli::Tool& tool, const ValidateOptions& options) {
   const int code = report.status == format::ContainerStatus::kUnsupportedVersion ? cli::kExitUnsupported
                    : report.status == format::ContainerStatus::kIoError          ? cli::kExitIo
                                                                                  : cli::kExitInvalidInput;
-  throw cli::Error(code, options.file + " is not valid: error-" + std::to_string(first->id) + ": " + first->message);
+  throw cli::Error(code, arguments.file + " is not valid: error-" + std::to_string(first->id) + ": " + first->message);
 }
 
 }  // namespace glintbake::glintinfo

@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/stdin_input.h>
 #include <glintbake/format/container.h>
 
 #include <cmath>
@@ -30,7 +31,8 @@ void parsePair(const std::string& text, const char* option, double* a, double* b
   if (!ok) throw Error(cli::kExitBadArguments, std::string(option) + " expects two numbers A,B (got '" + text + "')");
 }
 
-Asset openAsset(cli::Tool& tool, const std::string& path) {
+Asset openAsset(cli::Tool& tool, const std::string& argument) {
+  const std::string path = cli::resolveInput(argument);
   tool.addInput(path);
   Asset asset;
   const runtime::RuntimeStatus s = runtime::openNdfAsset(path.c_str(), &asset.source);

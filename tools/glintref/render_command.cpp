@@ -69,6 +69,9 @@ bake::render::NdfMode checkRenderOptions(const RenderOptions& options, int* widt
 
 // The scene with the command line's overrides.
 bake::render::Scene loadRenderScene(cli::Tool& tool, const RenderOptions& options, int width, int height) {
+  if (options.scene == "-")
+    throw cli::Error(cli::kExitBadArguments,
+                     "a scene cannot be read from standard input ('-'): its relative paths need the scene's folder");
   tool.addInput(options.scene);
   bake::render::Scene scene = cli::unwrap(bake::render::loadScene(options.scene));
   if (!options.asset.empty()) scene.material.asset = options.asset;

@@ -11,6 +11,7 @@
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/stdin_input.h>
 #include <glintbake/cli/tensor_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
@@ -240,6 +241,9 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
     return;
   }
   if (o.input.empty()) throw Error(cli::kExitBadArguments, "an input (or --procedural glitter) is required");
+  if (o.input == "-" && o.output.empty())
+    throw Error(cli::kExitBadArguments, "-o is required when the input is standard input ('-')");
+  o.input = cli::resolveInput(o.input);
   in.from_container = isContainer(o.input);
   if (o.output.empty()) o.output = defaultOutput(o.input, in.from_container);
   if (in.from_container) {
@@ -448,8 +452,10 @@ int glintbake::cli::tensorpackMain(int argc, char** argv) {
       "tensorpack",
       "Compresses the NDF footprint pyramid of a normal map or ndf-pyramid container into a tensor-ndf asset");
   Options o;
-  tool.addExample("tensorpack brushed.png -o brushed-t.gbk", "Bake and compress a normal map into a tensor-ndf asset in one step.");
-  tool.addExample("tensorpack brushed.gbk --rank 16 --strict", "Compress an ndf-pyramid asset; fail if the fit misses its error bound.");
+  tool.addExample("tensorpack brushed.png -o brushed-t.gbk",
+                  "Bake and compress a normal map into a tensor-ndf asset in one step.");
+  tool.addExample("tensorpack brushed.gbk --rank 16 --strict",
+                  "Compress an ndf-pyramid asset; fail if the fit misses its error bound.");
   addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();

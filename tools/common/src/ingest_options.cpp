@@ -4,6 +4,7 @@
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/stdin_input.h>
 
 #include <map>
 #include <string>
@@ -76,8 +77,9 @@ bake::NormalMap loadNormalMapForTool(Tool& tool, const std::string& path, const 
                                      bake::IngestReport* report) {
   bake::IngestReport local;
   bake::IngestReport* r = report != nullptr ? report : &local;
-  tool.addInput(path);
-  bake::Result<bake::NormalMap> loaded = bake::loadNormalMap(path, options, r);
+  const std::string file = resolveInput(path);
+  tool.addInput(file);
+  bake::Result<bake::NormalMap> loaded = bake::loadNormalMap(file, options, r);
   if (!loaded) throw Error(exitCodeOf(loaded.error()), loaded.error().message);
   // Every tool needs neighbours to differentiate or filter: a 1x1 map is refused everywhere.
   requireBakeableMap(loaded.value(), path);

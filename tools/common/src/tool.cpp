@@ -2,6 +2,7 @@
 // Command scaffolding shared by every tool: parsing, exit codes, reporting, progress, depfiles,
 // atomic outputs and the thread limit.
 #include <glintbake/cli/embed.h>
+#include <glintbake/cli/stdin_input.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
 #include <glintbake/version.h>
@@ -144,7 +145,8 @@ void writeDepfile(const std::string& depfile, const std::vector<std::string>& ta
   std::string text;
   for (size_t i = 0; i < targets.size(); ++i) text += (i ? " " : "") + escapeMake(targets[i]);
   text += ":";
-  for (const auto& d : dependencies) text += " \\\n  " + escapeMake(d);
+  for (const auto& d : dependencies)
+    if (d != "-") text += " \\\n  " + escapeMake(d);
   text += "\n";
   writeOutputFile(depfile, text);
 }
@@ -351,9 +353,12 @@ size_t editDistance(const std::string& a, const std::string& b) {
 std::string roff(const std::string& text) {
   std::string out;
   for (char c : text) {
-    if (c == '\\') out += "\\e";
-    else if (c == '-') out += "\\-";
-    else out += c;
+    if (c == '\\')
+      out += "\\e";
+    else if (c == '-')
+      out += "\\-";
+    else
+      out += c;
   }
   if (!out.empty() && (out[0] == '.' || out[0] == '\'')) out = "\\&" + out;
   return out;
@@ -369,7 +374,8 @@ void manOptions(std::string& page, const CLI::App& app) {
     page += ".TP\n.B " + roff(names);
     if (opt->get_type_size() != 0 && !plainTypeName(opt).empty()) page += " \\fI" + roff(plainTypeName(opt)) + "\\fR";
     page += "\n" + roff(opt->get_description());
-    if (!opt->get_default_str().empty() && opt->get_type_size() != 0) page += " (default: " + roff(opt->get_default_str()) + ")";
+    if (!opt->get_default_str().empty() && opt->get_type_size() != 0)
+      page += " (default: " + roff(opt->get_default_str()) + ")";
     page += "\n";
   }
 }
@@ -407,10 +413,13 @@ std::string Tool::manPage() const {
   }
   if (!examples_.empty()) {
     page += ".SH EXAMPLES\n";
-    for (const auto& [command, explanation] : examples_) page += ".TP\n.B " + roff(command) + "\n" + roff(explanation) + "\n";
+    for (const auto& [command, explanation] : examples_)
+      page += ".TP\n.B " + roff(command) + "\n" + roff(explanation) + "\n";
   }
   page += ".SH EXIT STATUS\n" + roff(kExitCodesText) + ".\n";
-  page += ".SH SEE ALSO\nThe container specification SPEC.md and the JSON schemas installed with glintbake's documentation.\n";
+  page +=
+      ".SH SEE ALSO\nThe container specification SPEC.md and the JSON schemas installed with glintbake's "
+      "documentation.\n";
   return page;
 }
 
@@ -453,7 +462,7 @@ int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
   EmbedHooks* hooks = embedHooks();
   if (!hooks) installSignalHandlers();
   const auto fail = [this, hooks](int code, const std::string& message) {
-    std::string line = message;
+    std::string line = nameStdin(message);
     std::replace(line.begin(), line.end(), '\n', ' ');
     if (hooks) hooks->error = line;
     std::fprintf(stderr, "%s: error: %s\n", name_.c_str(), line.c_str());
@@ -465,7 +474,8 @@ int Tool::run(int argc, char** argv, const std::function<int(Tool&)>& body) {
     if (opt->get_group().empty() || opt->get_name() == "--help") continue;
     global += "  " + plainOptionName(opt->get_name(false, true)) + "\n      " + opt->get_description() + "\n";
   }
-  for (CLI::App* sub : app_.get_subcommands([](CLI::App*) { return true; })) sub->footer(global + "\n" + app_.get_footer());
+  for (CLI::App* sub : app_.get_subcommands([](CLI::App*) { return true; }))
+    sub->footer(global + "\n" + app_.get_footer());
   for (int i = 1; i < argc; ++i)
     if (std::strcmp(argv[i], "--help-man") == 0) {
       std::cout << manPage();
@@ -537,7 +547,8 @@ std::string Tool::addInput(const std::string& path) {
   if (status != format::ContainerStatus::kOk) {
     throw Error(kExitIo, "cannot read " + path + ": " + (errno ? std::strerror(errno) : format::statusString(status)));
   }
-  inputs_.push_back(path);
+  // Standard input is named "-" in provenance and left out of depfiles (it is no file Make can see).
+  inputs_.push_back(!stdinInputPath().empty() && path == stdinInputPath() ? std::string("-") : path);
   input_hashes_.push_back(hex);
   return hex;
 }
