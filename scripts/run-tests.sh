@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # Builds everything and runs the whole test suite (CTest). Installs missing dependencies first.
 #  1. a runtime-only configuration (container library + runtime-lite, no OpenImageIO, Ceres, TBB
-#     or Eigen), built and tested as a renderer would build it;
+#     or Eigen), as shared libraries, built and tested as a renderer would build it;
 #  2. the full project, Release, with warnings as errors (GLINTBAKE_WERROR), every test;
 #  3. sanitizers (scripts/sanitize.sh): the unit tests under ASan+UBSan in a Debug build, the
 #     runtime's concurrency test under TSan;
@@ -25,8 +25,11 @@ stage() {
 runtime_only() {
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
+  # Shared libraries here (the full build below is static), so that the install consumers, the C
+  # program linked with pkg-config and the Python module are also tested against a shared runtime.
   cmake -S . -B build-runtime-only "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DGLINTBAKE_RUNTIME_ONLY=ON \
-    -DGLINTBAKE_BUILD_BENCH=OFF -DGLINTBAKE_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+    -DBUILD_SHARED_LIBS=ON -DGLINTBAKE_BUILD_BENCH=OFF -DGLINTBAKE_WERROR=ON -DPython3_EXECUTABLE=/usr/bin/python3 \
+    >/dev/null
   cmake --build build-runtime-only -j "$(nproc)" >/dev/null
   ctest --test-dir build-runtime-only --output-on-failure -j "$(nproc)"
 }

@@ -40,8 +40,13 @@ elseif(MODE STREQUAL "pkgconfig")
   endif()
   message(STATUS "pkg-config --cflags --libs glintbake-runtime: ${flags}")
   separate_arguments(flags UNIX_COMMAND "${flags}")
+  # A shared runtime outside the system's library path is found at run time through an rpath to
+  # the prefix's libdir, as a consumer of such a prefix would link it.
+  execute_process(COMMAND ${PKG_CONFIG} --variable=libdir glintbake-runtime OUTPUT_VARIABLE libdir
+                  OUTPUT_STRIP_TRAILING_WHITESPACE)
   # -lm for the program's own math.
-  run_step(${C_COMPILER} -std=c99 -Wall -Wextra -Werror ${C_SOURCE} -o ${WORK_DIR}/program ${flags} -lm)
+  run_step(${C_COMPILER} -std=c99 -Wall -Wextra -Werror ${C_SOURCE} -o ${WORK_DIR}/program ${flags} -lm
+           -Wl,-rpath,${libdir})
   run_step(${WORK_DIR}/program ${ARGS})
 elseif(MODE STREQUAL "python")
   set(ENV{PYTHONPATH} ${PREFIX}/${PYTHON_DIR})
