@@ -43,10 +43,10 @@ int exitCodeOf(rt::RuntimeStatus s) {
     case rt::RuntimeStatus::kIoError:
       return 2;
     case rt::RuntimeStatus::kInvalidAsset:
-    case rt::RuntimeStatus::kWrongKind:
       return 3;
     case rt::RuntimeStatus::kOutOfMemory:
       return 4;
+    case rt::RuntimeStatus::kWrongKind:  // as the tools: an asset of a kind this call cannot use
     case rt::RuntimeStatus::kUnsupportedVersion:
     case rt::RuntimeStatus::kPartialBake:
       return 5;

@@ -112,7 +112,7 @@ def test_open_errors_carry_exit_code_and_message_id(tmp_path):
         pytest.fail("no corrupted section was refused")
     with pytest.raises(glintbake.Error) as other:
         glintbake.open(LTC)
-    assert other.value.exit_code == 3 and "ltc-table" in str(other.value)
+    assert other.value.exit_code == 5 and "ltc-table" in str(other.value)  # as glintquery: wrong kind
 
 
 def write_pfm(path, size):
@@ -171,4 +171,4 @@ def test_ltcfit_table(tmp_path):
     glintbake.ltcfit_table(output=out, size=4, samples=8)
     with pytest.raises(glintbake.Error) as wrong:
         glintbake.open(out)  # an LTC table is not an NDF asset
-    assert wrong.value.exit_code == 3
+    assert wrong.value.exit_code == 5
