@@ -396,6 +396,35 @@ double weightNode(const WeightContext& c, const GlitterNode& node, double known 
   return sum;
 }
 
+// The resolved node (a cell of the resolution level, or a leaf) holding the target-th unit of
+// footprint weight, visiting the nodes in weightNode's order (dir = all): *acc sums the weights of
+// the resolved nodes before it. *last keeps the last node of positive weight, for a target that
+// rounding leaves just beyond the sum. True once found; *rest is the target's position inside it.
+bool pickResolved(const WeightContext& c, const GlitterNode& node, double known, double target, double* acc,
+                  GlitterNode* picked, double* rest, GlitterNode* last, double* last_weight) {
+  ++c.stats.nodes;
+  if (node.count == 0 || (known < 0.0 && beyondFootprint(c.fp, node))) return false;
+  if (node.uv_level >= c.level) {
+    if (known < 0.0) known = cellWeight(c.fp, node, c.level);
+    const double w = double(node.count) * known;
+    if (!(w > 0.0)) return false;
+    *last = node;
+    *last_weight = w;
+    if (target < *acc + w) {
+      *picked = node;
+      *rest = (target - *acc) / w;
+      return true;
+    }
+    *acc += w;
+    return false;
+  }
+  GlitterNode children[4];
+  glitterSplit(c.surface, c.shape, node, children);
+  for (const GlitterNode& child : children)
+    if (pickResolved(c, child, known, target, acc, picked, rest, last, last_weight)) return true;
+  return false;
+}
+
 }  // namespace
 
 uint64_t glitterMix(uint64_t x) {
@@ -653,14 +682,28 @@ bool glitterSampleFacet(const GlitterSurface& surface, const GlitterTreeShape& s
   const double root_weight = weightNode(c, node);
   if (total_weight) *total_weight = root_weight;
   if (!(root_weight > 0.0)) return false;
-  // Descend: above the resolution level children are chosen by their weighted counts; at and below
-  // it every facet of the subtree weighs the same, so by their counts.
+  // A second pass in the same order finds the resolved node (every facet below it weighs the same)
+  // holding u x the total weight: two weighted counts in all, whatever the depth.
+  {
+    double acc = 0.0, rest = 0.0, last_weight = 0.0;
+    GlitterNode picked, last;
+    if (pickResolved(c, node, -1.0, u * root_weight, &acc, &picked, &rest, &last, &last_weight)) {
+      node = picked;
+    } else if (last_weight > 0.0) {
+      node = last;  // u x total beyond the running sum by rounding: the last node of weight
+      rest = 1.0;
+    } else {
+      return false;
+    }
+    u = std::clamp(rest, 0.0, std::nextafter(1.0, 0.0));
+  }
+  // Below it, children are chosen by their counts.
   while (!glitterIsLeaf(surface, node)) {
     GlitterNode children[4];
     glitterSplit(surface, shape, node, children);
     double w[4], total = 0.0;
     for (int j = 0; j < 4; ++j) {
-      w[j] = node.uv_level >= c.level ? double(children[j].count) : weightNode(c, children[j]);
+      w[j] = double(children[j].count);
       total += w[j];
     }
     if (!(total > 0.0)) return false;

@@ -16,8 +16,8 @@
 //    bins of formats/SPEC.md section 9), as ndfgen --procedural glitter bakes them; average over a
 //    rectangle = weighted facets with (h_x, h_y) in it / (N x its area).
 // Every query uses the record's tree shape, so all footprints see the same facets. Cost grows
-// with log N and with the facets the footprint holds (bench/bench_glitter.cpp); sample() costs a
-// few dozen weighted counts. Queries are const, thread-safe and never allocate. load() is safe on
+// with log N and with the facets the footprint holds (bench/bench_glitter.cpp); sample() costs
+// about two weighted counts. Queries are const, thread-safe and never allocate. load() is safe on
 // untrusted input (the record and the integral table are checked before use).
 #pragma once
 

@@ -164,8 +164,9 @@ void glitterBinnedWeights(const GlitterSurface& surface, const GlitterTreeShape&
 
 // Picks one facet with probability proportional to its footprint weight, from u in [0, 1), and
 // returns its normal and the total weight (exactly glitterWeightedCount over all directions);
-// false when the footprint holds no weight. Costs a few weighted counts per
-// level above the resolution level. Thread-safe, no allocation.
+// false when the footprint holds no weight. Costs two weighted counts (the total, then the same
+// traversal up to the chosen cell of the resolution level) and a descent by counts below it.
+// Thread-safe, no allocation.
 bool glitterSampleFacet(const GlitterSurface& surface, const GlitterTreeShape& shape, const GlitterGaussian& fp,
                         double u, GlitterVec3* normal, double* total_weight, GlitterCountStats* stats);
 
