@@ -14,7 +14,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -197,6 +199,102 @@ BakeStatus checkImageSpec(const std::string& path, const OIIO::ImageSpec& spec, 
   return okStatus();
 }
 
+// The smallest number of bytes the decoded samples of the opened part can occupy: every channel of
+// the file (all are stored, whatever is read), at the bits per sample the file records (OIIO
+// expands 1-, 2- and 4-bit samples to uint8).
+uint64_t storedSampleBytes(const OIIO::ImageSpec& spec) {
+  const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
+  uint64_t bits_per_texel = 0;
+  for (int c = 0; c < spec.nchannels; ++c) bits_per_texel += uint64_t(spec.channelformat(c).size()) * 8;
+  const int recorded = spec.get_int_attribute("oiio:BitsPerSample", 0);
+  if (recorded > 0 && recorded < int(spec.format.size()) * 8) bits_per_texel = uint64_t(recorded) * spec.nchannels;
+  return texels / 8 * bits_per_texel + (texels % 8) * bits_per_texel / 8;
+}
+
+// The PNG header's own bits per pixel (IHDR: bit depth x samples of the colour type; a palette
+// index is one sample), or 0 when the header cannot be read.
+uint64_t pngBitsPerPixel(const std::string& path) {
+  unsigned char ihdr[26] = {};
+  std::ifstream f(path, std::ios::binary);
+  if (!f.read(reinterpret_cast<char*>(ihdr), sizeof(ihdr))) return 0;
+  if (std::string(reinterpret_cast<const char*>(ihdr + 12), 4) != "IHDR") return 0;
+  const unsigned depth = ihdr[24], colour = ihdr[25];
+  const unsigned samples = colour == 0 ? 1 : colour == 2 ? 3 : colour == 3 ? 1 : colour == 4 ? 2 : colour == 6 ? 4 : 0;
+  return uint64_t(depth) * samples;
+}
+
+// How many decoded bytes one byte of the file can produce at most, for the codecs whose ratio is
+// bounded (0: unbounded or unknown). Deflate: at most 1032:1 (zlib's documented limit: a 258-byte
+// match costs at least 2 bits); OpenEXR RLE and TIFF PackBits: 128 bytes from 2 (64:1); TIFF LZW: a
+// 12-bit code names at most 4096 bytes (2731:1); OpenEXR PXR24: deflate of 3 bytes per 4-byte float
+// (1376:1); OpenEXR B44/B44A: a flat 4x4 block of 32 bytes in 3 (11:1); no compression: 1:1.
+double maxExpansion(const std::string& format, const OIIO::ImageSpec& spec) {
+  if (format == "png") return 1032.0;
+  std::string codec = spec.get_string_attribute("compression", "none");
+  codec = codec.substr(0, codec.find(':'));
+  for (char& c : codec) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (format == "openexr") {
+    if (codec == "none") return 1.0;
+    if (codec == "rle") return 64.0;
+    if (codec == "zip" || codec == "zips") return 1032.0;
+    if (codec == "pxr24") return 1376.0;
+    if (codec == "b44" || codec == "b44a") return 11.0;
+    return 0.0;  // piz, dwaa, dwab, htj2k, ...: probed instead
+  }
+  if (format == "tiff") {
+    if (codec == "none") return 1.0;
+    if (codec == "packbits") return 64.0;
+    if (codec == "lzw") return 2731.0;
+    if (codec == "zip" || codec == "deflate" || codec == "adobe_deflate") return 1032.0;
+    return 0.0;
+  }
+  return 0.0;
+}
+
+// Refuses, before any pixel buffer is allocated, a file that cannot hold the image its header
+// declares (a 74-byte PNG declaring 8192 x 8192 texels): for codecs of bounded ratio, the file must
+// have at least (decoded bytes - 64 KiB) / ratio bytes (the slack covers stream ends and is far
+// below anything worth refusing); for the others the last row is decoded first, into a one-row
+// buffer, so a truncated file or missing chunks fail before the whole image is allocated.
+BakeStatus checkPlausibleSize(const std::string& path, OIIO::ImageInput& input, const IngestOptions& options,
+                              int used) {
+  const OIIO::ImageSpec& spec = input.spec();
+  const std::string format = input.format_name();
+  std::error_code ec;
+  const uintmax_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) return makeError(ErrorCode::kIo, path + ": cannot read the file size");
+  const double ratio = maxExpansion(format, spec);
+  if (ratio > 0.0) {
+    uint64_t decoded = storedSampleBytes(spec);
+    if (format == "png") {
+      const uint64_t bits = pngBitsPerPixel(path);
+      if (bits == 0) return makeError(ErrorCode::kInvalidInput, path + ": unreadable PNG header");
+      const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
+      decoded = texels / 8 * bits + (texels % 8) * bits / 8;
+    }
+    constexpr uint64_t kSlack = uint64_t(64) << 10;
+    const double needed = decoded > kSlack ? std::ceil(double(decoded - kSlack) / ratio) : 0.0;
+    if (double(file_size) < needed) {
+      return makeError(ErrorCode::kInvalidInput, path + ": " + std::to_string(file_size) +
+                                                     " bytes cannot hold the declared " + std::to_string(spec.width) +
+                                                     "x" + std::to_string(spec.height) + " image (" +
+                                                     std::to_string(decoded) + " bytes of samples need at least " +
+                                                     std::to_string(uint64_t(needed)) + " bytes of file at most " +
+                                                     std::to_string(int(ratio)) + ":1)");
+    }
+    return okStatus();
+  }
+  // Unbounded codecs: decode the last row alone first.
+  std::vector<float> row(size_t(spec.width) * size_t(used));
+  const int last = spec.y + spec.height - 1;
+  if (!input.read_scanlines(options.part, 0, last, last + 1, spec.z, 0, used, OIIO::TypeDesc::FLOAT, row.data()) ||
+      input.has_error()) {
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": corrupt or truncated image (" + oneLine(input.geterror()) + ")");
+  }
+  return okStatus();
+}
+
 // The first `used` channels of every texel as float.
 Result<std::vector<float>> readPixels(const std::string& path, OIIO::ImageInput& input, const IngestOptions& options,
                                       int used) {
@@ -316,6 +414,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
 
   // Alpha and any extra channels are never read; height fields use the first channel only.
   const int used = options.height ? 1 : std::min(spec.nchannels, 3);
+  if (BakeStatus s = checkPlausibleSize(path, input, options, used); !s) return s.error();
   Result<std::vector<float>> read = readPixels(path, input, options, used);
   if (!read) return read.error();
   std::vector<float>& pixels = read.value();
