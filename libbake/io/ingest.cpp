@@ -284,11 +284,21 @@ BakeStatus checkPlausibleSize(const std::string& path, OIIO::ImageInput& input, 
     }
     return okStatus();
   }
-  // Unbounded codecs: decode the last row alone first.
-  std::vector<float> row(size_t(spec.width) * size_t(used));
-  const int last = spec.y + spec.height - 1;
-  if (!input.read_scanlines(options.part, 0, last, last + 1, spec.z, 0, used, OIIO::TypeDesc::FLOAT, row.data()) ||
-      input.has_error()) {
+  // Unbounded codecs: decode the last row (tiled files: the last tile) alone first.
+  bool probed = false;
+  if (spec.tile_width > 0 && spec.tile_height > 0) {
+    const int x0 = spec.x + (spec.width - 1) / spec.tile_width * spec.tile_width;
+    const int y0 = spec.y + (spec.height - 1) / spec.tile_height * spec.tile_height;
+    const int x1 = spec.x + spec.width, y1 = spec.y + spec.height;
+    std::vector<float> tile(size_t(x1 - x0) * size_t(y1 - y0) * size_t(used));
+    probed = input.read_tiles(options.part, 0, x0, x1, y0, y1, spec.z, spec.z + 1, 0, used, OIIO::TypeDesc::FLOAT,
+                              tile.data());
+  } else {
+    std::vector<float> row(size_t(spec.width) * size_t(used));
+    const int last = spec.y + spec.height - 1;
+    probed = input.read_scanlines(options.part, 0, last, last + 1, spec.z, 0, used, OIIO::TypeDesc::FLOAT, row.data());
+  }
+  if (!probed || input.has_error()) {
     return makeError(ErrorCode::kInvalidInput,
                      path + ": corrupt or truncated image (" + oneLine(input.geterror()) + ")");
   }

@@ -482,6 +482,8 @@ TEST(Ingest, HighlyCompressibleLargeMapsStillLoad) {
                         {"pxr24.exr", OIIO::TypeDesc::FLOAT, "pxr24", false},
                         {"b44a.exr", OIIO::TypeDesc::HALF, "b44a", false},
                         {"piz.exr", OIIO::TypeDesc::HALF, "piz", false},
+                        {"piz-tiled.exr", OIIO::TypeDesc::HALF, "piz", true},
+                        {"dwaa.exr", OIIO::TypeDesc::HALF, "dwaa", false},
                         {"lzw.tif", OIIO::TypeDesc::UINT8, "lzw", false},
                         {"zip.tif", OIIO::TypeDesc::UINT16, "zip", false},
                         {"packbits.tif", OIIO::TypeDesc::UINT8, "packbits", false}};
