@@ -144,6 +144,64 @@ bool fileReadable(const std::string& path) {
   return f.good();
 }
 
+// OpenEXR (3.1) allocates every header attribute at the size the file declares before reading it,
+// so a 1 KB file can cost gigabytes before OIIO returns. The attributes of every header are walked
+// here first, skipping their values: each must lie inside the file. False (and *why) otherwise.
+bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
+  std::ifstream f(path, std::ios::binary);
+  unsigned char start[8] = {};
+  if (!f.read(reinterpret_cast<char*>(start), 8)) return true;  // not OpenEXR: OIIO decides
+  if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01)) return true;
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return true;
+  const bool multipart = (start[5] & 0x10) != 0;  // version flags bit 12
+  auto readName = [&](std::string* out) {
+    out->clear();
+    for (char c; f.get(c);) {
+      if (c == '\0') return true;
+      if (out->size() == 255) return false;
+      out->push_back(c);
+    }
+    return false;
+  };
+  std::string name, type;
+  for (int header = 0;; ++header) {
+    for (;;) {
+      if (!readName(&name)) {
+        *why = "truncated OpenEXR header";
+        return false;
+      }
+      if (name.empty()) break;  // end of this header
+      unsigned char bytes[4] = {};
+      if (!readName(&type) || !f.read(reinterpret_cast<char*>(bytes), 4)) {
+        *why = "truncated OpenEXR header";
+        return false;
+      }
+      const int32_t value_size =
+          int32_t(uint32_t(bytes[0]) | uint32_t(bytes[1]) << 8 | uint32_t(bytes[2]) << 16 | uint32_t(bytes[3]) << 24);
+      const uint64_t at = uint64_t(f.tellg());
+      if (value_size < 0 || uint64_t(value_size) > size - std::min(size, at)) {
+        // The name comes from the file: only printable ASCII of it reaches the one-line error.
+        for (char& c : name) c = c >= 0x20 && c < 0x7f ? c : '?';
+        *why = "OpenEXR attribute '" + name + "' declares " + std::to_string(value_size) + " bytes, more than the " +
+               std::to_string(size - std::min(size, at)) + " left in the file";
+        return false;
+      }
+      f.seekg(std::streamoff(value_size), std::ios::cur);
+    }
+    if (!multipart) return true;
+    // Multi-part files end their list of headers with an empty one.
+    const int next = f.peek();
+    if (next == std::char_traits<char>::eof()) {
+      *why = "truncated OpenEXR header";
+      return false;
+    }
+    if (next == 0) return true;
+    if (header > 1 << 16) return true;  // OIIO refuses such part counts itself
+  }
+}
+
 // Opens the image (and the requested part) after the checks that need no decoding.
 Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
@@ -155,6 +213,9 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
   }
   if (!fileReadable(path)) {
     return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
+  }
+  if (std::string why; !exrHeadersFitTheFile(path, &why)) {
+    return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + why + ")");
   }
   const OIIO::ImageSpec config = readConfig();
   auto input = OIIO::ImageInput::open(path, &config);

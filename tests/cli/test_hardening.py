@@ -150,14 +150,15 @@ def png_file(width, height, idat=b"", colour_type=2, bit_depth=8):
             chunk(b"IEND", b""))
 
 
-def exr_file(width, height, compression):
+def exr_file(width, height, compression, first=b""):
     """A scanline OpenEXR file of three half channels whose header declares width x height and
-    whose line offset table is all zeros: no chunk of pixels at all. compression: 3 zip, 4 piz."""
+    whose line offset table is all zeros: no chunk of pixels at all. compression: 3 zip, 4 piz.
+    `first`: bytes put before the header's attributes."""
     def attr(name, kind, data):
         return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(data)) + data
     channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 1, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
     box = struct.pack("<4i", 0, 0, width - 1, height - 1)
-    header = (struct.pack("<ii", 20000630, 2) + attr("channels", "chlist", channels) +
+    header = (struct.pack("<ii", 20000630, 2) + first + attr("channels", "chlist", channels) +
               attr("compression", "compression", bytes([compression])) + attr("dataWindow", "box2i", box) +
               attr("displayWindow", "box2i", box) + attr("lineOrder", "lineOrder", b"\0") +
               attr("pixelAspectRatio", "float", struct.pack("<f", 1.0)) +
@@ -180,7 +181,13 @@ class HostileImages(clitest.ToolTestCase):
         files["cut.png"] = png_file(8192, 8192, idat=rows)
         files["zip.exr"] = exr_file(8192, 8192, 3)  # bounded ratio: refused from its size
         files["piz.exr"] = exr_file(8192, 8192, 4)  # unbounded ratio: its last row is read first
+        # A 64 x 64 file whose first attribute declares a 1.8 GB string (OpenEXR allocates it).
+        files["attr.exr"] = exr_file(64, 64, 3, first=b"Software\0string\0" + struct.pack("<i", 0x6E000000))
         return {name: self.write(name, data) for name, data in files.items()}
+
+    EXPECTED = {"tiny.png": "cannot hold the declared 8192x8192 image", "cut.png": "1032:1",
+                "zip.exr": "cannot hold the declared 8192x8192 image", "piz.exr": "corrupt or truncated",
+                "attr.exr": "attribute 'Software' declares 1845493760 bytes"}
 
     def test_every_ingesting_tool_refuses_before_allocating(self):
         files = self.hostile_files()
@@ -196,7 +203,7 @@ class HostileImages(clitest.ToolTestCase):
                          ("tinyexample", path, "-o", gbk, "--quiet")):
                 err = self.assert_fails(INVALID, *args, outputs=[gbk, exr], limits=MEMORY_LIMIT)
                 self.assertIn(name, err)
-                self.assertIn("8192x8192" if name != "piz.exr" else "corrupt or truncated", err)
+                self.assertIn(self.EXPECTED[name], err)
 
     def test_manifest_assets_fail_alike(self):
         files = self.hostile_files()

@@ -521,6 +521,25 @@ TEST(Ingest, FileTooSmallForItsHeaderIsInvalid) {
       << map.error().message;
 }
 
+// OpenEXR allocates header attributes at their declared size: one declaring more bytes than the
+// file holds is refused before OIIO opens the file, in one line even when its name holds newlines
+// (found by fuzz_ingest).
+TEST(Ingest, ExrAttributeLargerThanTheFileIsInvalid) {
+  ScratchDir dir;
+  const std::string path = dir.file("attr.exr");
+  std::string bytes("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  bytes += std::string("Soft\nware\0string\0", 17);
+  bytes += std::string("\x00\x00\x00\x6e", 4);  // 1845493760 bytes
+  bytes += std::string(512, 'x');
+  test::writeBytes(path, bytes);
+  auto map = load(path, nullptr);
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.error().code, ErrorCode::kInvalidInput);
+  expectOneLineNaming(map.error(), "attr.exr");
+  EXPECT_NE(map.error().message.find("attribute 'Soft?ware' declares 1845493760 bytes"), std::string::npos)
+      << map.error().message;
+}
+
 TEST(Ingest, GarbageFileIsInvalid) {
   ScratchDir dir;
   const std::string path = dir.file("garbage.png");
