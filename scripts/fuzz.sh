@@ -31,19 +31,22 @@ for target in "${targets[@]}"; do
   mkdir -p "$corpus"
   run_seconds=$seconds
   extra=()
+  runner=()
   if [[ $target == fuzz_json ]]; then
     cp tests/fuzz/json/* "$corpus"/
   elif [[ $target == fuzz_ingest ]]; then
     cp tests/fuzz/images/* "$corpus"/
     run_seconds=$ingest_seconds
     # OpenImageIO's PNG reader leaks its error strings when libpng longjmps out of a read callback
-    # (not glintbake code; LSan's fast unwinder cannot tell those apart for a suppression).
+    # (not glintbake code; LSan's fast unwinder cannot tell those apart for a suppression): no leak
+    # checks, neither per input nor at exit.
     extra=(-detect_leaks=0)
+    runner=(env ASAN_OPTIONS=detect_leaks=0)
   else
     cp tests/format/*.gbk "$corpus"/
   fi
   log=build-fuzz/$target.log
-  if ! build-fuzz/bin/$target "$corpus" -max_total_time="$run_seconds" -rss_limit_mb=2048 -timeout=10 \
+  if ! "${runner[@]}" build-fuzz/bin/$target "$corpus" -max_total_time="$run_seconds" -rss_limit_mb=2048 -timeout=10 \
        -max_len=262144 -artifact_prefix=build-fuzz/artifacts/ -print_final_stats=1 "${extra[@]}" >"$log" 2>&1; then
     echo "$target: FAILED (see $log and build-fuzz/artifacts/)" >&2
     tail -30 "$log" >&2
