@@ -9,6 +9,8 @@
 
 #include "hash_stream.h"
 
+#include <xxhash.h>
+
 #include <algorithm>
 #include <cstring>
 #include <string>
@@ -377,6 +379,140 @@ ContainerStatus readSectionAlloc(const ByteSource& source, const SectionInfo& in
   status = decodeZstd(stored, size_t(info.stored_size), out->data(), out->size());
   if (status != ContainerStatus::kOk) std::vector<uint8_t>().swap(*out);
   return status;
+}
+
+namespace {
+
+constexpr int kStreamWindowLog = 27;  // ZSTD_WINDOWLOG_LIMIT_DEFAULT: the largest window streamed
+
+// Raw sections: hashed a chunk at a time (nothing reaches the sink on a mismatch), then read again.
+ContainerStatus streamRaw(const ByteSource& source, const SectionInfo& info, SectionSink* sink) {
+  if (info.stored_size != info.raw_size || info.raw_size > source.size()) return ContainerStatus::kCorruptIndex;
+  if (const uint8_t* data = source.data()) {
+    if (info.offset > source.size() || info.raw_size > source.size() - info.offset) return ContainerStatus::kTruncated;
+    const uint8_t* bytes = data + info.offset;
+    if (hash64(bytes, size_t(info.raw_size)) != info.checksum) return ContainerStatus::kChecksumMismatch;
+    for (uint64_t at = 0; at < info.raw_size; at += kSectionStreamChunk)
+      sink->consume(bytes + at, size_t(std::min<uint64_t>(kSectionStreamChunk, info.raw_size - at)));
+    return ContainerStatus::kOk;
+  }
+  std::vector<uint8_t> chunk(size_t(std::min<uint64_t>(kSectionStreamChunk, info.raw_size)));
+  XXH3Streamer hasher;
+  if (!hasher.ok()) return ContainerStatus::kIoError;
+  for (uint64_t at = 0; at < info.raw_size;) {
+    const size_t n = size_t(std::min<uint64_t>(chunk.size(), info.raw_size - at));
+    if (!source.readAt(info.offset + at, chunk.data(), n)) return ContainerStatus::kTruncated;
+    hasher.update(chunk.data(), n);
+    at += n;
+  }
+  if (hasher.digest() != info.checksum) return ContainerStatus::kChecksumMismatch;
+  for (uint64_t at = 0; at < info.raw_size;) {
+    const size_t n = size_t(std::min<uint64_t>(chunk.size(), info.raw_size - at));
+    if (!source.readAt(info.offset + at, chunk.data(), n)) return ContainerStatus::kTruncated;
+    sink->consume(chunk.data(), n);
+    at += n;
+  }
+  return ContainerStatus::kOk;
+}
+
+// A checked frame (loadZstdFrame) decoded by zstd's streaming decoder into one reused chunk.
+ContainerStatus streamZstdFrame(const uint8_t* stored, size_t stored_size, uint64_t raw_size, SectionSink* sink) {
+  ZSTD_DCtx* dctx = ZSTD_createDCtx();
+  if (!dctx) return ContainerStatus::kDecompressFailed;
+  ZSTD_DCtx_setParameter(dctx, ZSTD_d_windowLogMax, kStreamWindowLog);
+  std::vector<uint8_t> chunk(size_t(std::min<uint64_t>(kSectionStreamChunk, std::max<uint64_t>(raw_size, 1))));
+  ZSTD_inBuffer in{stored, stored_size, 0};
+  uint64_t total = 0;
+  ContainerStatus status = ContainerStatus::kDecompressFailed;
+  for (;;) {
+    ZSTD_outBuffer out{chunk.data(), chunk.size(), 0};
+    const size_t left = ZSTD_decompressStream(dctx, &out, &in);
+    if (ZSTD_isError(left) || out.pos > raw_size - total) break;
+    total += out.pos;
+    if (out.pos > 0) sink->consume(chunk.data(), out.pos);
+    if (left == 0) {
+      if (in.pos == in.size && total == raw_size) status = ContainerStatus::kOk;
+      break;
+    }
+    if (in.pos == in.size && out.pos < out.size) break;  // the frame needs bytes it does not have
+  }
+  ZSTD_freeDCtx(dctx);
+  return status;
+}
+
+// A checked frame whose blocks are all raw or RLE (checked here, false otherwise): expanded block
+// by block, so its window size does not matter. Same verdicts as zstd's own decoder on such frames.
+bool rawAndRleOnly(const uint8_t* frame, size_t size, size_t header) {
+  for (size_t at = header; size - at >= 3;) {
+    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
+    const uint32_t type = (block >> 1) & 3;
+    if (type != 0 && type != 1) return false;
+    const size_t consumed = type == 1 ? 1 : size_t(block >> 3);
+    if (consumed > size - at - 3) return false;
+    at += 3 + consumed;
+    if (block & 1) return true;
+  }
+  return false;
+}
+
+ContainerStatus expandRawAndRle(const uint8_t* frame, size_t size, const ZSTD_frameHeader& fh, uint64_t raw_size,
+                                SectionSink* sink) {
+  std::vector<uint8_t> run;
+  XXH64_state_t* xxh = XXH64_createState();
+  if (!xxh) return ContainerStatus::kDecompressFailed;
+  XXH64_reset(xxh, 0);
+  uint64_t total = 0;
+  size_t at = fh.headerSize;
+  bool last = false;
+  while (!last) {  // rawAndRleOnly proved every header and block lies inside the frame
+    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
+    at += 3;
+    last = block & 1;
+    const bool rle = ((block >> 1) & 3) == 1;
+    const size_t n = size_t(block >> 3);
+    if (n > raw_size - total) break;
+    const uint8_t* bytes = frame + at;
+    if (rle) {
+      run.assign(n, frame[at]);
+      bytes = run.data();
+    }
+    XXH64_update(xxh, bytes, n);
+    sink->consume(bytes, n);
+    total += n;
+    at += rle ? 1 : n;
+  }
+  const uint64_t digest = XXH64_digest(xxh);
+  XXH64_freeState(xxh);
+  if (!last || total != raw_size) return ContainerStatus::kDecompressFailed;
+  const size_t end = at + (fh.checksumFlag ? 4 : 0);
+  if (end != size) return ContainerStatus::kDecompressFailed;
+  if (fh.checksumFlag && layout::load32(frame + at) != uint32_t(digest)) return ContainerStatus::kDecompressFailed;
+  return ContainerStatus::kOk;
+}
+
+}  // namespace
+
+ContainerStatus streamSection(const ByteSource& source, const SectionInfo& info, SectionSink* sink) {
+  if (!knownCodec(info.codec)) return ContainerStatus::kDecompressFailed;
+  if (info.codec == uint32_t(Codec::kRaw)) return streamRaw(source, info, sink);
+  std::vector<uint8_t> buffer;
+  const uint8_t* stored = nullptr;
+  ContainerStatus status = loadZstdFrame(source, info, &buffer, &stored);
+  if (status != ContainerStatus::kOk) return status;
+  const size_t stored_size = size_t(info.stored_size);
+  ZSTD_frameHeader fh;
+  const bool plain = ZSTD_getFrameHeader(&fh, stored, stored_size) == 0 && fh.frameType == ZSTD_frame && fh.dictID == 0;
+  if (plain && fh.windowSize <= (uint64_t(1) << kStreamWindowLog))
+    return streamZstdFrame(stored, stored_size, info.raw_size, sink);
+  if (plain && rawAndRleOnly(stored, stored_size, fh.headerSize))
+    return expandRawAndRle(stored, stored_size, fh, info.raw_size, sink);
+  // Anything else (a window above 2^27 with compressed blocks): decoded whole, as readSectionAlloc.
+  std::vector<uint8_t> whole(size_t(info.raw_size));
+  status = decodeZstd(stored, stored_size, whole.data(), whole.size());
+  if (status != ContainerStatus::kOk) return status;
+  for (size_t at = 0; at < whole.size(); at += kSectionStreamChunk)
+    sink->consume(whole.data() + at, std::min(kSectionStreamChunk, whole.size() - at));
+  return ContainerStatus::kOk;
 }
 
 ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected) {

@@ -46,6 +46,24 @@ ContainerStatus readSectionFrom(const ByteSource& source, const SectionInfo& inf
 // frame and block headers, that they decode to raw_size bytes). out is empty on failure.
 ContainerStatus readSectionAlloc(const ByteSource& source, const SectionInfo& info, std::vector<uint8_t>* out);
 
+// Receives a section's decoded bytes in order, in pieces of at most kSectionStreamChunk bytes.
+class SectionSink {
+ public:
+  virtual ~SectionSink() = default;
+  virtual void consume(const uint8_t* data, size_t size) = 0;
+};
+constexpr size_t kSectionStreamChunk = size_t(1) << 20;
+
+// The decoded bytes of section `info`, passed to `sink` in bounded pieces instead of one raw_size
+// buffer, after the same checks and with the same statuses as readSectionAlloc: raw sections are
+// hashed, then read, a chunk at a time; zstd frames are decoded a chunk at a time with a window of
+// at most 2^27 bytes (frames of larger windows made only of raw and RLE blocks, which need no
+// window, are expanded block by block; any other such frame is decoded whole, as by
+// readSectionAlloc). The stored bytes of a zstd section are read whole (they are in the file). The
+// sink may have seen bytes when a failure is returned (a frame that stops early): callers keep
+// what it found only on kOk. Thread-safe.
+ContainerStatus streamSection(const ByteSource& source, const SectionInfo& info, SectionSink* sink);
+
 // Hashes bytes [kHeaderSize, size) of the source (streamed in fixed-size chunks) and compares
 // with `expected`.
 ContainerStatus verifyFileChecksumOf(const ByteSource& source, uint64_t expected);

@@ -30,6 +30,9 @@ constexpr size_t kMaxMetadataBytes = size_t(kMaxMetadataSize);
 constexpr int kMaxMetadataDepth = kMaxJsonDepth;
 constexpr const char* kMetadataSchemaId = "glintbake.container-metadata/1";
 
+// parseImageSection from the first 32 bytes of a section of `size` bytes (defined below).
+bool parseImageHeader(const uint8_t* data, uint64_t size, ImageSectionHeader* header);
+
 class Collector final : public detail::Diagnostics {
  public:
   explicit Collector(std::vector<ValidationMessage>* messages) : messages_(messages) {}
@@ -62,41 +65,97 @@ std::string describe(size_t index, const SectionInfo& s) {
          ")";
 }
 
+// What the payload checks need of a section, gathered while it streams past (detail::streamSection)
+// so that no section is ever held whole unless it is a small record: its size, its first bytes (the
+// image header or a record), every byte of the sections checked as a whole (metadata, at most
+// 16 MiB, records whose size is already known to be right, and a glitter integral table of at
+// most 16 MiB), and tallies of its 32-bit floats.
+struct Payload {
+  static constexpr size_t kHead = 256;  // >= every record and the image header
+  uint64_t size = 0;
+  std::vector<uint8_t> head;                   // the first min(size, kHead) bytes
+  std::vector<uint8_t> whole;                  // every byte, when keep_whole
+  uint64_t nonfinite_after_image_header = 0;   // floats at offsets >= 32
+  bool nonfinite_after_flakes_record = false;  // floats at offsets >= sizeof(FlakesRecord)
+  bool outside_unit = false;                   // !(|v| <= 1) for a float at any offset
+  bool negative_after_image_header = false;    // v < 0 for a float at offsets >= 32
+};
+static_assert(sizeof(FlakesRecord) <= Payload::kHead && sizeof(WangRecord) <= Payload::kHead &&
+                  sizeof(TinyExampleRecord) <= Payload::kHead && layout::kImageHeaderSize <= Payload::kHead,
+              "records fit the head");
+static_assert(sizeof(FlakesRecord) % 4 == 0 && layout::kImageHeaderSize % 4 == 0, "floats on one grid");
+
+class PayloadSink final : public detail::SectionSink {
+ public:
+  PayloadSink(Payload* payload, bool keep_whole) : p_(payload), keep_whole_(keep_whole) {}
+  void consume(const uint8_t* data, size_t size) override {
+    const size_t head = std::min(size, Payload::kHead - std::min(Payload::kHead, p_->head.size()));
+    p_->head.insert(p_->head.end(), data, data + head);
+    if (keep_whole_) p_->whole.insert(p_->whole.end(), data, data + size);
+    size_t i = 0;
+    while (carried_ != 0 && i < size) {  // a float split between two pieces
+      carry_[carried_++] = data[i++];
+      if (carried_ == 4) {
+        carried_ = 0;
+        noteAt(carry_);
+      }
+    }
+    for (; i + 4 <= size; i += 4) noteAt(data + i);
+    while (i < size) carry_[carried_++] = data[i++];
+    p_->size += size;
+  }
+
+ private:
+  void noteAt(const uint8_t* bytes) {
+    float v;
+    std::memcpy(&v, bytes, 4);
+    note(v, offset_);
+    offset_ += 4;
+  }
+  void note(float v, uint64_t offset) {
+    const bool finite = std::isfinite(v);
+    if (!(std::fabs(v) <= 1.0f)) p_->outside_unit = true;
+    if (offset >= sizeof(FlakesRecord) && !finite) p_->nonfinite_after_flakes_record = true;
+    if (offset >= layout::kImageHeaderSize) {
+      if (!finite) ++p_->nonfinite_after_image_header;
+      if (v < 0.0f) p_->negative_after_image_header = true;
+    }
+  }
+  Payload* p_;
+  bool keep_whole_;
+  uint8_t carry_[4] = {};
+  size_t carried_ = 0;
+  uint64_t offset_ = 0;
+};
+
 // The flakes section (SPEC.md 10.5): its record passes checkFlakesRecord and its normals are finite.
-void checkFlakesPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
+void checkFlakesPayload(size_t index, const SectionInfo& s, const Payload& raw,
                         std::vector<ValidationMessage>* messages) {
   FlakesRecord rec;
-  if (raw.size() < sizeof(rec)) {
+  if (raw.size < sizeof(rec)) {
     addError(messages, 4008, describe(index, s) + ": shorter than the flakes record");
     return;
   }
-  std::memcpy(&rec, raw.data(), sizeof(rec));
-  if (const char* why = checkFlakesRecord(rec, raw.size())) {
+  std::memcpy(&rec, raw.head.data(), sizeof(rec));
+  if (const char* why = checkFlakesRecord(rec, size_t(raw.size))) {
     addError(messages, 4008, describe(index, s) + ": " + why);
     return;
   }
-  for (size_t i = sizeof(rec); i + 4 <= raw.size(); i += 4) {
-    float v;
-    std::memcpy(&v, raw.data() + i, 4);
-    if (!std::isfinite(v)) {
-      addError(messages, 4008, describe(index, s) + ": non-finite normals");
-      return;
-    }
-  }
+  if (raw.nonfinite_after_flakes_record) addError(messages, 4008, describe(index, s) + ": non-finite normals");
 }
 
 // The wang-tiles sections (SPEC.md 10.7): the record passes checkWangRecord; the edges section
 // passes checkWangEdges against the record and the texels section has the record's size and
 // finite values within [-1, 1] (both need the record, which writers put first). The embedded tile
 // assets are left to the runtime's loader (6004).
-void checkWangPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, WangRecord* record,
-                      bool* have_record, std::vector<ValidationMessage>* messages) {
+void checkWangPayload(size_t index, const SectionInfo& s, const Payload& raw, WangRecord* record, bool* have_record,
+                      std::vector<ValidationMessage>* messages) {
   if (s.type == kSectionWangInfo) {
-    if (raw.size() != sizeof(WangRecord)) {
+    if (raw.size != sizeof(WangRecord)) {
       addError(messages, 4009, describe(index, s) + ": not the size of the wang record");
       return;
     }
-    std::memcpy(record, raw.data(), sizeof(WangRecord));
+    std::memcpy(record, raw.head.data(), sizeof(WangRecord));
     if (const char* why = checkWangRecord(*record)) {
       addError(messages, 4009, describe(index, s) + ": " + why);
       return;
@@ -106,65 +165,56 @@ void checkWangPayload(size_t index, const SectionInfo& s, const std::vector<uint
   }
   if (!*have_record) return;
   if (s.type == kSectionWangEdges) {
-    if (const char* why = checkWangEdges(*record, raw.data(), raw.size()))
+    // Kept whole only when of the record's size; otherwise checkWangEdges reports the size alone.
+    static const uint8_t kNone = 0;
+    const void* bytes = raw.whole.size() == raw.size && !raw.whole.empty() ? raw.whole.data() : &kNone;
+    if (const char* why = checkWangEdges(*record, bytes, size_t(raw.size)))
       addError(messages, 4009, describe(index, s) + ": " + why);
   } else if (s.type == kSectionWangTexels) {
-    if (raw.size() != wangTexelsBytes(*record)) {
+    if (raw.size != wangTexelsBytes(*record)) {
       addError(messages, 4009, describe(index, s) + ": size does not match the wang record");
       return;
     }
-    for (size_t i = 0; i + 4 <= raw.size(); i += 4) {
-      float v;
-      std::memcpy(&v, raw.data() + i, 4);
-      if (!(std::fabs(v) <= 1.0f)) {
-        addError(messages, 4009, describe(index, s) + ": texel values not finite or outside [-1, 1]");
-        return;
-      }
-    }
+    if (raw.outside_unit) addError(messages, 4009, describe(index, s) + ": texel values not finite or outside [-1, 1]");
   }
 }
 
-void checkImagePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw,
+void checkImagePayload(size_t index, const SectionInfo& s, const Payload& raw,
                        std::vector<ValidationMessage>* messages) {
-  const bool has_magic = raw.size() >= 4 && layout::load32(raw.data()) == layout::kImageMagic;
+  const bool has_magic = raw.size >= 4 && layout::load32(raw.head.data()) == layout::kImageMagic;
   if (!has_magic) {
     // Only the generic image section must carry an image header; others may hold anything.
     if (s.type == kSectionImage) addError(messages, 4004, describe(index, s) + ": missing the GIMG image header");
     return;
   }
   ImageSectionHeader header;
-  if (!parseImageSection(raw.data(), raw.size(), &header)) {
+  if (!parseImageHeader(raw.head.data(), raw.size, &header)) {
     addError(messages, 4005,
-             describe(index, s) + ": image header dimensions do not match the section's " + std::to_string(raw.size()) +
+             describe(index, s) + ": image header dimensions do not match the section's " + std::to_string(raw.size) +
                  " bytes");
     return;
   }
   if (header.flags != 0 || header.reserved != 0) {
     addWarning(messages, 4007, describe(index, s) + ": reserved image header fields are not zero");
   }
-  const size_t count = (raw.size() - layout::kImageHeaderSize) / 4;
-  size_t non_finite = 0;
-  for (size_t i = 0; i < count; ++i) {
-    float v;
-    std::memcpy(&v, raw.data() + layout::kImageHeaderSize + 4 * i, 4);
-    if (!std::isfinite(v)) ++non_finite;
-  }
-  if (non_finite != 0) {
-    addError(messages, 4006, describe(index, s) + ": " + std::to_string(non_finite) + " non-finite values");
+  if (raw.nonfinite_after_image_header != 0) {
+    addError(messages, 4006,
+             describe(index, s) + ": " + std::to_string(raw.nonfinite_after_image_header) + " non-finite values");
   }
 }
 
 // A kind's fixed-size record: exactly sizeof(Record) bytes passing its check (null when valid);
 // otherwise error `id` naming the problem. True when the record is usable.
 template <typename Record>
-bool readCheckedRecord(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, int id, const char* what,
+bool readCheckedRecord(size_t index, const SectionInfo& s, const Payload& raw, int id, const char* what,
                        const char* (*check)(const Record&), Record* record, std::vector<ValidationMessage>* messages) {
-  if (raw.size() != sizeof(Record)) {
+  static_assert(sizeof(Record) <= Payload::kHead, "records fit the head");
+  if (raw.size != sizeof(Record)) {
     addError(messages, id,
              describe(index, s) + ": the " + what + " record is not " + std::to_string(sizeof(Record)) + " bytes");
     return false;
   }
-  std::memcpy(record, raw.data(), sizeof(Record));
+  std::memcpy(record, raw.head.data(), sizeof(Record));
   if (const char* why = check(*record)) {
     addError(messages, id, describe(index, s) + ": " + why);
     return false;
@@ -180,31 +230,21 @@ struct TinyExampleSeen {
   std::vector<std::pair<uint64_t, ImageSectionHeader>> levels;  // (key, image header) of readable levels
 };
 
-void noteTinyExamplePayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, TinyExampleSeen* seen,
+void noteTinyExamplePayload(size_t index, const SectionInfo& s, const Payload& raw, TinyExampleSeen* seen,
                             std::vector<ValidationMessage>* messages) {
   if (s.type == kSectionTinyExampleInfo) {
     ++seen->info;
     seen->record_ok =
         readCheckedRecord(index, s, raw, 6006, "tiny-example", checkTinyExampleRecord, &seen->record, messages);
   } else if (s.type == kSectionTinyExampleTexels) {
-    for (size_t i = 0; i + 4 <= raw.size(); i += 4) {
-      float v;
-      std::memcpy(&v, raw.data() + i, 4);
-      if (!std::isfinite(v) || std::fabs(v) > 1.0f) {
-        addError(messages, 6006, describe(index, s) + ": example texels not finite or outside [-1, 1]");
-        return;
-      }
-    }
+    if (raw.outside_unit)
+      addError(messages, 6006, describe(index, s) + ": example texels not finite or outside [-1, 1]");
   } else if (s.type == kSectionTinyExampleLevel) {
     ImageSectionHeader header;
-    if (!parseImageSection(raw.data(), raw.size(), &header)) return;  // 4004/4005 already reported
-    for (size_t i = layout::kImageHeaderSize; i + 4 <= raw.size(); i += 4) {
-      float v;
-      std::memcpy(&v, raw.data() + i, 4);
-      if (v < 0.0f) {
-        addError(messages, 6006, describe(index, s) + ": negative NDF values");
-        return;
-      }
+    if (!parseImageHeader(raw.head.data(), raw.size, &header)) return;  // 4004/4005 already reported
+    if (raw.negative_after_image_header) {
+      addError(messages, 6006, describe(index, s) + ": negative NDF values");
+      return;
     }
     seen->levels.emplace_back(s.key, header);
   }
@@ -257,7 +297,7 @@ struct GlitterSeen {
 
 // The glitter record passes checkGlitterRecord and the integral table checkGlitterIntegrals, the
 // same checks the runtime's loader makes (one implementation, formats/kinds/glitter.h).
-void noteGlitterPayload(size_t index, const SectionInfo& s, const std::vector<uint8_t>& raw, GlitterSeen* seen,
+void noteGlitterPayload(size_t index, const SectionInfo& s, const Payload& raw, GlitterSeen* seen,
                         std::vector<ValidationMessage>* messages) {
   if ((s.type == kSectionGlitterInfo || s.type == kSectionGlitterIntegrals) && s.key != 0) {
     addError(messages, 6007, describe(index, s) + ": glitter sections have key 0");
@@ -268,13 +308,17 @@ void noteGlitterPayload(size_t index, const SectionInfo& s, const std::vector<ui
     seen->record_ok = readCheckedRecord(index, s, raw, 6007, "glitter", checkGlitterRecord, &seen->record, messages);
   } else if (s.type == kSectionGlitterIntegrals) {
     ++seen->tables;
-    if (raw.size() % sizeof(GlitterIntegral) != 0) {
+    if (raw.size % sizeof(GlitterIntegral) != 0) {
       addError(messages, 6007, describe(index, s) + ": not a whole number of 16-byte integral entries");
       return;
     }
-    const size_t count = raw.size() / sizeof(GlitterIntegral);
+    if (raw.size > uint64_t(kMaxGlitterIntegrals) * sizeof(GlitterIntegral) || raw.whole.size() != raw.size) {
+      addError(messages, 6007, describe(index, s) + ": more than 2^20 integral entries");
+      return;
+    }
+    const size_t count = size_t(raw.size) / sizeof(GlitterIntegral);
     std::vector<GlitterIntegral> table(count);
-    if (count > 0) std::memcpy(table.data(), raw.data(), raw.size());
+    if (count > 0) std::memcpy(table.data(), raw.whole.data(), size_t(raw.size));
     if (const char* why = checkGlitterIntegrals(table.data(), count)) {
       addError(messages, 6007, describe(index, s) + ": " + why);
       return;
@@ -330,7 +374,13 @@ size_t ValidationReport::errorCount() const {
 size_t ValidationReport::warningCount() const { return messages.size() - errorCount(); }
 
 bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* header) {
-  if (data == nullptr || size < layout::kImageHeaderSize) return false;
+  return data != nullptr && parseImageHeader(data, size, header);
+}
+
+namespace {
+
+bool parseImageHeader(const uint8_t* data, uint64_t size, ImageSectionHeader* header) {
+  if (size < layout::kImageHeaderSize) return false;
   ImageSectionHeader h;
   h.magic = layout::load32(data);
   h.width = layout::load32(data + 4);
@@ -343,7 +393,7 @@ bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* hea
   if (h.width == 0 || h.height == 0 || h.channels == 0 || h.layers == 0) return false;
   // Four 32-bit factors: the product of the first two fits in 64 bits; divide instead of
   // multiplying further so no product can overflow.
-  const uint64_t payload = uint64_t(size - layout::kImageHeaderSize);
+  const uint64_t payload = size - layout::kImageHeaderSize;
   if (payload % 4 != 0) return false;
   uint64_t values = payload / 4;
   const uint64_t factors[4] = {h.width, h.height, h.channels, h.layers};
@@ -355,6 +405,8 @@ bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* hea
   if (header) *header = h;
   return true;
 }
+
+}  // namespace
 
 void validateMetadata(const std::string& text, AssetKind kind, std::vector<ValidationMessage>* messages) {
   if (text.size() > kMaxMetadataBytes) {
@@ -478,7 +530,6 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       noteStatus(checksum);
     }
   }
-  std::vector<uint8_t> raw;
   std::string metadata_text;
   std::vector<bool> readable(sections.size(), false);
   WangRecord wang_record;  // the wang-tiles record, once seen and valid (its sections check against it)
@@ -499,8 +550,16 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       continue;
     }
     if (!options.check_payloads && s.type != kSectionMetadata) continue;
-    // The frame is checked against raw_size (content size, block bound) before raw grows.
-    const ContainerStatus status = detail::readSectionAlloc(source, s, &raw);
+    // Streamed in bounded chunks (the frame is checked against raw_size first); only the metadata
+    // and records of the right size are kept whole.
+    const bool keep_whole =
+        s.type == kSectionMetadata ||
+        (s.type == kSectionWangEdges && have_wang_record && s.raw_size == wangEdgesBytes(wang_record)) ||
+        (kind == AssetKind::kGlitter && s.type == kSectionGlitterIntegrals &&
+         s.raw_size <= uint64_t(kMaxGlitterIntegrals) * sizeof(GlitterIntegral));
+    Payload raw;
+    PayloadSink sink(&raw, keep_whole);
+    const ContainerStatus status = detail::streamSection(source, s, &sink);
     if (status == ContainerStatus::kChecksumMismatch) {
       addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
     } else if (status == ContainerStatus::kDecompressFailed) {
@@ -514,7 +573,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     }
     readable[i] = true;
     if (s.type == kSectionMetadata) {
-      if (metadata_text.empty()) metadata_text.assign(raw.begin(), raw.end());
+      if (metadata_text.empty()) metadata_text.assign(raw.whole.begin(), raw.whole.end());
       continue;
     }
     if (kind == AssetKind::kTinyExample) noteTinyExamplePayload(i, s, raw, &tiny, &report.messages);
@@ -531,14 +590,13 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     }
     if (s.type == kSectionNdfChunk) {
       ImageSectionHeader image;
-      if (parseImageSection(raw.data(), raw.size(), &image) && image.width != image.height) {
+      if (parseImageHeader(raw.head.data(), raw.size, &image) && image.width != image.height) {
         addWarning(&report.messages, 6003,
                    describe(i, s) + ": NDF images are " + std::to_string(image.width) + " x " +
                        std::to_string(image.height) + ", not square");
       }
     }
   }
-  std::vector<uint8_t>().swap(raw);
 
   // 5xxx: the metadata section.
   size_t metadata_count = 0;

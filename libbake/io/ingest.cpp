@@ -14,7 +14,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +144,64 @@ bool fileReadable(const std::string& path) {
   return f.good();
 }
 
+// OpenEXR (3.1) allocates every header attribute at the size the file declares before reading it,
+// so a 1 KB file can cost gigabytes before OIIO returns. The attributes of every header are walked
+// here first, skipping their values: each must lie inside the file. False (and *why) otherwise.
+bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
+  std::ifstream f(path, std::ios::binary);
+  unsigned char start[8] = {};
+  if (!f.read(reinterpret_cast<char*>(start), 8)) return true;  // not OpenEXR: OIIO decides
+  if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01)) return true;
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return true;
+  const bool multipart = (start[5] & 0x10) != 0;  // version flags bit 12
+  auto readName = [&](std::string* out) {
+    out->clear();
+    for (char c; f.get(c);) {
+      if (c == '\0') return true;
+      if (out->size() == 255) return false;
+      out->push_back(c);
+    }
+    return false;
+  };
+  std::string name, type;
+  for (int header = 0;; ++header) {
+    for (;;) {
+      if (!readName(&name)) {
+        *why = "truncated OpenEXR header";
+        return false;
+      }
+      if (name.empty()) break;  // end of this header
+      unsigned char bytes[4] = {};
+      if (!readName(&type) || !f.read(reinterpret_cast<char*>(bytes), 4)) {
+        *why = "truncated OpenEXR header";
+        return false;
+      }
+      const int32_t value_size =
+          int32_t(uint32_t(bytes[0]) | uint32_t(bytes[1]) << 8 | uint32_t(bytes[2]) << 16 | uint32_t(bytes[3]) << 24);
+      const uint64_t at = uint64_t(f.tellg());
+      if (value_size < 0 || uint64_t(value_size) > size - std::min(size, at)) {
+        // The name comes from the file: only printable ASCII of it reaches the one-line error.
+        for (char& c : name) c = c >= 0x20 && c < 0x7f ? c : '?';
+        *why = "OpenEXR attribute '" + name + "' declares " + std::to_string(value_size) + " bytes, more than the " +
+               std::to_string(size - std::min(size, at)) + " left in the file";
+        return false;
+      }
+      f.seekg(std::streamoff(value_size), std::ios::cur);
+    }
+    if (!multipart) return true;
+    // Multi-part files end their list of headers with an empty one.
+    const int next = f.peek();
+    if (next == std::char_traits<char>::eof()) {
+      *why = "truncated OpenEXR header";
+      return false;
+    }
+    if (next == 0) return true;
+    if (header > 1 << 16) return true;  // OIIO refuses such part counts itself
+  }
+}
+
 // Opens the image (and the requested part) after the checks that need no decoding.
 Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
@@ -153,6 +213,9 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
   }
   if (!fileReadable(path)) {
     return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
+  }
+  if (std::string why; !exrHeadersFitTheFile(path, &why)) {
+    return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + why + ")");
   }
   const OIIO::ImageSpec config = readConfig();
   auto input = OIIO::ImageInput::open(path, &config);
@@ -193,6 +256,112 @@ BakeStatus checkImageSpec(const std::string& path, const OIIO::ImageSpec& spec, 
         options.height ? "at least 1" : "2 (XY), 3 (RGB) or 4 (RGBA); 1-channel height fields need --height";
     return makeError(ErrorCode::kInvalidInput,
                      path + ": unsupported channel count " + std::to_string(channels) + " (expected " + expected + ")");
+  }
+  return okStatus();
+}
+
+// The smallest number of bytes the decoded samples of the opened part can occupy: every channel of
+// the file (all are stored, whatever is read), at the bits per sample the file records (OIIO
+// expands 1-, 2- and 4-bit samples to uint8).
+uint64_t storedSampleBytes(const OIIO::ImageSpec& spec) {
+  const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
+  uint64_t bits_per_texel = 0;
+  for (int c = 0; c < spec.nchannels; ++c) bits_per_texel += uint64_t(spec.channelformat(c).size()) * 8;
+  const int recorded = spec.get_int_attribute("oiio:BitsPerSample", 0);
+  if (recorded > 0 && recorded < int(spec.format.size()) * 8) bits_per_texel = uint64_t(recorded) * spec.nchannels;
+  return texels / 8 * bits_per_texel + (texels % 8) * bits_per_texel / 8;
+}
+
+// The PNG header's own bits per pixel (IHDR: bit depth x samples of the colour type; a palette
+// index is one sample), or 0 when the header cannot be read.
+uint64_t pngBitsPerPixel(const std::string& path) {
+  unsigned char ihdr[26] = {};
+  std::ifstream f(path, std::ios::binary);
+  if (!f.read(reinterpret_cast<char*>(ihdr), sizeof(ihdr))) return 0;
+  if (std::string(reinterpret_cast<const char*>(ihdr + 12), 4) != "IHDR") return 0;
+  const unsigned depth = ihdr[24], colour = ihdr[25];
+  const unsigned samples = colour == 0 ? 1 : colour == 2 ? 3 : colour == 3 ? 1 : colour == 4 ? 2 : colour == 6 ? 4 : 0;
+  return uint64_t(depth) * samples;
+}
+
+// How many decoded bytes one byte of the file can produce at most, for the codecs whose ratio is
+// bounded (0: unbounded or unknown). Deflate: at most 1032:1 (zlib's documented limit: a 258-byte
+// match costs at least 2 bits); OpenEXR RLE and TIFF PackBits: 128 bytes from 2 (64:1); TIFF LZW: a
+// 12-bit code names at most 4096 bytes (2731:1); OpenEXR PXR24: deflate of 3 bytes per 4-byte float
+// (1376:1); OpenEXR B44/B44A: a flat 4x4 block of 32 bytes in 3 (11:1); no compression: 1:1.
+double maxExpansion(const std::string& format, const OIIO::ImageSpec& spec) {
+  if (format == "png") return 1032.0;
+  std::string codec = spec.get_string_attribute("compression", "none");
+  codec = codec.substr(0, codec.find(':'));
+  for (char& c : codec) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (format == "openexr") {
+    if (codec == "none") return 1.0;
+    if (codec == "rle") return 64.0;
+    if (codec == "zip" || codec == "zips") return 1032.0;
+    if (codec == "pxr24") return 1376.0;
+    if (codec == "b44" || codec == "b44a") return 11.0;
+    return 0.0;  // piz, dwaa, dwab, htj2k, ...: probed instead
+  }
+  if (format == "tiff") {
+    if (codec == "none") return 1.0;
+    if (codec == "packbits") return 64.0;
+    if (codec == "lzw") return 2731.0;
+    if (codec == "zip" || codec == "deflate" || codec == "adobe_deflate") return 1032.0;
+    return 0.0;
+  }
+  return 0.0;
+}
+
+// Refuses, before any pixel buffer is allocated, a file that cannot hold the image its header
+// declares (a 74-byte PNG declaring 8192 x 8192 texels): for codecs of bounded ratio, the file must
+// have at least (decoded bytes - 64 KiB) / ratio bytes (the slack covers stream ends and is far
+// below anything worth refusing); for the others the last row is decoded first, into a one-row
+// buffer, so a truncated file or missing chunks fail before the whole image is allocated.
+BakeStatus checkPlausibleSize(const std::string& path, OIIO::ImageInput& input, const IngestOptions& options,
+                              int used) {
+  const OIIO::ImageSpec& spec = input.spec();
+  const std::string format = input.format_name();
+  std::error_code ec;
+  const uintmax_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) return makeError(ErrorCode::kIo, path + ": cannot read the file size");
+  const double ratio = maxExpansion(format, spec);
+  if (ratio > 0.0) {
+    uint64_t decoded = storedSampleBytes(spec);
+    if (format == "png") {
+      const uint64_t bits = pngBitsPerPixel(path);
+      if (bits == 0) return makeError(ErrorCode::kInvalidInput, path + ": unreadable PNG header");
+      const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
+      decoded = texels / 8 * bits + (texels % 8) * bits / 8;
+    }
+    constexpr uint64_t kSlack = uint64_t(64) << 10;
+    const double needed = decoded > kSlack ? std::ceil(double(decoded - kSlack) / ratio) : 0.0;
+    if (double(file_size) < needed) {
+      return makeError(ErrorCode::kInvalidInput, path + ": " + std::to_string(file_size) +
+                                                     " bytes cannot hold the declared " + std::to_string(spec.width) +
+                                                     "x" + std::to_string(spec.height) + " image (" +
+                                                     std::to_string(decoded) + " bytes of samples need at least " +
+                                                     std::to_string(uint64_t(needed)) + " bytes of file at most " +
+                                                     std::to_string(int(ratio)) + ":1)");
+    }
+    return okStatus();
+  }
+  // Unbounded codecs: decode the last row (tiled files: the last tile) alone first.
+  bool probed = false;
+  if (spec.tile_width > 0 && spec.tile_height > 0) {
+    const int x0 = spec.x + (spec.width - 1) / spec.tile_width * spec.tile_width;
+    const int y0 = spec.y + (spec.height - 1) / spec.tile_height * spec.tile_height;
+    const int x1 = spec.x + spec.width, y1 = spec.y + spec.height;
+    std::vector<float> tile(size_t(x1 - x0) * size_t(y1 - y0) * size_t(used));
+    probed = input.read_tiles(options.part, 0, x0, x1, y0, y1, spec.z, spec.z + 1, 0, used, OIIO::TypeDesc::FLOAT,
+                              tile.data());
+  } else {
+    std::vector<float> row(size_t(spec.width) * size_t(used));
+    const int last = spec.y + spec.height - 1;
+    probed = input.read_scanlines(options.part, 0, last, last + 1, spec.z, 0, used, OIIO::TypeDesc::FLOAT, row.data());
+  }
+  if (!probed || input.has_error()) {
+    return makeError(ErrorCode::kInvalidInput,
+                     path + ": corrupt or truncated image (" + oneLine(input.geterror()) + ")");
   }
   return okStatus();
 }
@@ -316,6 +485,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
 
   // Alpha and any extra channels are never read; height fields use the first channel only.
   const int used = options.height ? 1 : std::min(spec.nchannels, 3);
+  if (BakeStatus s = checkPlausibleSize(path, input, options, used); !s) return s.error();
   Result<std::vector<float>> read = readPixels(path, input, options, used);
   if (!read) return read.error();
   std::vector<float>& pixels = read.value();

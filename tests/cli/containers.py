@@ -87,14 +87,37 @@ def zstd_rle_frame(content_size, produced=None, byte=b"\0"):
     """One zstd frame whose header records content_size and whose RLE blocks really produce
     `produced` bytes (default content_size) of `byte`: about 4 bytes per 128 KiB."""
     produced = content_size if produced is None else produced
-    frame = struct.pack("<IBQ", 0xFD2FB528, 0xE0, content_size)  # single segment, 8-byte content size
-    left = produced
-    while True:
-        n = min(128 * 1024, left)
-        left -= n
-        frame += struct.pack("<I", (1 if left == 0 else 0) | (1 << 1) | (n << 3))[:3] + byte
-        if left == 0:
-            return frame
+    return zstd_block_frame(content_size, [("rle", byte, produced)])
+
+
+def zstd_block_frame(content_size, pieces, window_log=None):
+    """One zstd frame built from raw and RLE blocks (RFC 8878): pieces are ("raw", bytes) or
+    ("rle", byte, count), cut into blocks of at most 128 KiB. Single segment (the window is the
+    content) unless window_log is given."""
+    if window_log is None:
+        frame = struct.pack("<IBQ", 0xFD2FB528, 0xE0, content_size)  # single segment, 8-byte content size
+    else:
+        frame = struct.pack("<IBBQ", 0xFD2FB528, 0xC0, (window_log - 10) << 3, content_size)
+    blocks = []
+    for piece in pieces:
+        if piece[0] == "raw":
+            data = piece[1]
+            blocks += [(0, data[at:at + 128 * 1024]) for at in range(0, len(data), 128 * 1024)] or [(0, b"")]
+        else:
+            left = piece[2]
+            while True:
+                n = min(128 * 1024, left)
+                blocks.append((1, piece[1], n))
+                left -= n
+                if left == 0:
+                    break
+    for i, block in enumerate(blocks):
+        last = 1 if i == len(blocks) - 1 else 0
+        if block[0] == 0:
+            frame += struct.pack("<I", last | (len(block[1]) << 3))[:3] + block[1]
+        else:
+            frame += struct.pack("<I", last | (1 << 1) | (block[2] << 3))[:3] + block[1]
+    return frame
 
 
 def read_sections(data):

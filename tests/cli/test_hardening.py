@@ -8,11 +8,13 @@ import json
 import os
 import random
 import resource
+import struct
+import zlib
 
 import clitest
 from clitest import INVALID, IO, OK
 from containers import (CODEC_ZSTD, SECTION_IMAGE, SECTION_METADATA, build_container, image_payload, metadata,
-                        read_sections, zstd_rle_frame)
+                        read_sections, zstd_block_frame, zstd_rle_frame)
 from test_ndfgen import write_pfm
 
 KIND_NDF_PYRAMID, SECTION_NDF_CHUNK = 1, 17
@@ -83,6 +85,34 @@ class HostileContainers(clitest.ToolTestCase):
                           outputs=[self.path("x.exr")], limits=MEMORY_LIMIT)
         self.assert_fails(INVALID, "glintinfo", "diff", bomb, bomb, limits=MEMORY_LIMIT)
 
+    def test_a_gibibyte_section_is_validated_in_bounded_memory(self):
+        # Honest 1 GiB image sections in a few KB: a GIMG header in a raw block, RLE blocks of zero
+        # floats, and a last raw block of two floats. Validated as they stream past (under the
+        # 768 MiB address limit), with the same verdicts as a section read whole.
+        side = 16384
+        header = struct.pack("<6IQ", 0x474D4947, side, side, 1, 1, 0, 0)
+        raw_size = len(header) + side * side * 4
+        for window_log in (None, 20):  # single segment (window = 1 GiB) and a 1 MiB window
+            for tail, verdict in ((struct.pack("<2f", 0.5, 1.0), OK), (struct.pack("<2f", float("nan"), float("inf")), INVALID)):
+                frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 32 - 8), ("raw", tail)],
+                                         window_log=window_log)
+                path = self.write("big.gbk", build_container([
+                    (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
+                self.assertLess(os.path.getsize(path), 50_000)
+                code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
+                self.assertEqual(code, verdict, (window_log, out, err))
+                ids = [m["id"] for m in json.loads(out)["messages"]]
+                self.assertEqual(ids, [] if verdict == OK else [4006], out)
+                if verdict == INVALID:
+                    self.assertIn("2 non-finite values", out)
+        # A frame that stops short of its content size is still error-4003.
+        frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 64)], window_log=20)
+        path = self.write("short.gbk", build_container([
+            (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
+        code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
+        self.assertEqual(code, INVALID, err)
+        self.assertIn(4003, [m["id"] for m in json.loads(out)["messages"]])
+
     def test_oversized_metadata_is_refused_before_decoding(self):
         # 512 MiB of metadata in a 20 KB file (honest RLE blocks): over the 16 MiB limit.
         big = zstd_rle_frame(512 << 20, byte=b" ")
@@ -108,6 +138,91 @@ class HostileContainers(clitest.ToolTestCase):
         self.assertIn(5003, [m["id"] for m in json.loads(out)["messages"]])
         err = self.assert_fails(INVALID, "glintinfo", "diff", path, path, limits=MEMORY_LIMIT)
         self.assertIn("5003", err)
+
+
+def png_file(width, height, idat=b"", colour_type=2, bit_depth=8):
+    """A PNG whose header declares width x height and whose IDAT holds `idat` (default: an empty,
+    finished zlib stream), however little that is."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, colour_type, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat or zlib.compress(b"")) +
+            chunk(b"IEND", b""))
+
+
+def exr_file(width, height, compression, first=b""):
+    """A scanline OpenEXR file of three half channels whose header declares width x height and
+    whose line offset table is all zeros: no chunk of pixels at all. compression: 3 zip, 4 piz.
+    `first`: bytes put before the header's attributes."""
+    def attr(name, kind, data):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(data)) + data
+    channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 1, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
+    box = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    header = (struct.pack("<ii", 20000630, 2) + first + attr("channels", "chlist", channels) +
+              attr("compression", "compression", bytes([compression])) + attr("dataWindow", "box2i", box) +
+              attr("displayWindow", "box2i", box) + attr("lineOrder", "lineOrder", b"\0") +
+              attr("pixelAspectRatio", "float", struct.pack("<f", 1.0)) +
+              attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0)) +
+              attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    lines = {3: 16, 4: 32}[compression]
+    return header + b"\0" * 8 * ((height + lines - 1) // lines)
+
+
+class HostileImages(clitest.ToolTestCase):
+    """Normal maps whose headers declare far more texels than their bytes can hold are refused by
+    every tool that reads one (exit 3, one line naming the file), before the map is allocated: the
+    address-space limit is far below the ~800 MB an 8192 x 8192 map of floats costs."""
+
+    def hostile_files(self):
+        files = {"tiny.png": png_file(8192, 8192)}
+        # 1.5 KB of a real deflate stream of zero rows, cut short: 60 of the 8192 rows.
+        z = zlib.compressobj(9)
+        rows = z.compress(b"\0" * (1 + 8192 * 3) * 60) + z.flush(zlib.Z_SYNC_FLUSH)
+        files["cut.png"] = png_file(8192, 8192, idat=rows)
+        files["zip.exr"] = exr_file(8192, 8192, 3)  # bounded ratio: refused from its size
+        files["piz.exr"] = exr_file(8192, 8192, 4)  # unbounded ratio: its last row is read first
+        # A 64 x 64 file whose first attribute declares a 1.8 GB string (OpenEXR allocates it).
+        files["attr.exr"] = exr_file(64, 64, 3, first=b"Software\0string\0" + struct.pack("<i", 0x6E000000))
+        return {name: self.write(name, data) for name, data in files.items()}
+
+    EXPECTED = {"tiny.png": "cannot hold the declared 8192x8192 image", "cut.png": "1032:1",
+                "zip.exr": "cannot hold the declared 8192x8192 image", "piz.exr": "corrupt or truncated",
+                "attr.exr": "attribute 'Software' declares 1845493760 bytes"}
+
+    def test_every_ingesting_tool_refuses_before_allocating(self):
+        files = self.hostile_files()
+        self.assertLess(os.path.getsize(files["tiny.png"]), 100)
+        self.assertLess(os.path.getsize(files["cut.png"]), 2000)
+        gbk, exr = self.path("out.gbk"), self.path("out.exr")
+        for name, path in files.items():
+            for args in (("ndfgen", path, "-o", gbk, *NDF),
+                         ("tensorpack", path, "-o", gbk, *NDF, "--rank", "4", "--block", "16"),
+                         ("glintref", "ndf", path, "--at", "8,8", "--sigma", "2", "--s", "0,0"),
+                         ("ltcfit", "roughness", path, "--alpha-micro", "0.2", "-o", exr, "--quiet"),
+                         ("wangtile", path, "-o", gbk, "--quiet"),
+                         ("tinyexample", path, "-o", gbk, "--quiet")):
+                err = self.assert_fails(INVALID, *args, outputs=[gbk, exr], limits=MEMORY_LIMIT)
+                self.assertIn(name, err)
+                self.assertIn(self.EXPECTED[name], err)
+
+    def test_manifest_assets_fail_alike(self):
+        files = self.hostile_files()
+        manifest = self.write("m.json", json.dumps({
+            "schema": "glintbake.manifest/1", "defaults": {"tool": "ndfgen", "options": {"ndf-res": 16, "stride": 8}},
+            "assets": [{"name": n, "inputs": [n], "output": n + ".gbk"} for n in files]}).encode())
+        code, out, err = clitest.run("glintbake", "bake", manifest, "--json", limits=MEMORY_LIMIT)
+        self.assertEqual(code, clitest.RUNTIME, err)
+        for asset in json.loads(out)["assets"]:
+            self.assertEqual((asset["status"], asset["exit_code"]), ("failed", INVALID), asset)
+            self.assertIn(asset["name"], asset["message"])
+            self.assertFalse(os.path.exists(self.path(asset["name"] + ".gbk")))
+
+    def test_highly_compressible_large_maps_still_load(self):
+        # Constant 2048 x 2048 maps compress far better than real ones; both formats still load.
+        for name in ("flat.png", "flat.exr"):
+            flat = self.mapgen("flat", name, "--size", "2048")
+            out, _ = self.run_ok("glintref", "ndf", flat, "--at", "1024,1024", "--sigma", "1", "--s", "0,0", "--json")
+            self.assertGreater(json.loads(out)["value"], 0.0)
 
 
 class KindLayouts(clitest.ToolTestCase):

@@ -462,6 +462,84 @@ TEST(Ingest, TruncatedFileIsInvalid) {
   }
 }
 
+// Constant maps compress far better than real ones: every codec whose ratio bounds the file size
+// must still accept them (the bound is what the codec can reach, never a typical ratio).
+TEST(Ingest, HighlyCompressibleLargeMapsStillLoad) {
+  ScratchDir dir;
+  const int side = 2048;
+  const std::vector<float> flat(size_t(side) * side * 3, 0.5f);
+  struct Case {
+    const char* name;
+    OIIO::TypeDesc stored;
+    const char* compression;
+    bool tiled;
+  };
+  const Case cases[] = {{"flat8.png", OIIO::TypeDesc::UINT8, "zip:9", false},
+                        {"flat16.png", OIIO::TypeDesc::UINT16, "zip:9", false},
+                        {"zip.exr", OIIO::TypeDesc::HALF, "zip", false},
+                        {"zips.exr", OIIO::TypeDesc::FLOAT, "zips", false},
+                        {"rle.exr", OIIO::TypeDesc::HALF, "rle", true},
+                        {"pxr24.exr", OIIO::TypeDesc::FLOAT, "pxr24", false},
+                        {"b44a.exr", OIIO::TypeDesc::HALF, "b44a", false},
+                        {"piz.exr", OIIO::TypeDesc::HALF, "piz", false},
+                        {"piz-tiled.exr", OIIO::TypeDesc::HALF, "piz", true},
+                        {"dwaa.exr", OIIO::TypeDesc::HALF, "dwaa", false},
+                        {"lzw.tif", OIIO::TypeDesc::UINT8, "lzw", false},
+                        {"zip.tif", OIIO::TypeDesc::UINT16, "zip", false},
+                        {"packbits.tif", OIIO::TypeDesc::UINT8, "packbits", false}};
+  for (const Case& c : cases) {
+    const std::string path = dir.file(c.name);
+    writeFloats(path, side, side, 3, c.stored, flat, c.tiled, c.compression);
+    auto map = load(path, nullptr);
+    ASSERT_TRUE(map.ok()) << c.name << ": " << map.error().message;
+    EXPECT_EQ(map.value().width, side) << c.name;
+  }
+}
+
+// A file too small for the image its header declares is refused before the map is allocated.
+TEST(Ingest, FileTooSmallForItsHeaderIsInvalid) {
+  ScratchDir dir;
+  const std::string path = dir.file("claims.png");
+  writeFloats(path, 2048, 2048, 3, OIIO::TypeDesc::UINT8, std::vector<float>(size_t(2048) * 2048 * 3, 0.5f));
+  std::string bytes = test::readBytes(path);
+  // The same IHDR declaring 8192 x 8192 (width and height at bytes 16..23, then the CRC at 29).
+  const unsigned char big[8] = {0, 0, 0x20, 0, 0, 0, 0x20, 0};
+  bytes.replace(16, 8, reinterpret_cast<const char*>(big), 8);
+  uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of the chunk type and data (bytes 12..28)
+  for (size_t i = 12; i < 29; ++i) {
+    crc ^= uint8_t(bytes[i]);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  crc = ~crc;
+  for (int k = 0; k < 4; ++k) bytes[29 + size_t(k)] = char(crc >> (24 - 8 * k));
+  test::writeBytes(path, bytes);
+  auto map = load(path, nullptr);
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.error().code, ErrorCode::kInvalidInput) << map.error().message;
+  expectOneLineNaming(map.error(), "claims.png");
+  EXPECT_NE(map.error().message.find("cannot hold the declared 8192x8192 image"), std::string::npos)
+      << map.error().message;
+}
+
+// OpenEXR allocates header attributes at their declared size: one declaring more bytes than the
+// file holds is refused before OIIO opens the file, in one line even when its name holds newlines
+// (found by fuzz_ingest).
+TEST(Ingest, ExrAttributeLargerThanTheFileIsInvalid) {
+  ScratchDir dir;
+  const std::string path = dir.file("attr.exr");
+  std::string bytes("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+  bytes += std::string("Soft\nware\0string\0", 17);
+  bytes += std::string("\x00\x00\x00\x6e", 4);  // 1845493760 bytes
+  bytes += std::string(512, 'x');
+  test::writeBytes(path, bytes);
+  auto map = load(path, nullptr);
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.error().code, ErrorCode::kInvalidInput);
+  expectOneLineNaming(map.error(), "attr.exr");
+  EXPECT_NE(map.error().message.find("attribute 'Soft?ware' declares 1845493760 bytes"), std::string::npos)
+      << map.error().message;
+}
+
 TEST(Ingest, GarbageFileIsInvalid) {
   ScratchDir dir;
   const std::string path = dir.file("garbage.png");

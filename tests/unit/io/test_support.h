@@ -42,7 +42,8 @@ class ScratchDir {
 
 // Writes `values` (width*height*channels, in the given data type) as `stored` pixels.
 inline void writeRaw(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
-                     OIIO::TypeDesc data_type, const void* values, bool tiled = false) {
+                     OIIO::TypeDesc data_type, const void* values, bool tiled = false,
+                     const char* compression = nullptr) {
   auto out = OIIO::ImageOutput::create(path);
   ASSERT_TRUE(out) << OIIO::geterror();
   OIIO::ImageSpec spec(width, height, channels, stored);
@@ -51,6 +52,7 @@ inline void writeRaw(const std::string& path, int width, int height, int channel
     spec.attribute("compression", "jpeg:100");  // near-lossless, full chroma resolution
     spec.attribute("jpeg:subsampling", "4:4:4");
   }
+  if (compression) spec.attribute("compression", compression);
   if (tiled) {
     spec.tile_width = 16;
     spec.tile_height = 16;
@@ -61,8 +63,8 @@ inline void writeRaw(const std::string& path, int width, int height, int channel
 }
 
 inline void writeFloats(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
-                        const std::vector<float>& values, bool tiled = false) {
-  writeRaw(path, width, height, channels, stored, OIIO::TypeDesc::FLOAT, values.data(), tiled);
+                        const std::vector<float>& values, bool tiled = false, const char* compression = nullptr) {
+  writeRaw(path, width, height, channels, stored, OIIO::TypeDesc::FLOAT, values.data(), tiled, compression);
 }
 
 inline std::string readBytes(const std::string& path) {

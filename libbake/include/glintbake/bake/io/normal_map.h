@@ -80,8 +80,13 @@ struct NormalMap {
 //   kRuntime      out of memory.
 // Channels read as float through OIIO: integer files decode as n = 2 c / max - 1; float files
 // follow options.encoding (auto: signed if any value is negative). Height fields: see
-// IngestOptions::height. Safe on untrusted files as far as OIIO's decoders are (sizes are
-// checked against max_size before any allocation). Decoder messages that libraries print on
+// IngestOptions::height. Safe on untrusted files as far as OIIO's decoders are: before any pixel
+// buffer is allocated, sizes are checked against max_size and the file must be able to hold the
+// image its header declares (kInvalidInput otherwise): for codecs of bounded compression ratio
+// (PNG; OpenEXR none, RLE, ZIP(S), PXR24, B44(A); TIFF none, PackBits, LZW, deflate) at least
+// (decoded bytes - 64 KiB) / ratio bytes of file; for the others the last row (tiled files: the
+// last tile) is decoded first, so truncated files fail before the map is allocated. OpenEXR
+// headers are walked before OIIO opens the file: every attribute must fit in the file. Decoder messages that libraries print on
 // stderr are discarded while reading (the process-wide stderr is redirected briefly), so tools keep
 // their one-line errors. Thread-safe for distinct calls, but that redirection is process-wide.
 // `report` may be null; it is filled as far as reading got, also on failure.
