@@ -31,6 +31,16 @@ struct F4 {
   // Lanes where a < b keep x, the others become 0.
   friend F4 selectLess(F4 a, F4 b, F4 x) { return {_mm_and_ps(_mm_cmplt_ps(a.v, b.v), x.v)}; }
   friend bool anyLess(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)) != 0; }
+  // Bit i set where lane i has a <= b.
+  friend int lessEqualMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmple_ps(a.v, b.v)); }
+  // Four bytes as floats.
+  static F4 fromBytes(const uint8_t* p) {
+    int32_t word;
+    std::memcpy(&word, p, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i b = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
+    return {_mm_cvtepi32_ps(b)};
+  }
   // floor for |x| < 2^31.
   friend F4 floor4(F4 x) {
     const __m128 t = _mm_cvtepi32_ps(_mm_cvttps_epi32(x.v));
@@ -87,6 +97,16 @@ struct F4 {
       if (a.v[i] < b.v[i]) return true;
     return false;
   }
+  friend int lessEqualMask(F4 a, F4 b) {
+    int m = 0;
+    for (int i = 0; i < 4; ++i) m |= (a.v[i] <= b.v[i] ? 1 : 0) << i;
+    return m;
+  }
+  static F4 fromBytes(const uint8_t* p) {
+    F4 r;
+    for (int i = 0; i < 4; ++i) r.v[i] = float(p[i]);
+    return r;
+  }
   friend F4 floor4(F4 x) {
     F4 r;
     for (int i = 0; i < 4; ++i) {
@@ -108,6 +128,20 @@ struct F4 {
   }
 };
 #endif
+
+// |x| lane by lane.
+inline F4 abs4(F4 x) { return max(x, F4::splat(0.0f) - x); }
+
+// A hint to bring the cache line holding p closer (no effect on results).
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  __builtin_prefetch(p);
+#elif GLINTBAKE_FLAKES_SSE2
+  _mm_prefetch(static_cast<const char*>(p), _MM_HINT_T0);
+#else
+  (void)p;
+#endif
+}
 
 // e^-x for x in [0, 87] (larger x gives e^-87), relative error about 2e-7: range reduction by
 // ln 2 in two parts and a degree-6 polynomial (the classic single-precision expf coefficients).
