@@ -96,6 +96,28 @@ struct LeafVisit {
   double base_x, base_y;
 };
 
+// The float constants of one point query shared by every lane of the kernel (flake_kernel.inc).
+struct KernelTerms {
+  float sxh, sxl, syh, syl;  // s split into a float and its remainder
+  float a, b, inv2v, step;
+  float sr2, sr4, sr2b, b2;  // sigma_r^2, sigma_r^4, sigma_r^2 b, b^2
+  float keep_cut;            // the first pass's cutoff, kMaxExponent plus a margin
+};
+
+// Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
+// room the branch-free writes and the padding to a whole vector take).
+constexpr int kLaneList = 512;
+struct LaneList {
+  alignas(64) float spatial[kLaneList + 16];
+  alignas(64) float num[kLaneList + 16];
+  alignas(64) float det[kLaneList + 16];
+};
+
+namespace sse {
+using V = flakes::F4;
+#include "flake_kernel.inc"
+}  // namespace sse
+
 }  // namespace
 
 struct FlakeNdf::Impl {
@@ -430,10 +452,9 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
     return ex * ex + ey * ey <= 2.0 * budget * var;
   };
-  const F4 zero = F4::splat(0.0f), half = F4::splat(0.5f), two = F4::splat(2.0f);
+  const F4 zero = F4::splat(0.0f), two = F4::splat(2.0f);
   const F4 fsx = F4::splat(float(sx)), fsy = F4::splat(float(sy));
   const F4 a = F4::splat(float(t.a)), b = F4::splat(float(t.b)), inv2v = F4::splat(float(t.inv2v));
-  const F4 sr2 = F4::splat(float(sigma_r2)), cutoff = F4::splat(float(kMaxExponent));
   // The same test per leaf, four leaves at a time in float, from each leaf's box of positions; the
   // budget and variance widened against float rounding.
   const F4 budget_cut = F4::splat(float(kMaxExponent) + 1e-3f), var_slack = F4::splat(1.0f + 1e-4f);
@@ -458,42 +479,49 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     }
     return mask & ((1u << tb.leaves) - 1u);
   };
-  // Four flakes at a time in float: s split into a float and its remainder, so that s - n_k keeps
+  // The kernel (flake_kernel.inc): s split into a float and its remainder, so that s - n_k keeps
   // double accuracy; det C from the expansion sr^4 + sr^2 b tr(J J^T) + b^2 det(J J^T), which does
-  // not cancel for rank-1 Jacobians.
-  const float sx_hi = float(sx), sy_hi = float(sy);
-  const F4 sxh = F4::splat(sx_hi), sxl = F4::splat(float(sx - double(sx_hi)));
-  const F4 syh = F4::splat(sy_hi), syl = F4::splat(float(sy - double(sy_hi)));
-  const F4 sr4 = F4::splat(float(sigma_r2 * sigma_r2));
-  const F4 sr2b = F4::splat(float(sigma_r2 * t.b)), b2 = F4::splat(float(t.b * t.b));
-  const F4 step4 = F4::splat(float(step));
-  double sum = 0.0;
-  forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
-    const Block& k = *leaf.block;
-    const F4 bx = F4::splat(float(leaf.base_x)), by = F4::splat(float(leaf.base_y));
-    F4 acc = zero;
-    for (int h = 0; h < kLeafFlakes; h += 4) {
-      const F4 dx = bx - (F4::fromBytes(k.lx + h) + half) * step4;
-      const F4 dy = by - (F4::fromBytes(k.ly + h) + half) * step4;
-      const F4 spatial = (dx * dx + dy * dy) * inv2v;
-      if (!anyLess(spatial, cutoff)) continue;
-      const F4 j0 = F4::load(k.j0 + h), j1 = F4::load(k.j1 + h), j2 = F4::load(k.j2 + h), j3 = F4::load(k.j3 + h);
-      const F4 ex = ((sxh - F4::load(k.nx + h)) + sxl) - a * (j0 * dx + j1 * dy);
-      const F4 ey = ((syh - F4::load(k.ny + h)) + syl) - a * (j2 * dx + j3 * dy);
-      const F4 jxx = j0 * j0 + j1 * j1, jyy = j2 * j2 + j3 * j3, jxy = j0 * j2 + j1 * j3;
-      const F4 jd = j0 * j3 - j1 * j2;
-      const F4 cxx = sr2 + b * jxx, cxy = b * jxy, cyy = sr2 + b * jyy;
-      const F4 det = sr4 + sr2b * (jxx + jyy) + b2 * (jd * jd);
-      const F4 q = (cyy * ex * ex - two * cxy * ex * ey + cxx * ey * ey) / det;
-      const F4 e = spatial + half * q;
-      if (!anyLess(e, cutoff)) continue;
-      acc = acc + selectLess(e, cutoff, flakes::expNeg4(e) / sqrt(det));
+  // not cancel for rank-1 Jacobians. The lanes kept by its first pass are evaluated and summed
+  // (in double, four running sums in a fixed order) whenever the list fills up, and at the end.
+  KernelTerms c;
+  c.sxh = float(sx);
+  c.sxl = float(sx - double(c.sxh));
+  c.syh = float(sy);
+  c.syl = float(sy - double(c.syh));
+  c.a = float(t.a);
+  c.b = float(t.b);
+  c.inv2v = float(t.inv2v);
+  c.step = float(step);
+  c.sr2 = float(sigma_r2);
+  c.sr4 = float(sigma_r2 * sigma_r2);
+  c.sr2b = float(sigma_r2 * t.b);
+  c.b2 = float(t.b * t.b);
+  c.keep_cut = float(kMaxExponent) + 0.01f;
+  LaneList list;
+  int n = 0;
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  auto drain = [&] {
+    const int padded = (n + 15) & ~15;
+    for (int i = n; i < padded; ++i) {
+      list.spatial[i] = 1e30f;
+      list.num[i] = 0.0f;
+      list.det[i] = 1.0f;
     }
-    float lanes[4];
-    acc.store(lanes);
-    sum += (double(lanes[0]) + double(lanes[1])) + (double(lanes[2]) + double(lanes[3]));
+    sse::laneValues(&list, padded, float(kMaxExponent));
+    for (int i = 0; i < n; i += 4) {
+      sums[0] += double(list.spatial[i]);
+      sums[1] += double(list.spatial[i + 1]);
+      sums[2] += double(list.spatial[i + 2]);
+      sums[3] += double(list.spatial[i + 3]);
+    }
+    n = 0;
+  };
+  forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
+    n = sse::keepLanes(*leaf.block, c, float(leaf.base_x), float(leaf.base_y), &list, n);
+    if (n > kLaneList - kLeafFlakes) drain();
   });
-  return sum * t.wnorm / kTwoPi;
+  drain();
+  return ((sums[0] + sums[1]) + (sums[2] + sums[3])) * t.wnorm / kTwoPi;
 }
 
 template <typename Visit>

@@ -19,6 +19,7 @@ namespace glintbake::runtime::flakes {
 
 #if GLINTBAKE_FLAKES_SSE2
 struct F4 {
+  static constexpr int kWidth = 4;
   __m128 v;
   static F4 load(const float* p) { return {_mm_loadu_ps(p)}; }
   static F4 splat(float x) { return {_mm_set1_ps(x)}; }
@@ -31,8 +32,9 @@ struct F4 {
   // Lanes where a < b keep x, the others become 0.
   friend F4 selectLess(F4 a, F4 b, F4 x) { return {_mm_and_ps(_mm_cmplt_ps(a.v, b.v), x.v)}; }
   friend bool anyLess(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)) != 0; }
-  // Bit i set where lane i has a <= b.
+  // Bit i set where lane i has a <= b (a < b).
   friend int lessEqualMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmple_ps(a.v, b.v)); }
+  friend int lessMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)); }
   // Four bytes as floats.
   static F4 fromBytes(const uint8_t* p) {
     int32_t word;
@@ -54,6 +56,7 @@ struct F4 {
 };
 #else
 struct F4 {
+  static constexpr int kWidth = 4;
   float v[4];
   static F4 load(const float* p) {
     F4 r;
@@ -102,6 +105,11 @@ struct F4 {
     for (int i = 0; i < 4; ++i) m |= (a.v[i] <= b.v[i] ? 1 : 0) << i;
     return m;
   }
+  friend int lessMask(F4 a, F4 b) {
+    int m = 0;
+    for (int i = 0; i < 4; ++i) m |= (a.v[i] < b.v[i] ? 1 : 0) << i;
+    return m;
+  }
   static F4 fromBytes(const uint8_t* p) {
     F4 r;
     for (int i = 0; i < 4; ++i) r.v[i] = float(p[i]);
@@ -128,6 +136,8 @@ struct F4 {
   }
 };
 #endif
+
+inline F4 floorV(F4 x) { return floor4(x); }
 
 // |x| lane by lane.
 inline F4 abs4(F4 x) { return max(x, F4::splat(0.0f) - x); }
