@@ -6,6 +6,7 @@
 #include "../pyramid_blend.h"
 #include "flake_model.h"
 #include "float4.h"
+#include "float8.h"
 #include "gaussian_rect.h"
 
 #include <algorithm>
@@ -117,6 +118,31 @@ namespace sse {
 using V = flakes::F4;
 #include "flake_kernel.inc"
 }  // namespace sse
+
+#if GLINTBAKE_FLAKES_AVX2
+GLINTBAKE_FLAKES_AVX2_BEGIN
+namespace avx2 {
+using V = flakes::F8;
+#include "flake_kernel.inc"
+}  // namespace avx2
+GLINTBAKE_FLAKES_AVX2_END
+#endif
+
+// The kernels of the processor: AVX2 where it has it (the same bits), else SSE2 or scalar.
+int keepLanes(bool wide, const Block& k, const KernelTerms& c, float bx, float by, LaneList* list, int n) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::keepLanes(k, c, bx, by, list, n);
+#endif
+  (void)wide;
+  return sse::keepLanes(k, c, bx, by, list, n);
+}
+void laneValues(bool wide, LaneList* list, int n, float cutoff) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::laneValues(list, n, cutoff);
+#endif
+  (void)wide;
+  sse::laneValues(list, n, cutoff);
+}
 
 }  // namespace
 
@@ -497,6 +523,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   c.sr2b = float(sigma_r2 * t.b);
   c.b2 = float(t.b * t.b);
   c.keep_cut = float(kMaxExponent) + 0.01f;
+  const bool wide = flakes::hasAvx2();
   LaneList list;
   int n = 0;
   double sums[4] = {0.0, 0.0, 0.0, 0.0};
@@ -507,7 +534,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
       list.num[i] = 0.0f;
       list.det[i] = 1.0f;
     }
-    sse::laneValues(&list, padded, float(kMaxExponent));
+    laneValues(wide, &list, padded, float(kMaxExponent));
     for (int i = 0; i < n; i += 4) {
       sums[0] += double(list.spatial[i]);
       sums[1] += double(list.spatial[i + 1]);
@@ -517,7 +544,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     n = 0;
   };
   forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
-    n = sse::keepLanes(*leaf.block, c, float(leaf.base_x), float(leaf.base_y), &list, n);
+    n = keepLanes(wide, *leaf.block, c, float(leaf.base_x), float(leaf.base_y), &list, n);
     if (n > kLaneList - kLeafFlakes) drain();
   });
   drain();
@@ -555,6 +582,15 @@ double FlakeNdf::Impl::weightSum(const FootprintTerms& t, bool along_x) const {
   });
   return s;
 }
+
+namespace flakes {
+std::atomic<bool>& portableKernelsOnly() {
+  static std::atomic<bool> only{false};
+  return only;
+}
+}  // namespace flakes
+
+void usePortableFlakeKernels(bool portable) { flakes::portableKernelsOnly().store(portable); }
 
 FlakeNdf::FlakeNdf() = default;
 FlakeNdf::~FlakeNdf() = default;

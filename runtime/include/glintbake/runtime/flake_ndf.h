@@ -44,6 +44,12 @@ namespace glintbake::runtime {
 // larger footprints return kInvalidArgument (answer them from a pyramid).
 constexpr int64_t kMaxFlakeWindow = 4096;
 
+// The kernels of FlakeNdf and LobeNdf use AVX2 where the processor has it (chosen at run time, no
+// -march flag needed; they give the same bits as the portable SSE2 or scalar kernels). true
+// restricts both to the portable kernels (tests, benchmarks); it applies to the queries that
+// start afterwards and is safe to call from any thread.
+void usePortableFlakeKernels(bool portable);
+
 class FlakeNdf final : public AccumulatingNdfSource {
  public:
   FlakeNdf();
