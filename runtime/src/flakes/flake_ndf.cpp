@@ -4,6 +4,7 @@
 
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
+#include "flake_access.h"
 #include "flake_model.h"
 #include "float4.h"
 #include "float8.h"
@@ -86,6 +87,7 @@ struct FootprintTerms {
   double b;                // sigma_h^2 sigma_p^2 / v: the J J^T share of the lobe covariance
   double inv2v;            // 1 / (2 v)
   double wnorm;            // A / (2 pi v)
+  double spatial_cut;      // largest spatial exponent (kMaxExponent: the window of 6 sqrt(v))
   int64_t x0, x1, y0, y1;  // window of fine flake indices (unwrapped, inclusive)
   bool empty;
 };
@@ -103,6 +105,7 @@ struct KernelTerms {
   float a, b, inv2v, step;
   float sr2, sr4, sr2b, b2;  // sigma_r^2, sigma_r^4, sigma_r^2 b, b^2
   float keep_cut;            // the first pass's cutoff, kMaxExponent plus a margin
+  float spatial_cut;         // lanes with a spatial exponent below it only
 };
 
 // Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
@@ -162,7 +165,8 @@ struct FlakeNdf::Impl {
   RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in);
   void buildFlakes(const float* normals, int tx, int ty, FlakeRec* out, uint32_t* count) const;
   void buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int tx, int ty, uint32_t* next_leaf);
-  bool terms(const Footprint& fp, FootprintTerms* t) const;
+  // The constants of a footprint, with the spatial truncation at window_sigmas sqrt(v) (a disk).
+  bool terms(const Footprint& fp, FootprintTerms* t, double window_sigmas = kWindowSigmas) const;
   double flakePosition(int64_t f) const { return (double(f) + 0.5) * step; }
   double tileOrigin(int64_t tile) const { return double(tile * kTile) * step; }
   // Position of a flake within its tile, as the four-lane evaluator computes it.
@@ -353,7 +357,7 @@ void FlakeNdf::Impl::buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int t
   lb.phi_y[leaf] = phi[1];
 }
 
-bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
+bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t, double window_sigmas) const {
   const double sp2 = fp.sigma * fp.sigma;
   t->v = sigma_h2 + sp2;
   t->a = sigma_h2 / t->v;
@@ -366,7 +370,8 @@ bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
     t->ux -= format::NdfBlendAxis::floorOf(t->ux / width) * width;
     t->uy -= format::NdfBlendAxis::floorOf(t->uy / height) * height;
   }
-  const double reach = kWindowSigmas * std::sqrt(t->v);
+  t->spatial_cut = window_sigmas * window_sigmas / 2;
+  const double reach = window_sigmas * std::sqrt(t->v);
   const double fx0 = std::ceil((t->ux - reach) * rate - 0.5), fx1 = std::floor((t->ux + reach) * rate - 0.5);
   const double fy0 = std::ceil((t->uy - reach) * rate - 0.5), fy1 = std::floor((t->uy + reach) * rate - 0.5);
   if (!(fx1 - fx0 < double(kMaxFlakeWindow) && fy1 - fy0 < double(kMaxFlakeWindow))) return false;
@@ -404,22 +409,29 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafT
   TileVisit batch[kTileBatch];
   LeafVisit reached[kTileBatch * kLeaves];
   int batched = 0;
+  // Blocks are prefetched this many leaves ahead of the one visited.
+  constexpr int kAhead = 6;
+  auto fetch = [&](const LeafVisit& leaf) {
+    const char* bytes = reinterpret_cast<const char*>(leaf.block);
+    for (size_t o = 0; o < sizeof(Block); o += 64) flakes::prefetch(bytes + o);
+    flakes::prefetch(bytes + sizeof(Block) - 1);
+  };
   auto flush = [&] {
     int count = 0;
     for (int i = 0; i < batched; ++i) {
       const TileVisit& v = batch[i];
-      uint32_t mask = leaves(leaf_bounds.data[v.index], tile_bounds.data[v.index], v.base_x, v.base_y);
-      while (mask != 0) {
-        const int leaf = __builtin_ctz(mask);
-        mask &= mask - 1;
-        const Block* block = &blocks.data[v.index * kLeaves + size_t(leaf)];
-        const char* bytes = reinterpret_cast<const char*>(block);
-        for (size_t o = 0; o < sizeof(Block); o += 64) flakes::prefetch(bytes + o);
-        flakes::prefetch(bytes + sizeof(Block) - 1);
-        reached[count++] = LeafVisit{block, v.base_x, v.base_y};
+      const uint32_t mask = leaves(leaf_bounds.data[v.index], tile_bounds.data[v.index], v.base_x, v.base_y);
+      for (int leaf = 0; leaf < kLeaves; ++leaf) {
+        if (((mask >> leaf) & 1u) == 0) continue;
+        reached[count] = LeafVisit{&blocks.data[v.index * kLeaves + size_t(leaf)], v.base_x, v.base_y};
+        if (count < kAhead) fetch(reached[count]);
+        ++count;
       }
     }
-    for (int i = 0; i < count; ++i) visit(reached[i]);
+    for (int i = 0; i < count; ++i) {
+      if (i + kAhead < count) fetch(reached[i + kAhead]);
+      visit(reached[i]);
+    }
     batched = 0;
   };
   for (int64_t py = floorDiv(t.y0, fine_h); py <= floorDiv(t.y1, fine_h); ++py) {
@@ -439,8 +451,9 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafT
           span(t.ux, offx + flakePosition(std::max<int64_t>(tx * kTile, lx0)),
                offx + flakePosition(std::min<int64_t>(tx * kTile + kTile - 1, lx1)), &dx, &dx_min);
           // What the spatial weight leaves of the exponent budget for the nearest flake of the tile.
-          const double budget = kMaxExponent - (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
-          if (budget < 0.0) continue;
+          const double spatial_min = (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
+          const double budget = kMaxExponent - spatial_min;
+          if (budget < 0.0 || spatial_min > t.spatial_cut) continue;
           const size_t index = size_t(ty) * size_t(tiles_x) + size_t(tx);
           if (!tile(tile_bounds.data[index], std::sqrt(dx * dx + dy * dy), budget)) continue;
           const char* bytes = reinterpret_cast<const char*>(&leaf_bounds.data[index]);
@@ -484,6 +497,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   // The same test per leaf, four leaves at a time in float, from each leaf's box of positions; the
   // budget and variance widened against float rounding.
   const F4 budget_cut = F4::splat(float(kMaxExponent) + 1e-3f), var_slack = F4::splat(1.0f + 1e-4f);
+  const F4 spatial_bound = F4::splat(float(t.spatial_cut) + 1e-3f);
   const F4 bound_sr2 = F4::splat(float(sigma_r2) * (1.0f + 1e-4f));
   auto leaves = [&](const LeafBounds& lb, const TileBound& tb, double base_x, double base_y) {
     const F4 bx = F4::splat(float(base_x)), by = F4::splat(float(base_y));
@@ -495,13 +509,15 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
       const F4 dx_min = max(max(x_near, zero - x_far), zero), dy_min = max(max(y_near, zero - y_far), zero);
       const F4 dx_max = max(flakes::abs4(x_near), flakes::abs4(x_far));
       const F4 dy_max = max(flakes::abs4(y_near), flakes::abs4(y_far));
-      const F4 budget = budget_cut - (dx_min * dx_min + dy_min * dy_min) * inv2v;
+      const F4 spatial_min = (dx_min * dx_min + dy_min * dy_min) * inv2v;
+      const F4 budget = budget_cut - spatial_min;
       const F4 jmax = F4::load(lb.jmax + h);
       const F4 shift = jmax * a * sqrt(dx_max * dx_max + dy_max * dy_max) * var_slack;
       const F4 var = bound_sr2 + b * jmax * jmax * var_slack;
       const F4 ex = max(max(F4::load(lb.lo_x + h) - shift - fsx, fsx - F4::load(lb.hi_x + h) - shift), zero);
       const F4 ey = max(max(F4::load(lb.lo_y + h) - shift - fsy, fsy - F4::load(lb.hi_y + h) - shift), zero);
-      mask |= uint32_t(lessEqualMask(ex * ex + ey * ey, two * budget * var)) << h;
+      mask |= uint32_t(lessEqualMask(ex * ex + ey * ey, two * budget * var) & lessEqualMask(spatial_min, spatial_bound))
+              << h;
     }
     return mask & ((1u << tb.leaves) - 1u);
   };
@@ -523,6 +539,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   c.sr2b = float(sigma_r2 * t.b);
   c.b2 = float(t.b * t.b);
   c.keep_cut = float(kMaxExponent) + 0.01f;
+  c.spatial_cut = float(t.spatial_cut);
   const bool wide = flakes::hasAvx2();
   LaneList list;
   int n = 0;
@@ -589,6 +606,15 @@ std::atomic<bool>& portableKernelsOnly() {
   return only;
 }
 }  // namespace flakes
+
+RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
+                                           double window_sigmas, double* value) {
+  if (!f.impl_ || !value || !validFootprint(fp) || !flakes::validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  FootprintTerms t;
+  if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  *value = flakes::inSquare(s) ? f.impl_->evalAt(t, s.x, s.y) : 0.0;
+  return RuntimeStatus::kOk;
+}
 
 void usePortableFlakeKernels(bool portable) { flakes::portableKernelsOnly().store(portable); }
 

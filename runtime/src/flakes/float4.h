@@ -35,6 +35,16 @@ struct F4 {
   // Bit i set where lane i has a <= b (a < b).
   friend int lessEqualMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmple_ps(a.v, b.v)); }
   friend int lessMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)); }
+  // The lanes of x whose bit is set in mask, in order, at dst[0..) (writes kWidth floats).
+  friend void compressStore(float* dst, F4 x, int mask) {
+    float l[4];
+    x.store(l);
+    int c = 0;
+    for (int i = 0; i < 4; ++i) {
+      dst[c] = l[i];
+      c += (mask >> i) & 1;
+    }
+  }
   // Four bytes as floats.
   static F4 fromBytes(const uint8_t* p) {
     int32_t word;
@@ -110,6 +120,13 @@ struct F4 {
     for (int i = 0; i < 4; ++i) m |= (a.v[i] < b.v[i] ? 1 : 0) << i;
     return m;
   }
+  friend void compressStore(float* dst, F4 x, int mask) {
+    int c = 0;
+    for (int i = 0; i < 4; ++i) {
+      dst[c] = x.v[i];
+      c += (mask >> i) & 1;
+    }
+  }
   static F4 fromBytes(const uint8_t* p) {
     F4 r;
     for (int i = 0; i < 4; ++i) r.v[i] = float(p[i]);
@@ -138,6 +155,13 @@ struct F4 {
 #endif
 
 inline F4 floorV(F4 x) { return floor4(x); }
+
+// Set bits of a lane mask (eight lanes at most).
+inline int maskCount(int m) {
+  m = (m & 0x55) + ((m >> 1) & 0x55);
+  m = (m & 0x33) + ((m >> 2) & 0x33);
+  return (m & 0x0f) + ((m >> 4) & 0x0f);
+}
 
 // |x| lane by lane.
 inline F4 abs4(F4 x) { return max(x, F4::splat(0.0f) - x); }

@@ -50,6 +50,19 @@ inline bool hasAvx2() {
 GLINTBAKE_FLAKES_AVX2_BEGIN
 namespace glintbake::runtime::flakes {
 
+// For every mask of eight lanes, the indices of its set lanes in order (then zeros).
+struct CompressTable {
+  uint8_t index[256][8];
+  constexpr CompressTable() : index() {
+    for (int m = 0; m < 256; ++m) {
+      int c = 0;
+      for (int i = 0; i < 8; ++i)
+        if ((m >> i) & 1) index[m][c++] = uint8_t(i);
+    }
+  }
+};
+inline constexpr CompressTable kCompressTable{};
+
 struct F8 {
   static constexpr int kWidth = 8;
   __m256 v;
@@ -76,6 +89,12 @@ struct F8 {
   GLINTBAKE_AVX2_FN friend F8 pow2i(F8 n) {
     return {
         _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_add_epi32(_mm256_cvttps_epi32(n.v), _mm256_set1_epi32(127)), 23))};
+  }
+  // The lanes of x whose bit is set in mask, in order, at dst[0..) (writes kWidth floats).
+  GLINTBAKE_AVX2_FN friend void compressStore(float* dst, F8 x, int mask) {
+    const __m256i index =
+        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(kCompressTable.index[mask])));
+    _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(x.v, index));
   }
   GLINTBAKE_AVX2_FN void store(float* p) const { _mm256_storeu_ps(p, v); }
 };

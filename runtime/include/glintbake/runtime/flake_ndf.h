@@ -83,6 +83,7 @@ class FlakeNdf final : public AccumulatingNdfSource {
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
+  friend struct FlakeNdfAccess;  // the runtime's clustered lobes (internal)
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
