@@ -4,6 +4,8 @@
 
 #include <glintbake/runtime/flake_ndf.h>
 
+#include "gaussian_rect.h"
+
 namespace glintbake::runtime {
 
 struct FlakeNdfAccess {
@@ -12,6 +14,12 @@ struct FlakeNdfAccess {
   // exponent cutoff and kernels.
   static RuntimeStatus windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s, double window_sigmas,
                                     double* value);
+  // The sum of the footprint weights of the flakes in that disk (the integral of windowedEval).
+  static RuntimeStatus windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value);
+  // A flake of that disk in proportion to its weight (u1 picks its row, u2 the flake in the row;
+  // mass from windowedMass) and its lobe; v1, v2 are u1, u2 rescaled within the picked intervals.
+  static RuntimeStatus windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1, double u2,
+                                    double mass, flakes::Lobe* lobe, double* v1, double* v2);
 };
 
 }  // namespace glintbake::runtime

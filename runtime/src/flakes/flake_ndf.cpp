@@ -198,6 +198,13 @@ struct FlakeNdf::Impl {
   // flake, refreshed by exp every kWeightRefresh flakes).
   template <typename Visit>
   void forEachWeight(const FootprintTerms& t, bool along_x, Visit&& visit) const;
+  template <typename Visit>
+  void forEachWeightIn(double u, int64_t f0, int64_t f1, double c, Visit&& visit) const;
+  // The rows of the truncation disk (spatial exponent below t.spatial_cut): visit(fy, row
+  // weight, x0, x1) with the row's flakes [x0, x1], until it returns false.
+  template <typename Visit>
+  void forEachDiskRow(const FootprintTerms& t, Visit&& visit) const;
+  double diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x1) const;
   double weightSum(const FootprintTerms& t, bool along_x) const;
   double mass(const FootprintTerms& t) const { return t.wnorm * weightSum(t, true) * weightSum(t, false); }
 };
@@ -569,13 +576,10 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
 }
 
 template <typename Visit>
-void FlakeNdf::Impl::forEachWeight(const FootprintTerms& t, bool along_x, Visit&& visit) const {
-  if (t.empty) return;
-  const int64_t f0 = along_x ? t.x0 : t.y0, f1 = along_x ? t.x1 : t.y1;
-  const double u = along_x ? t.ux : t.uy;
+void FlakeNdf::Impl::forEachWeightIn(double u, int64_t f0, int64_t f1, double c, Visit&& visit) const {
   // With d = u - p_f: exp(-(d - step)^2 c) = exp(-d^2 c) exp((2 d step - step^2) c), and that
   // ratio shrinks by exp(-2 step^2 c) per flake.
-  const double c = t.inv2v, shrink = std::exp(-2.0 * step * step * c);
+  const double shrink = std::exp(-2.0 * step * step * c);
   double g = 0.0, ratio = 0.0;
   for (int64_t f = f0; f <= f1; ++f) {
     if ((f - f0) % kWeightRefresh == 0) {
@@ -587,6 +591,36 @@ void FlakeNdf::Impl::forEachWeight(const FootprintTerms& t, bool along_x, Visit&
     g *= ratio;
     ratio *= shrink;
   }
+}
+
+template <typename Visit>
+void FlakeNdf::Impl::forEachWeight(const FootprintTerms& t, bool along_x, Visit&& visit) const {
+  if (t.empty) return;
+  forEachWeightIn(along_x ? t.ux : t.uy, along_x ? t.x0 : t.y0, along_x ? t.x1 : t.y1, t.inv2v, visit);
+}
+
+template <typename Visit>
+void FlakeNdf::Impl::forEachDiskRow(const FootprintTerms& t, Visit&& visit) const {
+  if (t.empty) return;
+  const double r2 = 2.0 * t.spatial_cut * t.v;
+  forEachWeightIn(t.uy, t.y0, t.y1, t.inv2v, [&](int64_t fy, double gy) {
+    const double dy = t.uy - flakePosition(fy);
+    const double half_width = std::sqrt(std::max(r2 - dy * dy, 0.0));
+    int64_t x0 = int64_t(std::ceil((t.ux - half_width) * rate - 0.5));
+    int64_t x1 = int64_t(std::floor((t.ux + half_width) * rate - 0.5));
+    x0 = std::max(x0, t.x0);
+    x1 = std::min(x1, t.x1);
+    return visit(fy, gy, x0, x1);
+  });
+}
+
+double FlakeNdf::Impl::diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x1) const {
+  double s = 0.0;
+  forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t, double g) {
+    s += g;
+    return true;
+  });
+  return s;
 }
 
 // Sum of exp(-d^2 / 2v) over the window's flake positions along one axis (the footprint weights
@@ -613,6 +647,63 @@ RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& f
   FootprintTerms t;
   if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   *value = flakes::inSquare(s) ? f.impl_->evalAt(t, s.x, s.y) : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas,
+                                           double* value) {
+  if (!f.impl_ || !value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
+  FootprintTerms t;
+  if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  double sum = 0.0;
+  m.forEachDiskRow(t, [&](int64_t, double gy, int64_t x0, int64_t x1) {
+    sum += gy * m.diskRowSum(t, x0, x1);
+    return true;
+  });
+  *value = t.wnorm * sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1,
+                                           double u2, double mass, flakes::Lobe* lobe, double* v1, double* v2) {
+  if (!f.impl_ || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
+  FootprintTerms t;
+  if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  // A row by its weight, then a flake of it by its own; each uniform rescaled within the chosen
+  // interval. Rounding that leaves the target past the end takes the last row with weight.
+  double target = u1 * mass / t.wnorm, row_weight = 0.0;
+  int64_t fy = 0, x0 = 0, x1 = -1;
+  bool found = false;
+  m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
+    const double w = gy * m.diskRowSum(t, a, b);
+    if (!(w > 0.0)) return true;
+    fy = y, x0 = a, x1 = b, row_weight = w;
+    if (target < w) {
+      found = true;
+      return false;
+    }
+    target -= w;
+    return true;
+  });
+  if (x1 < x0) return RuntimeStatus::kInvalidArgument;
+  if (!found) target = row_weight;
+  *v1 = std::clamp(target / row_weight, 0.0, 0.99999999999999989);
+  double rest = u2 * m.diskRowSum(t, x0, x1), g = 0.0;
+  int64_t fx = x0;
+  m.forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t x, double w) {
+    fx = x;
+    g = w;
+    if (rest < w || x == x1) return false;
+    rest -= w;
+    return true;
+  });
+  *v2 = g > 0.0 ? std::clamp(rest / g, 0.0, 0.99999999999999989) : 0.5;
+  const int64_t gx = ((fx % m.fine_w) + m.fine_w) % m.fine_w, gy = ((fy % m.fine_h) + m.fine_h) % m.fine_h;
+  const uint32_t where = m.slot.data[size_t(gy) * size_t(m.fine_w) + size_t(gx)];
+  m.lobeOf(m.blocks.data[where / kLeafFlakes], int(where % kLeafFlakes), t.ux - m.flakePosition(fx),
+           t.uy - m.flakePosition(fy), t, lobe);
   return RuntimeStatus::kOk;
 }
 

@@ -605,6 +605,11 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
+  if (t.level == &levels[0] && exact.isBuilt()) {
+    double m = 0.0;
+    FlakeNdfAccess::windowedMass(exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, &m);
+    return m * kWindowNorm;
+  }
   double sum = 0.0;
   float lanes[kLanes];
   forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
@@ -720,6 +725,24 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double total = m.massOf(t);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+  auto finish = [&](const flakes::Lobe& g, double v1, double v2) {
+    const double radius = std::sqrt(-2.0 * std::log1p(-v1));
+    const double z0 = radius * std::cos(kTwoPi * v2), z1 = radius * std::sin(kTwoPi * v2);
+    const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11;
+    const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
+    out->s.x = g.mx + l11 * z0;
+    out->s.y = g.my + l21 * z0 + l22 * z1;
+    out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
+    return RuntimeStatus::kOk;
+  };
+  if (t.level == &m.levels[0] && m.exact.isBuilt()) {  // a flake of the window by its weight
+    flakes::Lobe g;
+    double v1 = 0.5, v2 = 0.5;
+    if (FlakeNdfAccess::windowedPick(m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
+                                     &v1, &v2) != RuntimeStatus::kOk)
+      return RuntimeStatus::kInvalidArgument;
+    return finish(g, v1, v2);
+  }
   // A tile in proportion to its mass, then a lane of it in proportion to its weight (the sums of
   // massOf, tile by tile), u1 rescaled within the lane. Rounding that leaves the target past the
   // end takes the last lobe of the last tile with mass.
@@ -765,14 +788,7 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
     target = std::numeric_limits<double>::infinity();
     pickIn(*last_block, *last_bound, last_bx, last_by);
   }
-  const double radius = std::sqrt(-2.0 * std::log1p(-v1));
-  const double z0 = radius * std::cos(kTwoPi * u2), z1 = radius * std::sin(kTwoPi * u2);
-  const double l11 = std::sqrt(picked.cxx), l21 = picked.cxy / l11;
-  const double l22 = std::sqrt(std::max(picked.cyy - l21 * l21, 0.0));
-  out->s.x = picked.mx + l11 * z0;
-  out->s.y = picked.my + l21 * z0 + l22 * z1;
-  out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
-  return RuntimeStatus::kOk;
+  return finish(picked, v1, u2);
 }
 
 }  // namespace glintbake::runtime
