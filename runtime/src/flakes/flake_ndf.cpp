@@ -74,6 +74,9 @@ struct TileBound {
   uint32_t leaves;     // leaves in use (the first ones)
 };
 
+// The mask of the first `leaves` leaves of a tile.
+inline uint32_t leafMask(uint32_t leaves) { return leaves >= 32 ? ~0u : (1u << leaves) - 1u; }
+
 // Leaves of the k-d tree over `count` flakes (the split rule of buildLeaves).
 uint32_t treeLeaves(uint32_t count) {
   return count <= uint32_t(kLeafFlakes) ? 1u : treeLeaves(count / 2) + treeLeaves(count - count / 2);
@@ -526,7 +529,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
       mask |= uint32_t(lessEqualMask(ex * ex + ey * ey, two * budget * var) & lessEqualMask(spatial_min, spatial_bound))
               << h;
     }
-    return mask & ((1u << tb.leaves) - 1u);
+    return mask & (leafMask(tb.leaves));
   };
   // The kernel (flake_kernel.inc): s split into a float and its remainder, so that s - n_k keeps
   // double accuracy; det C from the expansion sr^4 + sr^2 b tr(J J^T) + b^2 det(J J^T), which does
@@ -820,7 +823,7 @@ RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, floa
   // in the fixed order of the traversal.
   const double to_density = weight * t.wnorm / (bin * bin);
   auto tile = [](const TileBound&, double, double) { return true; };
-  auto leaves = [](const LeafBounds&, const TileBound& tb, double, double) { return (1u << tb.leaves) - 1u; };
+  auto leaves = [](const LeafBounds&, const TileBound& tb, double, double) { return leafMask(tb.leaves); };
   m.forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
     m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {
       flakes::Lobe g;
