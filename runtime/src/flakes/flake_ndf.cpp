@@ -64,6 +64,9 @@ struct Block {
 struct LeafBounds {
   float lo_x[kLeaves], lo_y[kLeaves], hi_x[kLeaves], hi_y[kLeaves];
   float jmax[kLeaves];
+  // Largest (J J^T)_xx, (J J^T)_yy and u^T J J^T u for u = (1, 1) / sqrt 2 and (1, -1) / sqrt 2:
+  // the lobes' variances along those directions are below sigma_r^2 + b times them.
+  float jxx[kLeaves], jyy[kLeaves], jpp[kLeaves], jmm[kLeaves];
   float plo_x[kLeaves], plo_y[kLeaves], phi_x[kLeaves], phi_y[kLeaves];
 };
 
@@ -278,6 +281,7 @@ RuntimeStatus FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double 
         lb.lo_x[i] = lb.lo_y[i] = kEmptyBox;
         lb.hi_x[i] = lb.hi_y[i] = -kEmptyBox;
         lb.jmax[i] = lb.plo_x[i] = lb.plo_y[i] = lb.phi_x[i] = lb.phi_y[i] = 0.0f;
+        lb.jxx[i] = lb.jyy[i] = lb.jpp[i] = lb.jmm[i] = 0.0f;
       }
       uint32_t leaves = 0;
       buildLeaves(index, tile, count, tx, ty, &leaves);
@@ -341,6 +345,17 @@ void FlakeNdf::Impl::buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int t
   lb.hi_x[leaf] = hi[0];
   lb.hi_y[leaf] = hi[1];
   lb.jmax[leaf] = jmax;
+  double var[4] = {0.0, 0.0, 0.0, 0.0};
+  for (uint32_t i = 0; i < count; ++i) {
+    const double j0 = f[i].j[0], j1 = f[i].j[1], j2 = f[i].j[2], j3 = f[i].j[3];
+    const double xx = j0 * j0 + j1 * j1, yy = j2 * j2 + j3 * j3, xy = j0 * j2 + j1 * j3;
+    const double along[4] = {xx, yy, 0.5 * (xx + yy) + xy, 0.5 * (xx + yy) - xy};
+    for (int d = 0; d < 4; ++d) var[d] = std::max(var[d], along[d]);
+  }
+  lb.jxx[leaf] = float(var[0] * (1.0 + 1e-5));
+  lb.jyy[leaf] = float(var[1] * (1.0 + 1e-5));
+  lb.jpp[leaf] = float(var[2] * (1.0 + 1e-5));
+  lb.jmm[leaf] = float(var[3] * (1.0 + 1e-5));
   float plo[2] = {1e30f, 1e30f}, phi[2] = {-1e30f, -1e30f};
   for (int i = 0; i < kLeafFlakes; ++i) {
     const bool used = uint32_t(i) < count;
@@ -503,6 +518,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   };
   const F4 zero = F4::splat(0.0f), two = F4::splat(2.0f);
   const F4 fsx = F4::splat(float(sx)), fsy = F4::splat(float(sy));
+  const F4 fsp = F4::splat(float(sx + sy)), fsm = F4::splat(float(sx - sy));
   const F4 a = F4::splat(float(t.a)), b = F4::splat(float(t.b)), inv2v = F4::splat(float(t.inv2v));
   // The same test per leaf, four leaves at a time in float, from each leaf's box of positions; the
   // budget and variance widened against float rounding.
@@ -524,10 +540,23 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
       const F4 jmax = F4::load(lb.jmax + h);
       const F4 shift = jmax * a * sqrt(dx_max * dx_max + dy_max * dy_max) * var_slack;
       const F4 var = bound_sr2 + b * jmax * jmax * var_slack;
-      const F4 ex = max(max(F4::load(lb.lo_x + h) - shift - fsx, fsx - F4::load(lb.hi_x + h) - shift), zero);
-      const F4 ey = max(max(F4::load(lb.lo_y + h) - shift - fsy, fsy - F4::load(lb.hi_y + h) - shift), zero);
-      mask |= uint32_t(lessEqualMask(ex * ex + ey * ey, two * budget * var) & lessEqualMask(spatial_min, spatial_bound))
-              << h;
+      // The box of the lobe means, and the distance of s from it along x, y and the diagonals
+      // (the latter times sqrt 2, from the box of m_x + m_y and m_x - m_y).
+      const F4 lo_x = F4::load(lb.lo_x + h) - shift, hi_x = F4::load(lb.hi_x + h) + shift;
+      const F4 lo_y = F4::load(lb.lo_y + h) - shift, hi_y = F4::load(lb.hi_y + h) + shift;
+      const F4 ex = max(max(lo_x - fsx, fsx - hi_x), zero);
+      const F4 ey = max(max(lo_y - fsy, fsy - hi_y), zero);
+      const F4 ep = max(max((lo_x + lo_y) - fsp, fsp - (hi_x + hi_y)), zero);
+      const F4 em = max(max((lo_x - hi_y) - fsm, fsm - (hi_x - lo_y)), zero);
+      // q = r^T C^-1 r >= (u . r)^2 / (u^T C u) for every unit u, and >= |r|^2 / lambda_max(C).
+      const F4 room = two * budget;
+      const int pass = lessEqualMask(ex * ex + ey * ey, room * var) &
+                       lessEqualMask(ex * ex, room * (bound_sr2 + b * F4::load(lb.jxx + h) * var_slack)) &
+                       lessEqualMask(ey * ey, room * (bound_sr2 + b * F4::load(lb.jyy + h) * var_slack)) &
+                       lessEqualMask(ep * ep, two * room * (bound_sr2 + b * F4::load(lb.jpp + h) * var_slack)) &
+                       lessEqualMask(em * em, two * room * (bound_sr2 + b * F4::load(lb.jmm + h) * var_slack)) &
+                       lessEqualMask(spatial_min, spatial_bound);
+      mask |= uint32_t(pass) << h;
     }
     return mask & (leafMask(tb.leaves));
   };
