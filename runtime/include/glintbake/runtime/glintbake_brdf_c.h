@@ -45,8 +45,8 @@ typedef struct gb_brdf_params {
 GLINTBAKE_C_API int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]);
 /* Samples wi (via the NDF) from two uniforms in [0, 1). *pdf = 0 marks a discarded sample;
  * weight = f cos(theta_i) / pdf. */
-GLINTBAKE_C_API int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double u1, double u2,
-                                       double wi[3], double* pdf, double weight[3]);
+GLINTBAKE_C_API int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double u1, double u2, double wi[3],
+                       double* pdf, double weight[3]);
 GLINTBAKE_C_API int32_t gb_brdf_pdf(const gb_brdf_params* params, const double wi[3], const double wo[3], double* pdf);
 
 /* A spherical Gaussian light a exp(lambda (mu . v - 1)), mu unit, lambda > 0, a per channel. */
@@ -61,8 +61,8 @@ GLINTBAKE_C_API int32_t gb_sg_support(const gb_sg* sg, double eps, double* cos_t
 /* Integral of G over the sphere per channel. */
 GLINTBAKE_C_API int32_t gb_sg_integral(const gb_sg* sg, double integral[3]);
 /* The prefiltered radiance towards wo of the SG light reflected by the BRDF (sg.h). */
-GLINTBAKE_C_API int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps,
-                                                  const double wo[3], double radiance[3]);
+GLINTBAKE_C_API int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps, const double wo[3],
+                                  double radiance[3]);
 
 #ifdef __cplusplus
 }

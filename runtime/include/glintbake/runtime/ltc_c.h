@@ -28,8 +28,7 @@ typedef struct gb_ltc_table gb_ltc_table;
 GLINTBAKE_C_API int32_t gb_ltc_table_open(const char* path, gb_ltc_table** out);
 GLINTBAKE_C_API int32_t gb_ltc_table_open_memory(const void* data, size_t size, gb_ltc_table** out);
 /* Adopts two size x size x 4 float arrays in the published layout (copied). */
-GLINTBAKE_C_API int32_t gb_ltc_table_from_arrays(int32_t size, const float* ltc1, const float* ltc2,
-                                                 gb_ltc_table** out);
+GLINTBAKE_C_API int32_t gb_ltc_table_from_arrays(int32_t size, const float* ltc1, const float* ltc2, gb_ltc_table** out);
 GLINTBAKE_C_API void gb_ltc_table_close(gb_ltc_table* table); /* NULL is allowed */
 GLINTBAKE_C_API int32_t gb_ltc_table_size(const gb_ltc_table* table, int32_t* size);
 
@@ -39,8 +38,8 @@ GLINTBAKE_C_API int32_t gb_ltc_lookup(const gb_ltc_table* table, float roughness
 /* Integral of the LTC (without magnitude) over a polygon: `count` vertices (3..16) as x, y, z
  * triples relative to the shading point in the shading frame (z = normal, x towards the view
  * vector), wound so that (v1 - v0) x (v2 - v0) points away from the shading point. */
-GLINTBAKE_C_API int32_t gb_ltc_integrate_polygon(const gb_ltc* ltc, const float* vertices, int32_t count,
-                                                 int32_t two_sided, float* out);
+GLINTBAKE_C_API int32_t gb_ltc_integrate_polygon(const gb_ltc* ltc, const float* vertices, int32_t count, int32_t two_sided,
+                                 float* out);
 
 /* f0 * norm + (1 - f0) * fresnel: the magnitude with Schlick Fresnel. */
 GLINTBAKE_C_API float gb_ltc_fresnel_magnitude(const gb_ltc* ltc, float f0);
