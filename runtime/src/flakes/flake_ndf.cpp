@@ -4,8 +4,10 @@
 
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
+#include "flake_access.h"
 #include "flake_model.h"
 #include "float4.h"
+#include "float8.h"
 #include "gaussian_rect.h"
 
 #include <algorithm>
@@ -17,14 +19,22 @@ namespace glintbake::runtime {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
-constexpr int kTile = 8;             // flakes per side of a tile of the hierarchy
-constexpr int kLeafFlakes = 8;       // flakes per leaf of a tile's k-d tree (one block)
-constexpr double kWindowSigmas = 6;  // spatial truncation radius, in sqrt(v), as the reference's
+constexpr int kTile = 8;                              // flakes per side of a tile of the hierarchy
+constexpr int kLeafFlakes = 8;                        // flakes per leaf of a tile's k-d tree (one block)
+constexpr int kLeaves = kTile * kTile / kLeafFlakes;  // leaves of a full tile
+constexpr double kWindowSigmas = 6;                   // spatial truncation radius, in sqrt(v), as the reference's
 // A flake is left out when its spatial exponent |u_Q - u_k|^2 / 2v plus its lobe's exponent at s
 // exceeds this: its contribution is below e^-18 of its own peak. The spatial part alone is the
 // reference evaluator's truncation (a disk of 6 sqrt(v)).
 constexpr double kMaxExponent = kWindowSigmas * kWindowSigmas / 2;
-constexpr float kPaddingPosition = 1e15f;  // position of the unused lanes of a block: weight 0
+constexpr float kPaddingNormal = 1e15f;  // normal of the unused lanes of a block: no lobe reaches s
+constexpr float kEmptyBox = 1e18f;       // normal bounds of unused leaves: lo = kEmptyBox, hi = -kEmptyBox
+// Tiles whose leaves are tested together before their blocks are evaluated (the leaf bounds of a
+// batch and then its blocks are prefetched, so that their cache misses overlap).
+constexpr int kTileBatch = 16;
+// The footprint weights along an axis follow a product recurrence, recomputed by exp every this
+// many flakes (rounding grows with the square of the run: below 1e-13 relative).
+constexpr int64_t kWeightRefresh = 16;
 constexpr int kMaxSide = 1 << 16;
 constexpr uint64_t kMaxFlakes = uint64_t(1) << 30;
 // The k-d tree splits flakes by n and by |J|, |J| scaled so that its range counts as much as the
@@ -40,27 +50,37 @@ struct FlakeRec {
 };
 
 // The flakes of one leaf, eight lanes of each quantity (structure of arrays for the evaluator's
-// four-lane loop). Positions are relative to the tile's origin, in texels.
+// four-lane loop). Positions are the flake's fine index within its tile: u_k - tile origin =
+// (l + 0.5) step. Unused lanes have normal kPaddingNormal, which no lobe test passes.
 struct Block {
   float nx[8], ny[8];
   float j0[8], j1[8], j2[8], j3[8];  // J
-  float jxx[8], jxy[8], jyy[8];      // J J^T = {j0^2 + j1^2, j0 j2 + j1 j3, j2^2 + j3^2}
-  float jdet[8];                     // det(J J^T) = (j0 j3 - j1 j2)^2
-  float px[8], py[8];
+  uint8_t lx[8], ly[8];
 };
 
-struct Node {
-  float lo[2], hi[2];  // bounds of n over the node's flakes
+// Bounds of a tile's leaves for the four-lane reach test: normal box, largest Frobenius norm of
+// J, and the box of the flake positions (relative to the tile's origin, texels). Unused leaves
+// have an empty normal box that no test passes.
+struct LeafBounds {
+  float lo_x[kLeaves], lo_y[kLeaves], hi_x[kLeaves], hi_y[kLeaves];
+  float jmax[kLeaves];
+  // Largest (J J^T)_xx, (J J^T)_yy and u^T J J^T u for u = (1, 1) / sqrt 2 and (1, -1) / sqrt 2:
+  // the lobes' variances along those directions are below sigma_r^2 + b times them.
+  float jxx[kLeaves], jyy[kLeaves], jpp[kLeaves], jmm[kLeaves];
+  float plo_x[kLeaves], plo_y[kLeaves], phi_x[kLeaves], phi_y[kLeaves];
+};
+
+// Bounds over a whole tile (dense, tested before its leaves are touched).
+struct TileBound {
+  float lo[2], hi[2];  // bounds of n over the tile's flakes
   float jmax;          // largest Frobenius norm of J over them
-  uint32_t block;      // leaf: its block
-  uint32_t count;      // flakes below the node
-  uint32_t child;      // index of the first of two children; 0 for a leaf
+  uint32_t leaves;     // leaves in use (the first ones)
 };
 
-// Nodes of the k-d tree over `count` flakes (the split rule of buildTree).
-uint32_t treeNodes(uint32_t count) {
-  return count <= uint32_t(kLeafFlakes) ? 1u : 1u + treeNodes(count / 2) + treeNodes(count - count / 2);
-}
+// The mask of the first `leaves` leaves of a tile.
+inline uint32_t leafMask(uint32_t leaves) { return leaves >= 32 ? ~0u : (1u << leaves) - 1u; }
+
+// Leaves of the k-d tree over `count` flakes (the split rule of buildLeaves).
 uint32_t treeLeaves(uint32_t count) {
   return count <= uint32_t(kLeafFlakes) ? 1u : treeLeaves(count / 2) + treeLeaves(count - count / 2);
 }
@@ -73,17 +93,65 @@ struct FootprintTerms {
   double b;                // sigma_h^2 sigma_p^2 / v: the J J^T share of the lobe covariance
   double inv2v;            // 1 / (2 v)
   double wnorm;            // A / (2 pi v)
+  double spatial_cut;      // largest spatial exponent (kMaxExponent: the window of 6 sqrt(v))
   int64_t x0, x1, y0, y1;  // window of fine flake indices (unwrapped, inclusive)
   bool empty;
 };
 
-// A leaf reached by the traversal: its block, flake count and the footprint centre relative to
+// A leaf reached by the traversal: its block and the footprint centre relative to
 // the origin of its tile's periodic image (so u_Q - u_k = base - p_k).
 struct LeafVisit {
   const Block* block;
-  int count;
   double base_x, base_y;
 };
+
+// The float constants of one point query shared by every lane of the kernel (flake_kernel.inc).
+struct KernelTerms {
+  float sxh, sxl, syh, syl;  // s split into a float and its remainder
+  float a, b, inv2v, step;
+  float sr2, sr4, sr2b, b2;  // sigma_r^2, sigma_r^4, sigma_r^2 b, b^2
+  float keep_cut;            // the first pass's cutoff, kMaxExponent plus a margin
+  float spatial_cut;         // lanes with a spatial exponent below it only
+};
+
+// Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
+// room the branch-free writes and the padding to a whole vector take).
+constexpr int kLaneList = 512;
+struct LaneList {
+  alignas(64) float spatial[kLaneList + 16];
+  alignas(64) float num[kLaneList + 16];
+  alignas(64) float det[kLaneList + 16];
+};
+
+namespace sse {
+using V = flakes::F4;
+#include "flake_kernel.inc"
+}  // namespace sse
+
+#if GLINTBAKE_FLAKES_AVX2
+GLINTBAKE_FLAKES_AVX2_BEGIN
+namespace avx2 {
+using V = flakes::F8;
+#include "flake_kernel.inc"
+}  // namespace avx2
+GLINTBAKE_FLAKES_AVX2_END
+#endif
+
+// The kernels of the processor: AVX2 where it has it (the same bits), else SSE2 or scalar.
+int keepLanes(bool wide, const Block& k, const KernelTerms& c, float bx, float by, LaneList* list, int n) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::keepLanes(k, c, bx, by, list, n);
+#endif
+  (void)wide;
+  return sse::keepLanes(k, c, bx, by, list, n);
+}
+void laneValues(bool wide, LaneList* list, int n, float cutoff) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::laneValues(list, n, cutoff);
+#endif
+  (void)wide;
+  sse::laneValues(list, n, cutoff);
+}
 
 }  // namespace
 
@@ -95,36 +163,54 @@ struct FlakeNdf::Impl {
   double step = 1.0, area = 1.0, sigma_h2 = 0.0, sigma_r2 = 0.0, sigma_r = 0.0;
   int res = 128;
   int tiles_x = 0, tiles_y = 0;
-  Array<Block> blocks;
-  Array<uint32_t> slot;  // fine index (fy * fine_w + fx) -> block * 8 + lane
-  Array<Node> nodes;
-  Array<uint32_t> tile_root;  // node index of every tile's root
+  Array<TileBound> tile_bounds;   // per tile (row-major)
+  Array<LeafBounds> leaf_bounds;  // per tile
+  Array<Block> blocks;            // kLeaves per tile: tile * kLeaves + leaf
+  Array<uint32_t> slot;           // fine index (fy * fine_w + fx) -> block * 8 + lane
 
   RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r_in, int res_in);
   void buildFlakes(const float* normals, int tx, int ty, FlakeRec* out, uint32_t* count) const;
-  void buildTree(uint32_t id, FlakeRec* f, uint32_t count, double origin_x, double origin_y, uint32_t* next_node,
-                 uint32_t* next_block);
-  bool terms(const Footprint& fp, FootprintTerms* t) const;
+  void buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int tx, int ty, uint32_t* next_leaf);
+  // The constants of a footprint, with the spatial truncation at window_sigmas sqrt(v) (a disk).
+  bool terms(const Footprint& fp, FootprintTerms* t, double window_sigmas = kWindowSigmas) const;
   double flakePosition(int64_t f) const { return (double(f) + 0.5) * step; }
   double tileOrigin(int64_t tile) const { return double(tile * kTile) * step; }
+  // Position of a flake within its tile, as the four-lane evaluator computes it.
+  float localPosition(uint8_t l) const { return (float(l) + 0.5f) * float(step); }
   // The lobe of lane i of a block for u_Q - u_k = (dx, dy).
   void lobeOf(const Block& k, int i, double dx, double dy, const FootprintTerms& t, flakes::Lobe* g) const {
-    g->mx = double(k.nx[i]) + t.a * (double(k.j0[i]) * dx + double(k.j1[i]) * dy);
-    g->my = double(k.ny[i]) + t.a * (double(k.j2[i]) * dx + double(k.j3[i]) * dy);
-    g->cxx = sigma_r2 + t.b * double(k.jxx[i]);
-    g->cxy = t.b * double(k.jxy[i]);
-    g->cyy = sigma_r2 + t.b * double(k.jyy[i]);
+    const double j0 = k.j0[i], j1 = k.j1[i], j2 = k.j2[i], j3 = k.j3[i];
+    g->mx = double(k.nx[i]) + t.a * (j0 * dx + j1 * dy);
+    g->my = double(k.ny[i]) + t.a * (j2 * dx + j3 * dy);
+    g->cxx = sigma_r2 + t.b * (j0 * j0 + j1 * j1);
+    g->cxy = t.b * (j0 * j2 + j1 * j3);
+    g->cyy = sigma_r2 + t.b * (j2 * j2 + j3 * j3);
   }
-  // Calls visit(LeafVisit) for every leaf of the window's tiles that passes reach(node, dmax,
-  // budget): dmax bounds |u_Q - u_k| over the tile, budget is kMaxExponent less the smallest
-  // spatial exponent of the tile. Tiles beyond the truncation disk are skipped.
-  template <typename Reach, typename Visit>
-  void forEachLeaf(const FootprintTerms& t, Reach&& reach, Visit&& visit) const;
+  // Calls visit(LeafVisit) for every leaf of the window's tiles that passes both tests:
+  // tile(bound, dmax, budget) on the tile's bounds (dmax bounds |u_Q - u_k| over the tile, budget
+  // is kMaxExponent less the smallest spatial exponent of the tile), then leaves(bounds, base_x,
+  // base_y), a mask of the tile's leaves to visit (base = u_Q - the origin of the tile's periodic
+  // image). Tiles beyond the truncation disk are skipped. The tiles of a batch are tested before
+  // their leaves are visited, in the order of the window.
+  template <typename TileTest, typename LeafTest, typename Visit>
+  void forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafTest&& leaves, Visit&& visit) const;
   // Calls visit(block, lane, dx, dy, spatial exponent) for every flake of the leaf within the
   // truncation disk (scalar paths: average, image).
   template <typename Visit>
   void forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms& t, Visit&& visit) const;
   double evalAt(const FootprintTerms& t, double sx, double sy) const;
+  // The footprint weights exp(-d^2 / 2v) of the window's flake positions along one axis, in order,
+  // passed to visit(index, weight) until it returns false (a recurrence of two products per
+  // flake, refreshed by exp every kWeightRefresh flakes).
+  template <typename Visit>
+  void forEachWeight(const FootprintTerms& t, bool along_x, Visit&& visit) const;
+  template <typename Visit>
+  void forEachWeightIn(double u, int64_t f0, int64_t f1, double c, Visit&& visit) const;
+  // The rows of the truncation disk (spatial exponent below t.spatial_cut): visit(fy, row
+  // weight, x0, x1) with the row's flakes [x0, x1], until it returns false.
+  template <typename Visit>
+  void forEachDiskRow(const FootprintTerms& t, Visit&& visit) const;
+  double diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x1) const;
   double weightSum(const FootprintTerms& t, bool along_x) const;
   double mass(const FootprintTerms& t) const { return t.wnorm * weightSum(t, true) * weightSum(t, false); }
 };
@@ -170,19 +256,12 @@ RuntimeStatus FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double 
   tiles_x = (fine_w + kTile - 1) / kTile;
   tiles_y = (fine_h + kTile - 1) / kTile;
 
-  size_t node_count = 0, block_count = 0;
-  for (int ty = 0; ty < tiles_y; ++ty) {
-    for (int tx = 0; tx < tiles_x; ++tx) {
-      const uint32_t c = uint32_t(std::min(kTile, fine_w - tx * kTile) * std::min(kTile, fine_h - ty * kTile));
-      node_count += treeNodes(c);
-      block_count += treeLeaves(c);
-    }
-  }
+  const size_t tile_count = size_t(tiles_x) * size_t(tiles_y);
   Array<float> normals;
   const size_t texels = size_t(width) * size_t(height);
-  if (!normals.allocate(texels * 2) || !blocks.allocate(block_count) ||
-      !slot.allocate(size_t(fine_w) * size_t(fine_h)) || !tile_root.allocate(size_t(tiles_x) * size_t(tiles_y)) ||
-      !nodes.allocate(node_count))
+  if (!normals.allocate(texels * 2) || !blocks.allocate(tile_count * kLeaves) ||
+      !slot.allocate(size_t(fine_w) * size_t(fine_h)) || !tile_bounds.allocate(tile_count) ||
+      !leaf_bounds.allocate(tile_count))
     return RuntimeStatus::kOutOfMemory;
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
@@ -192,43 +271,60 @@ RuntimeStatus FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double 
     }
   }
   FlakeRec tile[kTile * kTile];
-  uint32_t next_node = 0, next_block = 0;
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       uint32_t count = 0;
       buildFlakes(normals.data, tx, ty, tile, &count);
-      const uint32_t root = next_node++;
-      tile_root.data[size_t(ty) * size_t(tiles_x) + size_t(tx)] = root;
-      buildTree(root, tile, count, tileOrigin(tx), tileOrigin(ty), &next_node, &next_block);
+      const size_t index = size_t(ty) * size_t(tiles_x) + size_t(tx);
+      LeafBounds& lb = leaf_bounds.data[index];
+      for (int i = 0; i < kLeaves; ++i) {
+        lb.lo_x[i] = lb.lo_y[i] = kEmptyBox;
+        lb.hi_x[i] = lb.hi_y[i] = -kEmptyBox;
+        lb.jmax[i] = lb.plo_x[i] = lb.plo_y[i] = lb.phi_x[i] = lb.phi_y[i] = 0.0f;
+        lb.jxx[i] = lb.jyy[i] = lb.jpp[i] = lb.jmm[i] = 0.0f;
+      }
+      uint32_t leaves = 0;
+      buildLeaves(index, tile, count, tx, ty, &leaves);
+      TileBound& tb = tile_bounds.data[index];
+      tb.lo[0] = tb.lo[1] = kEmptyBox;
+      tb.hi[0] = tb.hi[1] = -kEmptyBox;
+      tb.jmax = 0.0f;
+      tb.leaves = leaves;
+      for (uint32_t i = 0; i < leaves; ++i) {
+        tb.lo[0] = std::min(tb.lo[0], lb.lo_x[i]);
+        tb.lo[1] = std::min(tb.lo[1], lb.lo_y[i]);
+        tb.hi[0] = std::max(tb.hi[0], lb.hi_x[i]);
+        tb.hi[1] = std::max(tb.hi[1], lb.hi_y[i]);
+        tb.jmax = std::max(tb.jmax, lb.jmax[i]);
+      }
+      for (uint32_t i = leaves; i < uint32_t(kLeaves); ++i) {  // unused blocks of an edge tile
+        Block& b = blocks.data[index * kLeaves + i];
+        for (int l = 0; l < kLeafFlakes; ++l) {
+          b.nx[l] = b.ny[l] = kPaddingNormal;
+          b.j0[l] = b.j1[l] = b.j2[l] = b.j3[l] = 0.0f;
+          b.lx[l] = b.ly[l] = 0;
+        }
+      }
     }
   }
   return RuntimeStatus::kOk;
 }
 
-// Builds node `id`, the k-d tree over f[0, count): splits at the median of the widest of n_x, n_y
-// and the scaled |J| until at most kLeafFlakes remain; children are allocated as a pair from
-// *next_node, leaves take the next block.
-void FlakeNdf::Impl::buildTree(uint32_t id, FlakeRec* f, uint32_t count, double origin_x, double origin_y,
-                               uint32_t* next_node, uint32_t* next_block) {
-  Node node;
-  node.lo[0] = node.lo[1] = 1e30f;
-  node.hi[0] = node.hi[1] = -1e30f;
-  node.jmax = 0.0f;
-  float jmin = 1e30f;
+// The leaves of the k-d tree over f[0, count) of a tile: splits at the median of the widest of
+// n_x, n_y and the scaled |J| until at most kLeafFlakes remain; leaves take the tile's blocks in
+// depth-first order, with their bounds.
+void FlakeNdf::Impl::buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int tx, int ty, uint32_t* next_leaf) {
+  float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f}, jmax = 0.0f, jmin = 1e30f;
   for (uint32_t i = 0; i < count; ++i) {
     for (int a = 0; a < 2; ++a) {
-      node.lo[a] = std::min(node.lo[a], f[i].n[a]);
-      node.hi[a] = std::max(node.hi[a], f[i].n[a]);
+      lo[a] = std::min(lo[a], f[i].n[a]);
+      hi[a] = std::max(hi[a], f[i].n[a]);
     }
-    node.jmax = std::max(node.jmax, f[i].jnorm);
+    jmax = std::max(jmax, f[i].jnorm);
     jmin = std::min(jmin, f[i].jnorm);
   }
-  node.count = count;
-  node.child = 0;
-  node.block = 0;
   if (count > uint32_t(kLeafFlakes)) {
-    const float extent[3] = {node.hi[0] - node.lo[0], node.hi[1] - node.lo[1],
-                             (node.jmax - jmin) * kJacobianSplitScale};
+    const float extent[3] = {hi[0] - lo[0], hi[1] - lo[1], (jmax - jmin) * kJacobianSplitScale};
     const int axis = extent[2] > std::max(extent[0], extent[1]) ? 2 : (extent[0] >= extent[1] ? 0 : 1);
     auto key = [axis](const FlakeRec& p) { return axis == 2 ? p.jnorm : p.n[axis]; };
     const uint32_t half = count / 2;
@@ -236,36 +332,57 @@ void FlakeNdf::Impl::buildTree(uint32_t id, FlakeRec* f, uint32_t count, double 
       const float a = key(p), b = key(q);
       return a < b || (a == b && (p.fy < q.fy || (p.fy == q.fy && p.fx < q.fx)));
     });
-    node.child = *next_node;
-    *next_node += 2;
-    buildTree(node.child, f, half, origin_x, origin_y, next_node, next_block);
-    buildTree(node.child + 1, f + half, count - half, origin_x, origin_y, next_node, next_block);
-  } else {
-    node.block = (*next_block)++;
-    Block& b = blocks.data[node.block];
-    for (int i = 0; i < kLeafFlakes; ++i) {
-      const bool used = uint32_t(i) < count;
-      const FlakeRec k = used ? f[i] : FlakeRec{{0, 0}, {0, 0, 0, 0}, 0, 0, 0};
-      b.nx[i] = k.n[0];
-      b.ny[i] = k.n[1];
-      b.j0[i] = k.j[0];
-      b.j1[i] = k.j[1];
-      b.j2[i] = k.j[2];
-      b.j3[i] = k.j[3];
-      b.jxx[i] = float(double(k.j[0]) * k.j[0] + double(k.j[1]) * k.j[1]);
-      b.jxy[i] = float(double(k.j[0]) * k.j[2] + double(k.j[1]) * k.j[3]);
-      b.jyy[i] = float(double(k.j[2]) * k.j[2] + double(k.j[3]) * k.j[3]);
-      const double dj = double(k.j[0]) * k.j[3] - double(k.j[1]) * k.j[2];
-      b.jdet[i] = float(dj * dj);
-      b.px[i] = used ? float(flakePosition(k.fx) - origin_x) : kPaddingPosition;
-      b.py[i] = used ? float(flakePosition(k.fy) - origin_y) : kPaddingPosition;
-      if (used) slot.data[size_t(k.fy) * size_t(fine_w) + k.fx] = node.block * kLeafFlakes + uint32_t(i);
-    }
+    buildLeaves(tile, f, half, tx, ty, next_leaf);
+    buildLeaves(tile, f + half, count - half, tx, ty, next_leaf);
+    return;
   }
-  nodes.data[id] = node;
+  const uint32_t leaf = (*next_leaf)++;
+  const uint32_t block = uint32_t(tile * kLeaves) + leaf;
+  Block& b = blocks.data[block];
+  LeafBounds& lb = leaf_bounds.data[tile];
+  lb.lo_x[leaf] = lo[0];
+  lb.lo_y[leaf] = lo[1];
+  lb.hi_x[leaf] = hi[0];
+  lb.hi_y[leaf] = hi[1];
+  lb.jmax[leaf] = jmax;
+  double var[4] = {0.0, 0.0, 0.0, 0.0};
+  for (uint32_t i = 0; i < count; ++i) {
+    const double j0 = f[i].j[0], j1 = f[i].j[1], j2 = f[i].j[2], j3 = f[i].j[3];
+    const double xx = j0 * j0 + j1 * j1, yy = j2 * j2 + j3 * j3, xy = j0 * j2 + j1 * j3;
+    const double along[4] = {xx, yy, 0.5 * (xx + yy) + xy, 0.5 * (xx + yy) - xy};
+    for (int d = 0; d < 4; ++d) var[d] = std::max(var[d], along[d]);
+  }
+  lb.jxx[leaf] = float(var[0] * (1.0 + 1e-5));
+  lb.jyy[leaf] = float(var[1] * (1.0 + 1e-5));
+  lb.jpp[leaf] = float(var[2] * (1.0 + 1e-5));
+  lb.jmm[leaf] = float(var[3] * (1.0 + 1e-5));
+  float plo[2] = {1e30f, 1e30f}, phi[2] = {-1e30f, -1e30f};
+  for (int i = 0; i < kLeafFlakes; ++i) {
+    const bool used = uint32_t(i) < count;
+    const FlakeRec k = used ? f[i] : FlakeRec{{kPaddingNormal, kPaddingNormal}, {0, 0, 0, 0}, 0, 0, 0};
+    b.nx[i] = k.n[0];
+    b.ny[i] = k.n[1];
+    b.j0[i] = k.j[0];
+    b.j1[i] = k.j[1];
+    b.j2[i] = k.j[2];
+    b.j3[i] = k.j[3];
+    b.lx[i] = used ? uint8_t(k.fx - uint32_t(tx * kTile)) : 0;
+    b.ly[i] = used ? uint8_t(k.fy - uint32_t(ty * kTile)) : 0;
+    if (!used) continue;
+    const float p[2] = {localPosition(b.lx[i]), localPosition(b.ly[i])};
+    for (int a = 0; a < 2; ++a) {
+      plo[a] = std::min(plo[a], p[a]);
+      phi[a] = std::max(phi[a], p[a]);
+    }
+    slot.data[size_t(k.fy) * size_t(fine_w) + k.fx] = block * kLeafFlakes + uint32_t(i);
+  }
+  lb.plo_x[leaf] = plo[0];
+  lb.plo_y[leaf] = plo[1];
+  lb.phi_x[leaf] = phi[0];
+  lb.phi_y[leaf] = phi[1];
 }
 
-bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
+bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t, double window_sigmas) const {
   const double sp2 = fp.sigma * fp.sigma;
   t->v = sigma_h2 + sp2;
   t->a = sigma_h2 / t->v;
@@ -278,7 +395,8 @@ bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
     t->ux -= format::NdfBlendAxis::floorOf(t->ux / width) * width;
     t->uy -= format::NdfBlendAxis::floorOf(t->uy / height) * height;
   }
-  const double reach = kWindowSigmas * std::sqrt(t->v);
+  t->spatial_cut = window_sigmas * window_sigmas / 2;
+  const double reach = window_sigmas * std::sqrt(t->v);
   const double fx0 = std::ceil((t->ux - reach) * rate - 0.5), fx1 = std::floor((t->ux + reach) * rate - 0.5);
   const double fy0 = std::ceil((t->uy - reach) * rate - 0.5), fy1 = std::floor((t->uy + reach) * rate - 0.5);
   if (!(fx1 - fx0 < double(kMaxFlakeWindow) && fy1 - fy0 < double(kMaxFlakeWindow))) return false;
@@ -297,8 +415,8 @@ bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t) const {
   return true;
 }
 
-template <typename Reach, typename Visit>
-void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, Reach&& reach, Visit&& visit) const {
+template <typename TileTest, typename LeafTest, typename Visit>
+void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafTest&& leaves, Visit&& visit) const {
   if (t.empty) return;
   auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
   // |u_Q - u| over the flake positions [p0, p1] of a tile: largest and smallest.
@@ -307,7 +425,40 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, Reach&& reach, Visit&&
     *dmax = std::max(std::fabs(a), std::fabs(b));
     *dmin = (a > 0.0) == (b > 0.0) ? std::min(std::fabs(a), std::fabs(b)) : 0.0;
   };
-  uint32_t stack[64];
+  // A batch of tiles that passed their tile test, their leaf bounds prefetched; then the leaves
+  // of the batch that pass, their blocks prefetched, visited in order.
+  struct TileVisit {
+    size_t index;
+    double base_x, base_y;
+  };
+  TileVisit batch[kTileBatch];
+  LeafVisit reached[kTileBatch * kLeaves];
+  int batched = 0;
+  // Blocks are prefetched this many leaves ahead of the one visited.
+  constexpr int kAhead = 6;
+  auto fetch = [&](const LeafVisit& leaf) {
+    const char* bytes = reinterpret_cast<const char*>(leaf.block);
+    for (size_t o = 0; o < sizeof(Block); o += 64) flakes::prefetch(bytes + o);
+    flakes::prefetch(bytes + sizeof(Block) - 1);
+  };
+  auto flush = [&] {
+    int count = 0;
+    for (int i = 0; i < batched; ++i) {
+      const TileVisit& v = batch[i];
+      const uint32_t mask = leaves(leaf_bounds.data[v.index], tile_bounds.data[v.index], v.base_x, v.base_y);
+      for (int leaf = 0; leaf < kLeaves; ++leaf) {
+        if (((mask >> leaf) & 1u) == 0) continue;
+        reached[count] = LeafVisit{&blocks.data[v.index * kLeaves + size_t(leaf)], v.base_x, v.base_y};
+        if (count < kAhead) fetch(reached[count]);
+        ++count;
+      }
+    }
+    for (int i = 0; i < count; ++i) {
+      if (i + kAhead < count) fetch(reached[i + kAhead]);
+      visit(reached[i]);
+    }
+    batched = 0;
+  };
   for (int64_t py = floorDiv(t.y0, fine_h); py <= floorDiv(t.y1, fine_h); ++py) {
     const int64_t oy = py * fine_h;
     const int64_t ly0 = std::max<int64_t>(t.y0 - oy, 0), ly1 = std::min<int64_t>(t.y1 - oy, fine_h - 1);
@@ -325,99 +476,270 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, Reach&& reach, Visit&&
           span(t.ux, offx + flakePosition(std::max<int64_t>(tx * kTile, lx0)),
                offx + flakePosition(std::min<int64_t>(tx * kTile + kTile - 1, lx1)), &dx, &dx_min);
           // What the spatial weight leaves of the exponent budget for the nearest flake of the tile.
-          const double budget = kMaxExponent - (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
-          if (budget < 0.0) continue;
-          const double dmax = std::sqrt(dx * dx + dy * dy);
-          const LeafVisit base{nullptr, 0, t.ux - offx - tileOrigin(tx), t.uy - offy - tileOrigin(ty)};
-          int top = 0;
-          stack[top++] = tile_root.data[size_t(ty) * size_t(tiles_x) + size_t(tx)];
-          while (top > 0) {
-            const Node& node = nodes.data[stack[--top]];
-            if (!reach(node, dmax, budget)) continue;
-            if (node.child != 0) {
-              stack[top++] = node.child + 1;
-              stack[top++] = node.child;
-              continue;
-            }
-            LeafVisit leaf = base;
-            leaf.block = &blocks.data[node.block];
-            leaf.count = int(node.count);
-            visit(leaf);
-          }
+          const double spatial_min = (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
+          const double budget = kMaxExponent - spatial_min;
+          if (budget < 0.0 || spatial_min > t.spatial_cut) continue;
+          const size_t index = size_t(ty) * size_t(tiles_x) + size_t(tx);
+          if (!tile(tile_bounds.data[index], std::sqrt(dx * dx + dy * dy), budget)) continue;
+          const char* bytes = reinterpret_cast<const char*>(&leaf_bounds.data[index]);
+          for (size_t o = 0; o < sizeof(LeafBounds); o += 64) flakes::prefetch(bytes + o);
+          flakes::prefetch(bytes + sizeof(LeafBounds) - 1);
+          batch[batched++] = TileVisit{index, t.ux - offx - tileOrigin(tx), t.uy - offy - tileOrigin(ty)};
+          if (batched == kTileBatch) flush();
         }
       }
     }
   }
+  flush();
 }
 
 template <typename Visit>
 void FlakeNdf::Impl::forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms& t, Visit&& visit) const {
-  for (int i = 0; i < leaf.count; ++i) {
-    const double dx = leaf.base_x - double(leaf.block->px[i]), dy = leaf.base_y - double(leaf.block->py[i]);
+  const Block& k = *leaf.block;
+  for (int i = 0; i < kLeafFlakes; ++i) {
+    if (k.nx[i] == kPaddingNormal) continue;
+    const double dx = leaf.base_x - double(localPosition(k.lx[i])), dy = leaf.base_y - double(localPosition(k.ly[i]));
     const double spatial = (dx * dx + dy * dy) * t.inv2v;
-    if (spatial <= kMaxExponent) visit(*leaf.block, i, dx, dy, spatial);
+    if (spatial <= kMaxExponent) visit(k, i, dx, dy, spatial);
   }
 }
 
 double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) const {
   using flakes::F4;
-  // Largest lobe variance and mean shift of a node: C_k <= (sigma_r^2 + b |J|^2) I and
+  // Largest lobe variance and mean shift over a tile: C_k <= (sigma_r^2 + b |J|^2) I and
   // |mu_k - n_k| <= a |J| |u_Q - u_k|.
-  auto reach = [&](const Node& node, double dmax, double budget) {
-    const double shift = double(node.jmax) * t.a * dmax;
-    const double var = sigma_r2 + t.b * double(node.jmax) * double(node.jmax);
-    const double ex = std::max(std::max(double(node.lo[0]) - shift - sx, sx - double(node.hi[0]) - shift), 0.0);
-    const double ey = std::max(std::max(double(node.lo[1]) - shift - sy, sy - double(node.hi[1]) - shift), 0.0);
+  auto tile = [&](const TileBound& bound, double dmax, double budget) {
+    const double jmax = bound.jmax;
+    const double shift = jmax * t.a * dmax;
+    const double var = sigma_r2 + t.b * jmax * jmax;
+    const double ex = std::max(std::max(double(bound.lo[0]) - shift - sx, sx - double(bound.hi[0]) - shift), 0.0);
+    const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
     return ex * ex + ey * ey <= 2.0 * budget * var;
   };
-  // Four flakes at a time in float: s split into a float and its remainder, so that s - n_k keeps
-  // double accuracy; det C from the expansion sr^4 + sr^2 b tr(J J^T) + b^2 det(J J^T), which does
-  // not cancel for rank-1 Jacobians.
-  const float sx_hi = float(sx), sy_hi = float(sy);
-  const F4 sxh = F4::splat(sx_hi), sxl = F4::splat(float(sx - double(sx_hi)));
-  const F4 syh = F4::splat(sy_hi), syl = F4::splat(float(sy - double(sy_hi)));
+  const F4 zero = F4::splat(0.0f), two = F4::splat(2.0f);
+  const F4 fsx = F4::splat(float(sx)), fsy = F4::splat(float(sy));
+  const F4 fsp = F4::splat(float(sx + sy)), fsm = F4::splat(float(sx - sy));
   const F4 a = F4::splat(float(t.a)), b = F4::splat(float(t.b)), inv2v = F4::splat(float(t.inv2v));
-  const F4 sr2 = F4::splat(float(sigma_r2)), sr4 = F4::splat(float(sigma_r2 * sigma_r2));
-  const F4 sr2b = F4::splat(float(sigma_r2 * t.b)), b2 = F4::splat(float(t.b * t.b));
-  const F4 half = F4::splat(0.5f), two = F4::splat(2.0f), cutoff = F4::splat(float(kMaxExponent));
-  double sum = 0.0;
-  forEachLeaf(t, reach, [&](const LeafVisit& leaf) {
-    const Block& k = *leaf.block;
-    const F4 bx = F4::splat(float(leaf.base_x)), by = F4::splat(float(leaf.base_y));
-    F4 acc = F4::splat(0.0f);
-    for (int h = 0; h < leaf.count; h += 4) {
-      const F4 dx = bx - F4::load(k.px + h), dy = by - F4::load(k.py + h);
-      const F4 spatial = (dx * dx + dy * dy) * inv2v;
-      const F4 ex = ((sxh - F4::load(k.nx + h)) + sxl) - a * (F4::load(k.j0 + h) * dx + F4::load(k.j1 + h) * dy);
-      const F4 ey = ((syh - F4::load(k.ny + h)) + syl) - a * (F4::load(k.j2 + h) * dx + F4::load(k.j3 + h) * dy);
-      const F4 jxx = F4::load(k.jxx + h), jyy = F4::load(k.jyy + h);
-      const F4 cxx = sr2 + b * jxx, cxy = b * F4::load(k.jxy + h), cyy = sr2 + b * jyy;
-      const F4 det = sr4 + sr2b * (jxx + jyy) + b2 * F4::load(k.jdet + h);
-      const F4 q = (cyy * ex * ex - two * cxy * ex * ey + cxx * ey * ey) / det;
-      const F4 e = spatial + half * q;
-      if (!anyLess(e, cutoff)) continue;
-      acc = acc + selectLess(e, cutoff, flakes::expNeg4(e) / sqrt(det));
+  // The same test per leaf, four leaves at a time in float, from each leaf's box of positions; the
+  // budget and variance widened against float rounding.
+  const F4 budget_cut = F4::splat(float(kMaxExponent) + 1e-3f), var_slack = F4::splat(1.0f + 1e-4f);
+  const F4 spatial_bound = F4::splat(float(t.spatial_cut) + 1e-3f);
+  const F4 bound_sr2 = F4::splat(float(sigma_r2) * (1.0f + 1e-4f));
+  auto leaves = [&](const LeafBounds& lb, const TileBound& tb, double base_x, double base_y) {
+    const F4 bx = F4::splat(float(base_x)), by = F4::splat(float(base_y));
+    uint32_t mask = 0;
+    for (int h = 0; h < kLeaves; h += 4) {
+      // u_Q - u_k over the leaf: [base - phi, base - plo] along each axis.
+      const F4 x_near = bx - F4::load(lb.phi_x + h), x_far = bx - F4::load(lb.plo_x + h);
+      const F4 y_near = by - F4::load(lb.phi_y + h), y_far = by - F4::load(lb.plo_y + h);
+      const F4 dx_min = max(max(x_near, zero - x_far), zero), dy_min = max(max(y_near, zero - y_far), zero);
+      const F4 dx_max = max(flakes::abs4(x_near), flakes::abs4(x_far));
+      const F4 dy_max = max(flakes::abs4(y_near), flakes::abs4(y_far));
+      const F4 spatial_min = (dx_min * dx_min + dy_min * dy_min) * inv2v;
+      const F4 budget = budget_cut - spatial_min;
+      const F4 jmax = F4::load(lb.jmax + h);
+      const F4 shift = jmax * a * sqrt(dx_max * dx_max + dy_max * dy_max) * var_slack;
+      const F4 var = bound_sr2 + b * jmax * jmax * var_slack;
+      // The box of the lobe means, and the distance of s from it along x, y and the diagonals
+      // (the latter times sqrt 2, from the box of m_x + m_y and m_x - m_y).
+      const F4 lo_x = F4::load(lb.lo_x + h) - shift, hi_x = F4::load(lb.hi_x + h) + shift;
+      const F4 lo_y = F4::load(lb.lo_y + h) - shift, hi_y = F4::load(lb.hi_y + h) + shift;
+      const F4 ex = max(max(lo_x - fsx, fsx - hi_x), zero);
+      const F4 ey = max(max(lo_y - fsy, fsy - hi_y), zero);
+      const F4 ep = max(max((lo_x + lo_y) - fsp, fsp - (hi_x + hi_y)), zero);
+      const F4 em = max(max((lo_x - hi_y) - fsm, fsm - (hi_x - lo_y)), zero);
+      // q = r^T C^-1 r >= (u . r)^2 / (u^T C u) for every unit u, and >= |r|^2 / lambda_max(C).
+      const F4 room = two * budget;
+      const int pass = lessEqualMask(ex * ex + ey * ey, room * var) &
+                       lessEqualMask(ex * ex, room * (bound_sr2 + b * F4::load(lb.jxx + h) * var_slack)) &
+                       lessEqualMask(ey * ey, room * (bound_sr2 + b * F4::load(lb.jyy + h) * var_slack)) &
+                       lessEqualMask(ep * ep, two * room * (bound_sr2 + b * F4::load(lb.jpp + h) * var_slack)) &
+                       lessEqualMask(em * em, two * room * (bound_sr2 + b * F4::load(lb.jmm + h) * var_slack)) &
+                       lessEqualMask(spatial_min, spatial_bound);
+      mask |= uint32_t(pass) << h;
     }
-    float lanes[4];
-    acc.store(lanes);
-    sum += (double(lanes[0]) + double(lanes[1])) + (double(lanes[2]) + double(lanes[3]));
+    return mask & (leafMask(tb.leaves));
+  };
+  // The kernel (flake_kernel.inc): s split into a float and its remainder, so that s - n_k keeps
+  // double accuracy; det C from the expansion sr^4 + sr^2 b tr(J J^T) + b^2 det(J J^T), which does
+  // not cancel for rank-1 Jacobians. The lanes kept by its first pass are evaluated and summed
+  // (in double, four running sums in a fixed order) whenever the list fills up, and at the end.
+  KernelTerms c;
+  c.sxh = float(sx);
+  c.sxl = float(sx - double(c.sxh));
+  c.syh = float(sy);
+  c.syl = float(sy - double(c.syh));
+  c.a = float(t.a);
+  c.b = float(t.b);
+  c.inv2v = float(t.inv2v);
+  c.step = float(step);
+  c.sr2 = float(sigma_r2);
+  c.sr4 = float(sigma_r2 * sigma_r2);
+  c.sr2b = float(sigma_r2 * t.b);
+  c.b2 = float(t.b * t.b);
+  c.keep_cut = float(kMaxExponent) + 0.01f;
+  c.spatial_cut = float(t.spatial_cut);
+  const bool wide = flakes::hasAvx2();
+  LaneList list;
+  int n = 0;
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  auto drain = [&] {
+    const int padded = (n + 15) & ~15;
+    for (int i = n; i < padded; ++i) {
+      list.spatial[i] = 1e30f;
+      list.num[i] = 0.0f;
+      list.det[i] = 1.0f;
+    }
+    laneValues(wide, &list, padded, float(kMaxExponent));
+    for (int i = 0; i < n; i += 4) {
+      sums[0] += double(list.spatial[i]);
+      sums[1] += double(list.spatial[i + 1]);
+      sums[2] += double(list.spatial[i + 2]);
+      sums[3] += double(list.spatial[i + 3]);
+    }
+    n = 0;
+  };
+  forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
+    n = keepLanes(wide, *leaf.block, c, float(leaf.base_x), float(leaf.base_y), &list, n);
+    if (n > kLaneList - kLeafFlakes) drain();
   });
-  return sum * t.wnorm / kTwoPi;
+  drain();
+  return ((sums[0] + sums[1]) + (sums[2] + sums[3])) * t.wnorm / kTwoPi;
+}
+
+template <typename Visit>
+void FlakeNdf::Impl::forEachWeightIn(double u, int64_t f0, int64_t f1, double c, Visit&& visit) const {
+  // With d = u - p_f: exp(-(d - step)^2 c) = exp(-d^2 c) exp((2 d step - step^2) c), and that
+  // ratio shrinks by exp(-2 step^2 c) per flake.
+  const double shrink = std::exp(-2.0 * step * step * c);
+  double g = 0.0, ratio = 0.0;
+  for (int64_t f = f0; f <= f1; ++f) {
+    if ((f - f0) % kWeightRefresh == 0) {
+      const double d = u - flakePosition(f);
+      g = std::exp(-d * d * c);
+      ratio = std::exp((2.0 * d * step - step * step) * c);
+    }
+    if (!visit(f, g)) return;
+    g *= ratio;
+    ratio *= shrink;
+  }
+}
+
+template <typename Visit>
+void FlakeNdf::Impl::forEachWeight(const FootprintTerms& t, bool along_x, Visit&& visit) const {
+  if (t.empty) return;
+  forEachWeightIn(along_x ? t.ux : t.uy, along_x ? t.x0 : t.y0, along_x ? t.x1 : t.y1, t.inv2v, visit);
+}
+
+template <typename Visit>
+void FlakeNdf::Impl::forEachDiskRow(const FootprintTerms& t, Visit&& visit) const {
+  if (t.empty) return;
+  const double r2 = 2.0 * t.spatial_cut * t.v;
+  forEachWeightIn(t.uy, t.y0, t.y1, t.inv2v, [&](int64_t fy, double gy) {
+    const double dy = t.uy - flakePosition(fy);
+    const double half_width = std::sqrt(std::max(r2 - dy * dy, 0.0));
+    int64_t x0 = int64_t(std::ceil((t.ux - half_width) * rate - 0.5));
+    int64_t x1 = int64_t(std::floor((t.ux + half_width) * rate - 0.5));
+    x0 = std::max(x0, t.x0);
+    x1 = std::min(x1, t.x1);
+    return visit(fy, gy, x0, x1);
+  });
+}
+
+double FlakeNdf::Impl::diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x1) const {
+  double s = 0.0;
+  forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t, double g) {
+    s += g;
+    return true;
+  });
+  return s;
 }
 
 // Sum of exp(-d^2 / 2v) over the window's flake positions along one axis (the footprint weights
 // are separable: their total is wnorm times the product of the two sums).
 double FlakeNdf::Impl::weightSum(const FootprintTerms& t, bool along_x) const {
-  if (t.empty) return 0.0;
-  const int64_t f0 = along_x ? t.x0 : t.y0, f1 = along_x ? t.x1 : t.y1;
-  const double u = along_x ? t.ux : t.uy;
   double s = 0.0;
-  for (int64_t f = f0; f <= f1; ++f) {
-    const double d = u - flakePosition(f);
-    s += std::exp(-d * d * t.inv2v);
-  }
+  forEachWeight(t, along_x, [&](int64_t, double g) {
+    s += g;
+    return true;
+  });
   return s;
 }
+
+namespace flakes {
+std::atomic<bool>& portableKernelsOnly() {
+  static std::atomic<bool> only{false};
+  return only;
+}
+}  // namespace flakes
+
+RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
+                                           double window_sigmas, double* value) {
+  if (!f.impl_ || !value || !validFootprint(fp) || !flakes::validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  FootprintTerms t;
+  if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  *value = flakes::inSquare(s) ? f.impl_->evalAt(t, s.x, s.y) : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas,
+                                           double* value) {
+  if (!f.impl_ || !value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
+  FootprintTerms t;
+  if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  double sum = 0.0;
+  m.forEachDiskRow(t, [&](int64_t, double gy, int64_t x0, int64_t x1) {
+    sum += gy * m.diskRowSum(t, x0, x1);
+    return true;
+  });
+  *value = t.wnorm * sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1,
+                                           double u2, double mass, flakes::Lobe* lobe, double* v1, double* v2) {
+  if (!f.impl_ || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
+  FootprintTerms t;
+  if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  // A row by its weight, then a flake of it by its own; each uniform rescaled within the chosen
+  // interval. Rounding that leaves the target past the end takes the last row with weight.
+  double target = u1 * mass / t.wnorm, row_weight = 0.0;
+  int64_t fy = 0, x0 = 0, x1 = -1;
+  bool found = false;
+  m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
+    const double w = gy * m.diskRowSum(t, a, b);
+    if (!(w > 0.0)) return true;
+    fy = y, x0 = a, x1 = b, row_weight = w;
+    if (target < w) {
+      found = true;
+      return false;
+    }
+    target -= w;
+    return true;
+  });
+  if (x1 < x0) return RuntimeStatus::kInvalidArgument;
+  if (!found) target = row_weight;
+  *v1 = std::clamp(target / row_weight, 0.0, 0.99999999999999989);
+  double rest = u2 * m.diskRowSum(t, x0, x1), g = 0.0;
+  int64_t fx = x0;
+  m.forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t x, double w) {
+    fx = x;
+    g = w;
+    if (rest < w || x == x1) return false;
+    rest -= w;
+    return true;
+  });
+  *v2 = g > 0.0 ? std::clamp(rest / g, 0.0, 0.99999999999999989) : 0.5;
+  const int64_t gx = ((fx % m.fine_w) + m.fine_w) % m.fine_w, gy = ((fy % m.fine_h) + m.fine_h) % m.fine_h;
+  const uint32_t where = m.slot.data[size_t(gy) * size_t(m.fine_w) + size_t(gx)];
+  m.lobeOf(m.blocks.data[where / kLeafFlakes], int(where % kLeafFlakes), t.ux - m.flakePosition(fx),
+           t.uy - m.flakePosition(fy), t, lobe);
+  return RuntimeStatus::kOk;
+}
+
+void usePortableFlakeKernels(bool portable) { flakes::portableKernelsOnly().store(portable); }
 
 FlakeNdf::FlakeNdf() = default;
 FlakeNdf::~FlakeNdf() = default;
@@ -482,14 +804,27 @@ RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, d
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
   if (x1 > x0 && y1 > y0) {
-    auto reach = [&](const Node& node, double dmax, double) {
-      const double shift = double(node.jmax) * t.a * dmax;
-      const double sd = std::sqrt(m.sigma_r2 + t.b * double(node.jmax) * double(node.jmax)) * 8.5;
-      return double(node.hi[0]) + shift + sd > x0 &&
-             double(node.lo[0]) - shift - sd<x1&& double(node.hi[1]) + shift + sd> y0 &&
-             double(node.lo[1]) - shift - sd < y1;
+    // A tile or leaf is visited when its lobes may put mass in the rectangle (within 8.5
+    // standard deviations of the normal box widened by the mean shift).
+    auto overlaps = [&](double lo_x, double lo_y, double hi_x, double hi_y, double jmax, double dmax) {
+      const double shift = jmax * t.a * dmax;
+      const double sd = std::sqrt(m.sigma_r2 + t.b * jmax * jmax) * 8.5;
+      return hi_x + shift + sd > x0 && lo_x - shift - sd < x1 && hi_y + shift + sd > y0 && lo_y - shift - sd < y1;
     };
-    m.forEachLeaf(t, reach, [&](const LeafVisit& leaf) {
+    auto tile = [&](const TileBound& b, double dmax, double) {
+      return overlaps(b.lo[0], b.lo[1], b.hi[0], b.hi[1], b.jmax, dmax);
+    };
+    auto leaves = [&](const LeafBounds& lb, const TileBound& tb, double base_x, double base_y) {
+      uint32_t mask = 0;
+      for (uint32_t i = 0; i < tb.leaves; ++i) {
+        const double dx = std::max(std::fabs(base_x - lb.plo_x[i]), std::fabs(base_x - lb.phi_x[i]));
+        const double dy = std::max(std::fabs(base_y - lb.plo_y[i]), std::fabs(base_y - lb.phi_y[i]));
+        if (overlaps(lb.lo_x[i], lb.lo_y[i], lb.hi_x[i], lb.hi_y[i], lb.jmax[i], std::sqrt(dx * dx + dy * dy)))
+          mask |= 1u << i;
+      }
+      return mask;
+    };
+    m.forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
       m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {
         flakes::Lobe g;
         m.lobeOf(k, i, dx, dy, t, &g);
@@ -516,8 +851,9 @@ RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, floa
   // Each lobe adds its probability over the bins, scaled to a density (divided by the bin area),
   // in the fixed order of the traversal.
   const double to_density = weight * t.wnorm / (bin * bin);
-  auto all = [](const Node&, double, double) { return true; };
-  m.forEachLeaf(t, all, [&](const LeafVisit& leaf) {
+  auto tile = [](const TileBound&, double, double) { return true; };
+  auto leaves = [](const LeafBounds&, const TileBound& tb, double, double) { return leafMask(tb.leaves); };
+  m.forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
     m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {
       flakes::Lobe g;
       m.lobeOf(k, i, dx, dy, t, &g);
@@ -538,22 +874,23 @@ RuntimeStatus FlakeNdf::sample(const Footprint& footprint, double u1, double u2,
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The footprint weights are separable: a row by its weight, then a column; each uniform is
   // rescaled within the chosen interval and reused for the lobe.
-  auto pick = [&](int64_t f0, int64_t f1, double centre, double u, double sum, double* rest) {
-    double target = u * sum;
-    int64_t f = f0;
-    double g = 0.0;
-    for (; f <= f1; ++f) {
-      const double d = centre - m.flakePosition(f);
-      g = std::exp(-d * d * t.inv2v);
-      if (target < g || f == f1) break;
-      target -= g;
-    }
+  auto pick = [&](bool along_x, double u, double sum, double* rest) {
+    double target = u * sum, g = 0.0;
+    int64_t f = along_x ? t.x0 : t.y0;
+    const int64_t last = along_x ? t.x1 : t.y1;
+    m.forEachWeight(t, along_x, [&](int64_t index, double weight) {
+      f = index;
+      g = weight;
+      if (target < weight || index == last) return false;
+      target -= weight;
+      return true;
+    });
     *rest = g > 0.0 ? std::clamp(target / g, 0.0, 0.99999999999999989) : 0.5;
     return f;
   };
   double v1, v2;
-  const int64_t fy = pick(t.y0, t.y1, t.uy, u1, sum_y, &v1);
-  const int64_t fx = pick(t.x0, t.x1, t.ux, u2, sum_x, &v2);
+  const int64_t fy = pick(false, u1, sum_y, &v1);
+  const int64_t fx = pick(true, u2, sum_x, &v2);
   const int64_t gx = ((fx % m.fine_w) + m.fine_w) % m.fine_w, gy = ((fy % m.fine_h) + m.fine_h) % m.fine_h;
   const uint32_t where = m.slot.data[size_t(gy) * size_t(m.fine_w) + size_t(gx)];
   flakes::Lobe g;

@@ -19,6 +19,7 @@ namespace glintbake::runtime::flakes {
 
 #if GLINTBAKE_FLAKES_SSE2
 struct F4 {
+  static constexpr int kWidth = 4;
   __m128 v;
   static F4 load(const float* p) { return {_mm_loadu_ps(p)}; }
   static F4 splat(float x) { return {_mm_set1_ps(x)}; }
@@ -31,6 +32,27 @@ struct F4 {
   // Lanes where a < b keep x, the others become 0.
   friend F4 selectLess(F4 a, F4 b, F4 x) { return {_mm_and_ps(_mm_cmplt_ps(a.v, b.v), x.v)}; }
   friend bool anyLess(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)) != 0; }
+  // Bit i set where lane i has a <= b (a < b).
+  friend int lessEqualMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmple_ps(a.v, b.v)); }
+  friend int lessMask(F4 a, F4 b) { return _mm_movemask_ps(_mm_cmplt_ps(a.v, b.v)); }
+  // The lanes of x whose bit is set in mask, in order, at dst[0..) (writes kWidth floats).
+  friend void compressStore(float* dst, F4 x, int mask) {
+    float l[4];
+    x.store(l);
+    int c = 0;
+    for (int i = 0; i < 4; ++i) {
+      dst[c] = l[i];
+      c += (mask >> i) & 1;
+    }
+  }
+  // Four bytes as floats.
+  static F4 fromBytes(const uint8_t* p) {
+    int32_t word;
+    std::memcpy(&word, p, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i b = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
+    return {_mm_cvtepi32_ps(b)};
+  }
   // floor for |x| < 2^31.
   friend F4 floor4(F4 x) {
     const __m128 t = _mm_cvtepi32_ps(_mm_cvttps_epi32(x.v));
@@ -44,6 +66,7 @@ struct F4 {
 };
 #else
 struct F4 {
+  static constexpr int kWidth = 4;
   float v[4];
   static F4 load(const float* p) {
     F4 r;
@@ -87,6 +110,28 @@ struct F4 {
       if (a.v[i] < b.v[i]) return true;
     return false;
   }
+  friend int lessEqualMask(F4 a, F4 b) {
+    int m = 0;
+    for (int i = 0; i < 4; ++i) m |= (a.v[i] <= b.v[i] ? 1 : 0) << i;
+    return m;
+  }
+  friend int lessMask(F4 a, F4 b) {
+    int m = 0;
+    for (int i = 0; i < 4; ++i) m |= (a.v[i] < b.v[i] ? 1 : 0) << i;
+    return m;
+  }
+  friend void compressStore(float* dst, F4 x, int mask) {
+    int c = 0;
+    for (int i = 0; i < 4; ++i) {
+      dst[c] = x.v[i];
+      c += (mask >> i) & 1;
+    }
+  }
+  static F4 fromBytes(const uint8_t* p) {
+    F4 r;
+    for (int i = 0; i < 4; ++i) r.v[i] = float(p[i]);
+    return r;
+  }
   friend F4 floor4(F4 x) {
     F4 r;
     for (int i = 0; i < 4; ++i) {
@@ -108,6 +153,29 @@ struct F4 {
   }
 };
 #endif
+
+inline F4 floorV(F4 x) { return floor4(x); }
+
+// Set bits of a lane mask (eight lanes at most).
+inline int maskCount(int m) {
+  m = (m & 0x55) + ((m >> 1) & 0x55);
+  m = (m & 0x33) + ((m >> 2) & 0x33);
+  return (m & 0x0f) + ((m >> 4) & 0x0f);
+}
+
+// |x| lane by lane.
+inline F4 abs4(F4 x) { return max(x, F4::splat(0.0f) - x); }
+
+// A hint to bring the cache line holding p closer (no effect on results).
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  __builtin_prefetch(p);
+#elif GLINTBAKE_FLAKES_SSE2
+  _mm_prefetch(static_cast<const char*>(p), _MM_HINT_T0);
+#else
+  (void)p;
+#endif
+}
 
 // e^-x for x in [0, 87] (larger x gives e^-87), relative error about 2e-7: range reduction by
 // ln 2 in two parts and a degree-6 polynomial (the classic single-precision expf coefficients).

@@ -4,8 +4,10 @@
 
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
+#include "flake_access.h"
 #include "flake_model.h"
 #include "float4.h"
+#include "float8.h"
 #include "gaussian_rect.h"
 
 #include <algorithm>
@@ -173,10 +175,58 @@ int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
   return count;
 }
 
+// The float constants of one point query shared by every lane of the kernel (lobe_kernel.inc).
+struct KernelTerms {
+  float sp2, sx, sy;
+  float spatial_cut;  // kMaxSpatial
+  float keep_cut;     // the first pass's cutoff, kMaxExponent plus a margin
+};
+
+// Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
+// room the branch-free writes and the padding to a whole vector take).
+constexpr int kLaneList = 512;
+struct LaneList {
+  alignas(64) float spatial[kLaneList + 32];
+  alignas(64) float num[kLaneList + 32];
+  alignas(64) float det_c[kLaneList + 32];
+  alignas(64) float det_ac[kLaneList + 32];
+  alignas(64) float w[kLaneList + 32];
+};
+
+namespace sse {
+using V = flakes::F4;
+#include "lobe_kernel.inc"
+}  // namespace sse
+
+#if GLINTBAKE_FLAKES_AVX2
+GLINTBAKE_FLAKES_AVX2_BEGIN
+namespace avx2 {
+using V = flakes::F8;
+#include "lobe_kernel.inc"
+}  // namespace avx2
+GLINTBAKE_FLAKES_AVX2_END
+#endif
+
+// The kernels of the processor: AVX2 where it has it (the same bits), else SSE2 or scalar.
+int keepLanes(bool wide, const Block& b, int count, const KernelTerms& c, float bx, float by, LaneList* list, int n) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::keepLanes(b, count, c, bx, by, list, n);
+#endif
+  (void)wide;
+  return sse::keepLanes(b, count, c, bx, by, list, n);
+}
+void laneValues(bool wide, LaneList* list, int n, float cutoff) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::laneValues(list, n, cutoff);
+#endif
+  (void)wide;
+  sse::laneValues(list, n, cutoff);
+}
+
 // The footprint terms of one query: centre (reduced into the map for repeating maps), sigma_p^2,
 // the answering level and the window.
 struct Terms {
-  double ux, uy, sp2;
+  double sigma, ux, uy, sp2;
   const Level* level;
   double tile_texels;
   double reach;
@@ -193,6 +243,9 @@ struct LobeNdf::Impl {
   int level_count = 0;
   Array<Block> blocks;
   Array<Bound> bounds;
+  // With every flake its own lobe on level 0 (lobes == kLanes), that level's eval is the exact
+  // flakes' with the lobes' window: answered by their evaluator, which prunes by normal.
+  FlakeNdf exact;
 
   RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in);
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
@@ -299,6 +352,10 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
       }
     }
   }
+  if (lobes == kLanes) {
+    InterleavedTexels texels(width, height, repeat, normals.data, 2);
+    if (RuntimeStatus st = exact.build(texels, rate, sigma_r, res); st != RuntimeStatus::kOk) return st;
+  }
   return RuntimeStatus::kOk;
 }
 
@@ -380,6 +437,7 @@ int LobeNdf::Impl::levelFor(double sigma) const {
 }
 
 bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
+  t->sigma = fp.sigma;
   t->sp2 = fp.sigma * fp.sigma;
   t->level = &levels[levelFor(fp.sigma)];
   t->tile_texels = t->level->tile * step;
@@ -496,11 +554,41 @@ double LobeNdf::Impl::laneWeights(const Block& b, const Bound& bound, double bx,
 }
 
 double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
-  using flakes::F4;
-  const F4 sp2 = F4::splat(float(t.sp2)), vsx = F4::splat(float(sx)), vsy = F4::splat(float(sy));
-  const F4 half = F4::splat(0.5f), two = F4::splat(2.0f), cutoff = F4::splat(float(kMaxExponent));
-  const F4 spatial_cut = F4::splat(float(kMaxSpatial)), tiny = F4::splat(1e-12f);
-  double sum = 0.0;
+  if (t.level == &levels[0] && exact.isBuilt()) {
+    double v = 0.0;
+    FlakeNdfAccess::windowedEval(exact, {t.ux, t.uy, t.sigma}, {sx, sy}, kWindowSigmas, &v);
+    return v * kWindowNorm;
+  }
+  // The kernel (lobe_kernel.inc) on the tiles whose lobes may reach s; the lanes kept by its
+  // first pass are evaluated and summed (in double, four running sums in a fixed order) whenever
+  // the list fills up, and at the end.
+  KernelTerms c;
+  c.sp2 = float(t.sp2);
+  c.sx = float(sx);
+  c.sy = float(sy);
+  c.spatial_cut = float(kMaxSpatial);
+  c.keep_cut = float(kMaxExponent) + 0.01f;
+  const bool wide = flakes::hasAvx2();
+  LaneList list;
+  int n = 0;
+  double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  auto drain = [&] {
+    const int padded = (n + 15) & ~15;
+    for (int i = n; i < padded; ++i) {
+      list.spatial[i] = 1e30f;
+      list.num[i] = 0.0f;
+      list.det_c[i] = list.det_ac[i] = 1.0f;
+      list.w[i] = 0.0f;
+    }
+    laneValues(wide, &list, padded, float(kMaxExponent));
+    for (int i = 0; i < n; i += 4) {
+      sums[0] += double(list.spatial[i]);
+      sums[1] += double(list.spatial[i + 1]);
+      sums[2] += double(list.spatial[i + 2]);
+      sums[3] += double(list.spatial[i + 3]);
+    }
+    n = 0;
+  };
   forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double spatial_min, double inv_a) {
     // The lobes' means lie within the box widened by |S_su A^-1 (u_Q - c)| and their covariance
     // below tr S_ss: skip the tile when none can reach s.
@@ -509,41 +597,19 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
     const double ex = std::max(std::max(double(bound.lo[0]) - shift - sx, sx - double(bound.hi[0]) - shift), 0.0);
     const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
     if ((ex * ex + ey * ey) > 2.0 * (kMaxExponent - spatial_min) * double(bound.ss)) return;
-    const F4 vbx = F4::splat(float(bx)), vby = F4::splat(float(by));
-    F4 acc = F4::splat(0.0f);
-    for (uint32_t h = 0; h < bound.count; h += 4) {
-      const F4 a00 = F4::load(b.uxx + h) + sp2, a01 = F4::load(b.uxy + h), a11 = F4::load(b.uyy + h) + sp2;
-      const F4 det_a = a00 * a11 - a01 * a01;
-      const F4 inv = F4::splat(1.0f) / det_a;
-      const F4 i00 = a11 * inv, i01 = (F4::splat(0.0f) - a01) * inv, i11 = a00 * inv;
-      const F4 dx = vbx - F4::load(b.cx + h), dy = vby - F4::load(b.cy + h);
-      const F4 gx = i00 * dx + i01 * dy, gy = i01 * dx + i11 * dy;
-      const F4 spatial = half * (dx * gx + dy * gy);
-      if (!anyLess(spatial, spatial_cut)) continue;
-      const F4 s00 = F4::load(b.s00 + h), s01 = F4::load(b.s01 + h), s10 = F4::load(b.s10 + h),
-               s11 = F4::load(b.s11 + h);
-      const F4 h00 = s00 * i00 + s01 * i01, h01 = s00 * i01 + s01 * i11;
-      const F4 h10 = s10 * i00 + s11 * i01, h11 = s10 * i01 + s11 * i11;
-      const F4 cxx = max(F4::load(b.sxx + h) - (h00 * s00 + h01 * s01), tiny);
-      const F4 cxy = F4::load(b.sxy + h) - (h00 * s10 + h01 * s11);
-      const F4 cyy = max(F4::load(b.syy + h) - (h10 * s10 + h11 * s11), tiny);
-      const F4 det_c = max(cxx * cyy - cxy * cxy, tiny * tiny);
-      const F4 ex4 = vsx - (F4::load(b.mx + h) + s00 * gx + s01 * gy);
-      const F4 ey4 = vsy - (F4::load(b.my + h) + s10 * gx + s11 * gy);
-      const F4 q = (cyy * ex4 * ex4 - two * cxy * ex4 * ey4 + cxx * ey4 * ey4) / det_c;
-      const F4 e = spatial + half * q;
-      if (!anyLess(e, cutoff)) continue;
-      const F4 lane = F4::load(b.w + h) * flakes::expNeg4(e) / sqrt(det_a * det_c);
-      acc = acc + selectLess(spatial, spatial_cut, selectLess(e, cutoff, lane));
-    }
-    float lanes[4];
-    acc.store(lanes);
-    sum += (double(lanes[0]) + double(lanes[1])) + (double(lanes[2]) + double(lanes[3]));
+    n = keepLanes(wide, b, int(bound.count), c, float(bx), float(by), &list, n);
+    if (n > kLaneList - kLanes) drain();
   });
-  return sum * kWindowNorm / (kTwoPi * kTwoPi);
+  drain();
+  return ((sums[0] + sums[1]) + (sums[2] + sums[3])) * kWindowNorm / (kTwoPi * kTwoPi);
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
+  if (t.level == &levels[0] && exact.isBuilt()) {
+    double m = 0.0;
+    FlakeNdfAccess::windowedMass(exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, &m);
+    return m * kWindowNorm;
+  }
   double sum = 0.0;
   float lanes[kLanes];
   forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
@@ -659,6 +725,24 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double total = m.massOf(t);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+  auto finish = [&](const flakes::Lobe& g, double v1, double v2) {
+    const double radius = std::sqrt(-2.0 * std::log1p(-v1));
+    const double z0 = radius * std::cos(kTwoPi * v2), z1 = radius * std::sin(kTwoPi * v2);
+    const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11;
+    const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
+    out->s.x = g.mx + l11 * z0;
+    out->s.y = g.my + l21 * z0 + l22 * z1;
+    out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
+    return RuntimeStatus::kOk;
+  };
+  if (t.level == &m.levels[0] && m.exact.isBuilt()) {  // a flake of the window by its weight
+    flakes::Lobe g;
+    double v1 = 0.5, v2 = 0.5;
+    if (FlakeNdfAccess::windowedPick(m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
+                                     &v1, &v2) != RuntimeStatus::kOk)
+      return RuntimeStatus::kInvalidArgument;
+    return finish(g, v1, v2);
+  }
   // A tile in proportion to its mass, then a lane of it in proportion to its weight (the sums of
   // massOf, tile by tile), u1 rescaled within the lane. Rounding that leaves the target past the
   // end takes the last lobe of the last tile with mass.
@@ -704,14 +788,7 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
     target = std::numeric_limits<double>::infinity();
     pickIn(*last_block, *last_bound, last_bx, last_by);
   }
-  const double radius = std::sqrt(-2.0 * std::log1p(-v1));
-  const double z0 = radius * std::cos(kTwoPi * u2), z1 = radius * std::sin(kTwoPi * u2);
-  const double l11 = std::sqrt(picked.cxx), l21 = picked.cxy / l11;
-  const double l22 = std::sqrt(std::max(picked.cyy - l21 * l21, 0.0));
-  out->s.x = picked.mx + l11 * z0;
-  out->s.y = picked.my + l21 * z0 + l22 * z1;
-  out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
-  return RuntimeStatus::kOk;
+  return finish(picked, v1, u2);
 }
 
 }  // namespace glintbake::runtime

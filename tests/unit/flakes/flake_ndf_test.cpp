@@ -211,6 +211,30 @@ TEST(FlakeNdf, SamplesFollowTheirPdf) {
   }
 }
 
+// The AVX2 kernels (where the processor has them) and the portable ones give the same bits.
+TEST(FlakeNdf, KernelsGiveTheSameBits) {
+  for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kScratches, bake::MapKind::kFlakes}) {
+    Fixture f(mapOf(kind, 64, 31));
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> pos(0.0, 64.0);
+    for (double sigma : {0.0, 0.6, 2.0, 5.0}) {
+      for (int trial = 0; trial < 4; ++trial) {
+        const reference::Footprint rfp{pos(rng), pos(rng), std::max(sigma, 1e-6)};
+        for (const SPoint& s : probePoints(f, rfp, rng)) {
+          const Footprint fp{rfp.x, rfp.y, sigma};
+          double wide = -1.0, portable = -2.0;
+          runtime::usePortableFlakeKernels(false);
+          ASSERT_EQ(f.ndf.eval(fp, s, &wide), RuntimeStatus::kOk);
+          runtime::usePortableFlakeKernels(true);
+          ASSERT_EQ(f.ndf.eval(fp, s, &portable), RuntimeStatus::kOk);
+          runtime::usePortableFlakeKernels(false);
+          EXPECT_EQ(wide, portable) << "sigma " << sigma;
+        }
+      }
+    }
+  }
+}
+
 TEST(FlakeNdf, RejectsBadArgumentsAndSources) {
   Fixture f(mapOf(bake::MapKind::kBeckmann, 16, 2));
   double v = 0.0;

@@ -199,6 +199,50 @@ TEST(LobeNdf, AverageIsTheMeanOfTheImageBins) {
   }
 }
 
+// Point evals (not only images) stay close to the exact flakes: on level 0 (every flake its own
+// lobe, evaluated by the exact flakes' evaluator with the 3-sigma window) and on a clustered level.
+TEST(LobeNdf, EvalStaysCloseToTheExactFlakes) {
+  for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kScratches, bake::MapKind::kFlakes}) {
+    Pair p(mapOf(kind, 128, 12), 16);
+    for (double sigma : {6.0, 12.0, 24.0}) {
+      const Footprint fp{50.7, 81.2, sigma};
+      double num = 0.0, den = 0.0;
+      for (int j = 0; j < 40; ++j) {
+        for (int i = 0; i < 40; ++i) {
+          const SPoint s{-1.0 + (i + 0.5) / 20.0, -1.0 + (j + 0.5) / 20.0};
+          if (s.x * s.x + s.y * s.y > 1.0) continue;
+          double a = 0.0, b = 0.0;
+          ASSERT_EQ(p.lobes.eval(fp, s, &a), RuntimeStatus::kOk);
+          ASSERT_EQ(p.flakes.eval(fp, s, &b), RuntimeStatus::kOk);
+          num += std::fabs(a - b);
+          den += b;
+        }
+      }
+      EXPECT_LT(num / den, sigma < 20.0 ? 0.03 : 0.4) << "kind " << int(kind) << " sigma " << sigma;
+    }
+  }
+}
+
+// The AVX2 kernels (where the processor has them) and the portable ones give the same bits.
+TEST(LobeNdf, KernelsGiveTheSameBits) {
+  Pair p(mapOf(bake::MapKind::kBeckmann, 128, 13), 16);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> pos(0.0, 128.0), any(-0.6, 0.6);
+  for (double sigma : {6.0, 14.0, 30.0}) {
+    for (int trial = 0; trial < 24; ++trial) {
+      const Footprint fp{pos(rng), pos(rng), sigma};
+      const SPoint s{any(rng), any(rng)};
+      double wide = -1.0, portable = -2.0;
+      runtime::usePortableFlakeKernels(false);
+      ASSERT_EQ(p.lobes.eval(fp, s, &wide), RuntimeStatus::kOk);
+      runtime::usePortableFlakeKernels(true);
+      ASSERT_EQ(p.lobes.eval(fp, s, &portable), RuntimeStatus::kOk);
+      runtime::usePortableFlakeKernels(false);
+      EXPECT_EQ(wide, portable) << "sigma " << sigma;
+    }
+  }
+}
+
 TEST(LobeNdf, DeterministicAndRejectsBadArguments) {
   const bake::NormalMap map = mapOf(bake::MapKind::kScratches, 64, 4);
   const auto texels = mapTexels(map);

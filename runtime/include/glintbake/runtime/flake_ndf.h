@@ -15,11 +15,17 @@
 // along each axis (a square window; the reference's disk of the same radius differs by less than
 // 1e-7 of the mass). With a repeating map every periodic image of a flake inside the window counts.
 //
-// Cost: a hierarchy bounds the flakes' normals over tiles of 16 x 16 flakes (each tile a k-d tree
-// over n with leaves of 8 flakes; every node keeps its normal box and the largest |J_k|), so a
-// point query visits only the flakes whose lobe can reach s (within 6 standard deviations). It
-// grows with sigma_p^2 times the share of flakes near s: about a microsecond at sigma_p = 1 texel
-// and tens at 16 (bench/bench_flakes.cpp). sigma_p = 0 is a point footprint.
+// Cost: the flakes are stored in tiles of 8 x 8, each split into 8 leaves of 8 flakes by a k-d
+// tree over n and |J|; every tile keeps its normal box and largest |J_k|, every leaf its normal
+// box, largest |J_k| and box of positions. A point query tests the tiles of the window, then four
+// leaves at a time, and evaluates only the leaves whose lobes can reach s (spatial plus lobe
+// exponent below 18); the leaves of a batch of tiles are prefetched together. Their flakes go
+// through a two-pass kernel (a division-free test, then exp and sqrt on the kept flakes only), in
+// AVX2 where the processor has it (chosen at run time; the same bits as the SSE2 kernel). It grows
+// with sigma_p^2 times the share of flakes near s: on 1024^2 maps about 0.6-0.9 us at
+// sigma_p = 0, 1.5-2 us at 1 texel, 7-11 us at 4 and 20-40 us at 8 (bench/bench_flakes.cpp).
+// mass() and sample() sum the separable footprint weights by a product recurrence (an exp every
+// 16 flakes), so that sampling costs little more than the eval of its pdf.
 //
 // Queries follow the NdfSource contract: eval() is the closed form inside [-1, 1]^2 and 0 outside;
 // average() its exact mean over a rectangle (numerical integration to about 1e-10 of each lobe's
@@ -44,6 +50,12 @@ namespace glintbake::runtime {
 // larger footprints return kInvalidArgument (answer them from a pyramid).
 constexpr int64_t kMaxFlakeWindow = 4096;
 
+// The kernels of FlakeNdf and LobeNdf use AVX2 where the processor has it (chosen at run time, no
+// -march flag needed; they give the same bits as the portable SSE2 or scalar kernels). true
+// restricts both to the portable kernels (tests, benchmarks); it applies to the queries that
+// start afterwards and is safe to call from any thread.
+void usePortableFlakeKernels(bool portable);
+
 class FlakeNdf final : public AccumulatingNdfSource {
  public:
   FlakeNdf();
@@ -53,7 +65,7 @@ class FlakeNdf final : public AccumulatingNdfSource {
 
   // Builds the flakes and their hierarchy from a texel source: rate flakes per texel side (1..16),
   // intrinsic roughness sigma_r in (0, 1], image resolution R (2..4096) reported by resolution()
-  // and used by image(). Memory: about 36 bytes per flake. kInvalidArgument for parameters out of
+  // and used by image(). Memory: about 35 bytes per flake. kInvalidArgument for parameters out of
   // range or a source larger than 65536 texels per side or 2^30 flakes; kOutOfMemory.
   RuntimeStatus build(const TexelSource& source, int rate, double sigma_r, int resolution);
   bool isBuilt() const;
@@ -77,6 +89,7 @@ class FlakeNdf final : public AccumulatingNdfSource {
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
+  friend struct FlakeNdfAccess;  // the runtime's clustered lobes (internal)
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
