@@ -72,9 +72,9 @@ EXPOSURE = "0.5"
 # Procedural glitter (Jakob et al. 2014): the example build's glitter asset (examples/Makefile),
 # rendered at three distances (scenes glitter_{near,mid,far}.json: the same framing, the camera,
 # plane and point light scaled by 0.1, 0.8 and 3.2) beside the smooth Beckmann BRDF of its
-# roughness. The footprint grows from 0.5 to 16 texels of its 64 x 64 texel surface (49 facets per
-# texel), that is from about 150 to 160,000 facets per pixel (over the Gaussian's effective area
-# 4 pi sigma^2).
+# roughness. At the scenes' 128 x 128 pixels the footprint grows from 0.25 to 8 texels of its
+# 64 x 64 texel surface (49 facets per texel), that is from about 40 to 40,000 facets per pixel
+# (over the Gaussian's effective area 4 pi sigma^2).
 GLITTER_ARGS = ["--procedural", "glitter", "--glitter-asset", "--particles", "200000", "--alpha", "0.2",
                 "--size", "64,64"]
 GLITTER_VIEWS = ["near", "mid", "far"]
@@ -769,7 +769,7 @@ def glitter_html(glitter):
 <p>A glitter asset (<code>ndfgen {e(glitter['bake'])}</code>, baked by {e(glitter['baked_by'])}: discrete
 stochastic microfacets, Jakob et al. 2014, no normal map) rendered through the runtime on a plane seen
 from three distances, beside the smooth Beckmann BRDF of the same roughness. Near, a pixel sees a few
-hundred facets and only some of them reflect the lights: sparkles. Far, it sees tens of thousands and
+dozen facets and only some of them reflect the lights: sparkles. Far, it sees tens of thousands and
 the glitter converges to the smooth BRDF. Sparkle contrast = standard deviation over the lit pixels of
 the ratio glitter / smooth (one colour channel, pixels above 5% of the smooth render's maximum),
 divided by its mean; the mean ratio stays near 1 (the facets carry the smooth NDF's energy).</p>
