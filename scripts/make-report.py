@@ -78,7 +78,9 @@ EXPOSURE = "0.5"
 GLITTER_ARGS = ["--procedural", "glitter", "--glitter-asset", "--particles", "200000", "--alpha", "0.2",
                 "--size", "64,64"]
 GLITTER_VIEWS = ["near", "mid", "far"]
-GLITTER_FACETS_PER_TEXEL = 200000 / (64 * 64)
+# Facets per texel of that surface, from its bake arguments.
+GLITTER_FACETS_PER_TEXEL = (int(GLITTER_ARGS[GLITTER_ARGS.index("--particles") + 1]) /
+                            math.prod(int(v) for v in GLITTER_ARGS[GLITTER_ARGS.index("--size") + 1].split(",")))
 # Wang tiles (Cohen et al. 2003): the example build's tile set cut from the scratches map (16 tiles of
 # 64 texels) on a plane far away, 32 x 32 tiles across (2048 texels), seen from straight above by a
 # distant narrow camera under one directional light, so that the half vector hardly changes over the

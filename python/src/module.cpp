@@ -145,8 +145,8 @@ class Asset {
   // One query per row of footprints (n, 3) and of args (n, width), rows of width 1 shared:
   // query(source, footprint, args row, &value) -> status. Returns (n,) with NaN where refused.
   template <typename Query>
-  py::array_t<double> batch(const DoubleArray& footprints, const DoubleArray& args, py::ssize_t width,
-                            const char* name, Query query) const {
+  py::array_t<double> batch(const DoubleArray& footprints, const DoubleArray& args, py::ssize_t width, const char* name,
+                            Query query) const {
     Rows f = rows(footprints, 3, "footprints"), a = rows(args, width, name);
     const py::ssize_t n = batchSize(f, a);
     py::array_t<double> out(n);
@@ -163,13 +163,17 @@ class Asset {
   }
 
   py::array_t<double> eval(const DoubleArray& footprints, const DoubleArray& points) const {
-    return batch(footprints, points, 2, "s", [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s,
-                                                double* v) { return src.eval(fp, rt::SPoint{s[0], s[1]}, v); });
+    return batch(footprints, points, 2, "s",
+                 [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s, double* v) {
+                   return src.eval(fp, rt::SPoint{s[0], s[1]}, v);
+                 });
   }
 
   py::array_t<double> pdf(const DoubleArray& footprints, const DoubleArray& points) const {
-    return batch(footprints, points, 2, "s", [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s,
-                                                double* v) { return src.pdf(fp, rt::SPoint{s[0], s[1]}, v); });
+    return batch(footprints, points, 2, "s",
+                 [](const rt::NdfSource& src, const rt::Footprint& fp, const double* s, double* v) {
+                   return src.pdf(fp, rt::SPoint{s[0], s[1]}, v);
+                 });
   }
 
   py::array_t<double> average(const DoubleArray& footprints, const DoubleArray& rects) const {
@@ -324,17 +328,18 @@ PYBIND11_MODULE(_glintbake, m) {
       .def_static("from_bytes", &Asset::fromBytes, py::arg("data"), "Opens an asset from its bytes")
       .def_property_readonly("kind", &Asset::kind, "Registry name of the asset kind")
       .def_property_readonly("kind_code", &Asset::kindCode, "Numeric asset kind (formats/SPEC.md)")
-      .def_property_readonly("resolution", [](const Asset& a) { return a.source().resolution(); },
-                             "Bins per side R of the NDF images")
-      .def_property_readonly("map_size",
-                             [](const Asset& a) {
-                               const rt::MapSize s = a.source().mapSize();
-                               return py::make_tuple(s.width, s.height);
-                             },
-                             "(width, height) of the source map in texels")
-      .def_property_readonly("wrap",
-                             [](const Asset& a) { return a.source().wrap() == rt::MapWrap::kRepeat ? "repeat" : "clamp"; },
-                             "How positions outside the map read it: 'repeat' or 'clamp'")
+      .def_property_readonly(
+          "resolution", [](const Asset& a) { return a.source().resolution(); }, "Bins per side R of the NDF images")
+      .def_property_readonly(
+          "map_size",
+          [](const Asset& a) {
+            const rt::MapSize s = a.source().mapSize();
+            return py::make_tuple(s.width, s.height);
+          },
+          "(width, height) of the source map in texels")
+      .def_property_readonly(
+          "wrap", [](const Asset& a) { return a.source().wrap() == rt::MapWrap::kRepeat ? "repeat" : "clamp"; },
+          "How positions outside the map read it: 'repeat' or 'clamp'")
       .def_property_readonly("footprint_range", &Asset::footprintRange,
                              "The sigma (texels) each path answers (ndf_source.h, FootprintRange)")
       .def_property_readonly("metadata_text", &Asset::metadataText, "The container's metadata JSON text")

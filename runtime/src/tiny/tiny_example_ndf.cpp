@@ -177,10 +177,10 @@ const double kIdentity[4] = {1.0, 0.0, 0.0, 1.0};
 // ---------------------------------------------------------------------------------------------
 // Tile images.
 
-RuntimeStatus tinyTileImage(const float* texels, int n, bool repeats, double sigma_r, int res, int x0, int y0,
-                            int side, float* out) {
-  if (!texels || !out || n < 1 || n > 65536 || res < 2 || res > 4096 || side < 1 || x0 < 0 || y0 < 0 ||
-      x0 + side > n || y0 + side > n || !(sigma_r > 0.0 && sigma_r <= 1.0))
+RuntimeStatus tinyTileImage(const float* texels, int n, bool repeats, double sigma_r, int res, int x0, int y0, int side,
+                            float* out) {
+  if (!texels || !out || n < 1 || n > 65536 || res < 2 || res > 4096 || side < 1 || x0 < 0 || y0 < 0 || x0 + side > n ||
+      y0 + side > n || !(sigma_r > 0.0 && sigma_r <= 1.0))
     return RuntimeStatus::kInvalidArgument;
   std::fill(out, out + size_t(res) * res, 0.0f);
   const double bin = 2.0 / res;
@@ -300,8 +300,8 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
   const size_t image = size_t(res) * res;
   for (uint32_t l = 0; l < rec.levels; ++l) {
     const uint64_t m = format::tinyTilesPerSide(rec.example_size, l);
-    if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleLevel, l, format::tinyLevelSectionSize(rec, l),
-                                    &bytes);
+    if (RuntimeStatus s =
+            readSized(reader, format::kSectionTinyExampleLevel, l, format::tinyLevelSectionSize(rec, l), &bytes);
         s != RuntimeStatus::kOk)
       return s;
     format::ImageSectionHeader h;
@@ -544,7 +544,6 @@ RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* 
 
 namespace {
 
-
 Poly transformedRect(const double b[4], double x0, double x1, double y0, double y1) {
   Poly p;
   const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
@@ -623,26 +622,26 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
   std::fill(out, out + count, 0.0f);
   const double bin = 2.0 / res;
   if (!batched(fp, [&](const Batch& batch) {
-    const Frame& f = batch.frame;
-    for (int j = 0; j < res; ++j) {
-      for (int i = 0; i < res; ++i) {
-        if (!flakes::binInDisk(i, j, res)) continue;
-        const double cx = -1.0 + (i + 0.5) * bin, cy = 1.0 - (j + 0.5) * bin;
-        double v = 0.0;
-        if (f.grid) {
-          // A signed permutation maps the bin onto one stored bin.
-          const double ex = f.b[0] * cx + f.b[1] * cy, ey = f.b[2] * cx + f.b[3] * cy;
-          const size_t at = size_t(binRow(ey, res)) * res + size_t(binColumn(ex, res));
-          for (int k = 0; k < batch.count; ++k) v += batch.images[k].weight * double(batch.images[k].image[at]);
-        } else {
-          v = polygonIntegral(transformedRect(f.b, cx - 0.5 * bin, cx + 0.5 * bin, cy - 0.5 * bin, cy + 0.5 * bin),
-                              batch.images, batch.count, res) /
-              (bin * bin);
+        const Frame& f = batch.frame;
+        for (int j = 0; j < res; ++j) {
+          for (int i = 0; i < res; ++i) {
+            if (!flakes::binInDisk(i, j, res)) continue;
+            const double cx = -1.0 + (i + 0.5) * bin, cy = 1.0 - (j + 0.5) * bin;
+            double v = 0.0;
+            if (f.grid) {
+              // A signed permutation maps the bin onto one stored bin.
+              const double ex = f.b[0] * cx + f.b[1] * cy, ey = f.b[2] * cx + f.b[3] * cy;
+              const size_t at = size_t(binRow(ey, res)) * res + size_t(binColumn(ex, res));
+              for (int k = 0; k < batch.count; ++k) v += batch.images[k].weight * double(batch.images[k].image[at]);
+            } else {
+              v = polygonIntegral(transformedRect(f.b, cx - 0.5 * bin, cx + 0.5 * bin, cy - 0.5 * bin, cy + 0.5 * bin),
+                                  batch.images, batch.count, res) /
+                  (bin * bin);
+            }
+            out[size_t(j) * res + i] += float(v);
+          }
         }
-        out[size_t(j) * res + i] += float(v);
-      }
-    }
-  }))
+      }))
     return RuntimeStatus::kInvalidArgument;
   return RuntimeStatus::kOk;
 }

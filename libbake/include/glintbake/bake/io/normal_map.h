@@ -86,10 +86,10 @@ struct NormalMap {
 // (PNG; OpenEXR none, RLE, ZIP(S), PXR24, B44(A); TIFF none, PackBits, LZW, deflate) at least
 // (decoded bytes - 64 KiB) / ratio bytes of file; for the others the last row (tiled files: the
 // last tile) is decoded first, so truncated files fail before the map is allocated. OpenEXR
-// headers are walked before OIIO opens the file: every attribute must fit in the file. Decoder messages that libraries print on
-// stderr are discarded while reading (the process-wide stderr is redirected briefly), so tools keep
-// their one-line errors. Thread-safe for distinct calls, but that redirection is process-wide.
-// `report` may be null; it is filled as far as reading got, also on failure.
+// headers are walked before OIIO opens the file: every attribute must fit in the file. Decoder messages that libraries
+// print on stderr are discarded while reading (the process-wide stderr is redirected briefly), so tools keep their
+// one-line errors. Thread-safe for distinct calls, but that redirection is process-wide. `report` may be null; it is
+// filled as far as reading got, also on failure.
 Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& options, IngestReport* report);
 
 // Builds a normal map from raw decoded channel data (for tests and generated maps): `channels` = 2,
