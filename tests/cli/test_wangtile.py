@@ -45,7 +45,8 @@ class WangTile(ToolTestCase):
         out = self.path("w.gbk")
         self.run_ok("wangtile", ex, "-o", out, "--uncompressed", *SMALL)
         region = self.path("region.exr")
-        doc = self.run_json("glintquery", "materialise", out, "--cells", "-2,3,4,4", "-o", region)
+        doc = self.run_json("glintquery", "materialise", out, "--cells", "-2,3,4,4", "-o", region,
+                            schema="glintquery-materialise.schema.json")
         self.assertEqual(doc["size"], [64, 64])
         # Cell (-2, 3) is texel (0, 0) of the region: texel (24.5, 40.5) of it is (-7.5, 88.5) on the plane.
         for s in ("0.05,0.02", "-0.1,0.04"):

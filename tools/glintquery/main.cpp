@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
                   "The P-NDF density of one footprint at one s-plane point.");
   tool.addExample("glintquery image brushed.gbk --at 64,64 --sigma 4 -o ndf.exr",
                   "The NDF image the runtime blends for that footprint.");
+  tool.addExample("glintquery materialise floor.gbk --cells 0,0,8,8 -o region.exr",
+                  "8 x 8 cells of a wang-tiles asset's grid as a normal map, for the reference evaluator.");
   CLI::App& app = tool.app();
   app.require_subcommand(1);
   app.fallthrough();
