@@ -419,8 +419,7 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
 
   // Unbounded assets answer anywhere on the plane: their footprints are not wrapped into one map.
   const bool unbounded = options.mode == NdfMode::kAsset && inputs.asset != nullptr &&
-                         (inputs.asset->kind() == format::AssetKind::kWangTiles ||
-                          inputs.asset->kind() == format::AssetKind::kTinyExample);
+                         inputs.asset->wrap() == runtime::MapWrap::kUnbounded;
 
   RenderedImage image;
   image.width = cam.width;

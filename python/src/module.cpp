@@ -338,8 +338,20 @@ PYBIND11_MODULE(_glintbake, m) {
           },
           "(width, height) of the source map in texels")
       .def_property_readonly(
-          "wrap", [](const Asset& a) { return a.source().wrap() == rt::MapWrap::kRepeat ? "repeat" : "clamp"; },
-          "How positions outside the map read it: 'repeat' or 'clamp'")
+          "wrap",
+          [](const Asset& a) {
+            switch (a.source().wrap()) {
+              case rt::MapWrap::kRepeat:
+                return "repeat";
+              case rt::MapWrap::kClamp:
+                return "clamp";
+              case rt::MapWrap::kUnbounded:
+                break;
+            }
+            return "unbounded";
+          },
+          "How positions outside the map read it: 'repeat' or 'clamp'; 'unbounded' for Wang tiles and tiny "
+          "examples, which cover the plane without a period")
       .def_property_readonly("footprint_range", &Asset::footprintRange,
                              "The sigma (texels) each path answers (ndf_source.h, FootprintRange)")
       .def_property_readonly("metadata_text", &Asset::metadataText, "The container's metadata JSON text")

@@ -153,11 +153,11 @@ TEST(TinyExample, LevelZeroTilesEqualTheReference) {
           for (int i = 0; i < res; ++i) {
             const double cx = -1.0 + (i + 0.5) * bin, cy = 1.0 - (j + 0.5) * bin;
             if (cx * cx + cy * cy > 1.0) continue;
-            ref[size_t(j) * res + i] += 0.25 *
-                                        reference::gaussianRectangleIntegral(f.n, cov, -1.0 + i * bin,
-                                                                             -1.0 + (i + 1) * bin, 1.0 - (j + 1) * bin,
-                                                                             1.0 - j * bin) /
-                                        (bin * bin);
+            ref[size_t(j) * res + i] +=
+                0.25 *
+                reference::gaussianRectangleIntegral(f.n, cov, -1.0 + i * bin, -1.0 + (i + 1) * bin,
+                                                     1.0 - (j + 1) * bin, 1.0 - j * bin) /
+                (bin * bin);
           }
         }
       }
@@ -373,6 +373,7 @@ TEST(TinyExample, ImageIsTheBinAverageAndArgumentsAreChecked) {
   p.rotate_range[0] = p.rotate_range[1] = 20.0;
   const auto asset = bakeAsset(map, 16, p, "avg");
   ASSERT_TRUE(asset);
+  EXPECT_EQ(asset->wrap(), runtime::MapWrap::kUnbounded);  // placed examples have no period
   const Footprint fp{3.0, 2.0, 5.0};
   const std::vector<double> img = imageOf(*asset, fp);
   const double bin = 2.0 / 16;
@@ -408,8 +409,8 @@ TEST(TinyExample, LayeredBrdf) {
   runtime::Fresnel coat_f;
   coat_f.kind = runtime::FresnelKind::kSchlick;
   coat_f.f0 = {0.04, 0.04, 0.04};
-  const auto base = runtime::MicrofacetBrdf::glinty(asset.get(), {3.0, 5.0, 8.0}, runtime::MicrofacetModel::kGgx, 0.3,
-                                                    none);
+  const auto base =
+      runtime::MicrofacetBrdf::glinty(asset.get(), {3.0, 5.0, 8.0}, runtime::MicrofacetModel::kGgx, 0.3, none);
   const auto coat = runtime::MicrofacetBrdf::smooth(runtime::MicrofacetModel::kGgx, 0.08, coat_f);
   const runtime::LayeredBrdf layered(base, coat, coat_f);
   const runtime::Vec3 wo = runtime::normalize({0.3, -0.2, 0.9});

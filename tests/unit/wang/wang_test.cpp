@@ -31,10 +31,10 @@
 namespace glintbake {
 namespace {
 
-constexpr int kT = 16;          // tile size of the tests
-constexpr int kRes = 32;        // NDF resolution
-constexpr uint64_t kGrid = 7;   // grid seed
-constexpr int kRegion = 4;      // cells per side of the materialised region
+constexpr int kT = 16;         // tile size of the tests
+constexpr int kRes = 32;       // NDF resolution
+constexpr uint64_t kGrid = 7;  // grid seed
+constexpr int kRegion = 4;     // cells per side of the materialised region
 
 bake::NormalMap example() {
   bake::MapParams p;
@@ -216,6 +216,8 @@ TEST(WangNdf, ImplicitGridMatchesReferenceOnMaterialisedRegionExactPath) {
   ASSERT_TRUE(src);
   const reference::FlakeSet ref = reference::buildFlakes(region(), 1);
   ASSERT_EQ(src->kind(), format::AssetKind::kWangTiles);
+  // The grid covers the plane without a period: callers must not wrap positions into one tile.
+  EXPECT_EQ(src->wrap(), runtime::MapWrap::kUnbounded);
   const runtime::WangGridTexels texels(static_cast<const runtime::WangNdf&>(*src), 0, 0, kRegion, kRegion);
   runtime::FlakeNdf grid_flakes;
   ASSERT_EQ(grid_flakes.build(texels, 1, reference::kDefaultSigmaR, kRes), runtime::RuntimeStatus::kOk);
@@ -284,14 +286,16 @@ TEST(WangNdf, ImplicitGridMatchesMaterialisedRegionPyramidPath) {
       ASSERT_EQ(src->image(f, img.data(), img.size()), runtime::RuntimeStatus::kOk);
       ASSERT_EQ(explicit_src->image(f, exp.data(), exp.size()), runtime::RuntimeStatus::kOk);
       const std::vector<double> a(img.begin(), img.end()), b(exp.begin(), exp.end());
-      const std::vector<double> r = reference::binAveragedImage(ref, {f.x, f.y, sigma}, reference::kDefaultSigmaR, kRes);
+      const std::vector<double> r =
+          reference::binAveragedImage(ref, {f.x, f.y, sigma}, reference::kDefaultSigmaR, kRes);
       worst = std::max(worst, relL1(a, b));
       worst_ref = std::max(worst_ref, std::fabs(relL1(a, r) - relL1(b, r)));
     }
   }
-  std::printf("[ measured ] implicit vs materialised region, uncompressed tiles: relative L1 %.2e; their distances "
-              "to the reference differ by at most %.2e\n",
-              worst, worst_ref);
+  std::printf(
+      "[ measured ] implicit vs materialised region, uncompressed tiles: relative L1 %.2e; their distances "
+      "to the reference differ by at most %.2e\n",
+      worst, worst_ref);
   EXPECT_LT(worst, 1e-4);
 }
 

@@ -87,7 +87,8 @@ GLINTBAKE_C_API const char* gb_kind_name(int32_t kind);
 GLINTBAKE_C_API int32_t gb_ndf_asset_metadata(const gb_ndf_asset* asset, char* buffer, size_t capacity,
                                               size_t* length);
 
-/* Source map size in texels and wrap mode (0 repeat, 1 clamp); any pointer may be NULL. */
+/* Source map size in texels and wrap mode (0 repeat, 1 clamp, 2
+ * unbounded: Wang tiles and tiny examples cover the plane without a period, pass positions as they are); any pointer may be NULL. */
 GLINTBAKE_C_API int32_t gb_ndf_asset_map(const gb_ndf_asset* asset, int32_t* width, int32_t* height, int32_t* wrap);
 
 /* The footprint std (texels) each path answers (ndf_source.h, FootprintRange): exact from the

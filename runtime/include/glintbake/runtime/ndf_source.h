@@ -54,6 +54,10 @@ struct MapSize {
 enum class MapWrap : uint32_t {
   kRepeat = 0,  // the map tiles the plane
   kClamp = 1,   // positions outside the map read its edge
+  // The source covers the whole plane without a period (Wang-tile grids, placed tiny examples):
+  // callers pass surface positions as they are and never reduce them into one map; mapSize() is
+  // then the size of one tile or example.
+  kUnbounded = 2,
 };
 
 class NdfSource {

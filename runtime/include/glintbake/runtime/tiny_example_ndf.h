@@ -106,7 +106,7 @@ class TinyExampleNdf final : public NdfSource {
   FootprintRange footprintRange() const override;
   // The example's size (the plane is unbounded).
   MapSize mapSize() const override;
-  MapWrap wrap() const override { return MapWrap::kRepeat; }
+  MapWrap wrap() const override { return MapWrap::kUnbounded; }
 
   RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;

@@ -55,7 +55,7 @@ class WangNdf final : public NdfSource {
   FootprintRange footprintRange() const override;
   // One tile's size (the surface itself is unbounded) and kRepeat.
   MapSize mapSize() const override;
-  MapWrap wrap() const override { return MapWrap::kRepeat; }
+  MapWrap wrap() const override { return MapWrap::kUnbounded; }
 
   RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
