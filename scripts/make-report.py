@@ -861,6 +861,16 @@ Images are shown on one linear scale per footprint: the reference's maximum is w
             cells = "".join(f"<td>{fmt(entry['renders'][v][mode].get('relative_mse'))}</td>" for v in views)
             parts.append(f"<tr>{head}<td class='l'>{e(MODE_TITLES[mode])}</td>{cells}</tr>\n")
     parts.append("</table>\n")
+    parts.append("""<p>Above the flakes' range a render under a point light reads the P-NDF at one half vector per
+pixel, while a pyramid level stores bin averages (bins 2/R wide in s, R = 128 here: 3.1 times the flakes'
+intrinsic roughness sigma_r = 0.005) read as constant over each bin. Scratch maps concentrate much of
+their mass on curves in s narrower than a bin, so at the far views a pixel's point value can lie far
+above or below its bin's average even where the NDF images agree closely (next table): the large
+relative MSE of the scratch maps at 24 and 64 texels is this angular resolution, not a wrong NDF.
+Baked at R = 256 and 512, the curved-scratches crop renders at 0.17 and 0.037 (24 texels) and 0.072
+and 0.005 (64 texels), at 4 and 16 times the storage (measured once; README, "Figures").
+Area and environment lights integrate the NDF over s, where bin averages are what counts.</p>
+""")
     # Summary: NDF L1 per sigma.
     parts.append("<h2 id='summary-ndf'>NDF relative L1 against the reference</h2>\n<table>\n"
                  "<tr><th class='l'>map</th><th class='l'>asset</th>")
