@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Entry points of the tensor-ndf packer: option checks, packing while the pyramid is built from a
 // normal map, and packing an ndf-pyramid container chunk by chunk.
+#include <glintbake/bake/tensor/tensor_assembly.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 
@@ -84,9 +85,36 @@ BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPack
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
   return inArena(options.threads, [&]() -> BakeStatus {
-    detail::TensorPackSink sink(writer, options, rep, cancel);
+    TensorAssembler assembler(writer, options, rep);
+    detail::TensorPackSink sink(assembler, options, rep, cancel, &writer);
     const auto t_build = Clock::now();
     if (BakeStatus s = build(sink, rep.pyramid); !s) return s;
+    rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
+    if (BakeStatus s = sink.finish(); !s) return s;
+    if (BakeStatus s = assembler.finish(); !s) return s;
+    rep.total_seconds = secondsSince(t0);
+    return okStatus();
+  });
+}
+
+// The same into any consumer (a shard's recorder); the consumer is not finished.
+BakeStatus packIntoConsumer(const NormalMap& map, const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
+                            TensorRegionConsumer& consumer, TensorPackReport* report,
+                            const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
+  const auto t0 = Clock::now();
+  if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
+  if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
+  if (pyramid.splat.ndf_res % options.block != 0) {
+    return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options.block) + " must divide --ndf-res " +
+                                                  std::to_string(pyramid.splat.ndf_res));
+  }
+  TensorPackReport local;
+  TensorPackReport& rep = report ? *report : local;
+  rep = TensorPackReport{};
+  return inArena(options.threads, [&]() -> BakeStatus {
+    detail::TensorPackSink sink(consumer, options, rep, cancel);
+    const auto t_build = Clock::now();
+    if (BakeStatus s = ndf::buildNdfPyramid(map, pyramid, sink, &rep.pyramid, progress, cancel); !s) return s;
     rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
     if (BakeStatus s = sink.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
@@ -103,6 +131,13 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
                           [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
                             return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
                           });
+}
+
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, TensorRegionConsumer& consumer,
+                                TensorPackReport* report, const ndf::PyramidProgress& progress,
+                                const std::atomic<bool>* cancel) {
+  return packIntoConsumer(map, pyramid, options, consumer, report, progress, cancel);
 }
 
 BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
@@ -126,7 +161,8 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
   return inArena(options.threads, [&]() -> BakeStatus {
-    detail::TensorPackSink sink(writer, options, rep, cancel);
+    TensorAssembler assembler(writer, options, rep);
+    detail::TensorPackSink sink(assembler, options, rep, cancel, &writer);
     std::vector<uint8_t> bytes;
     std::vector<float> chunk_buffer;
     format::NdfLevelRecord below;
@@ -200,6 +236,7 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
     }
     if (level == 0) return invalid("the container has no ndf-level sections");
     if (BakeStatus s = sink.finish(); !s) return s;
+    if (BakeStatus s = assembler.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
     rep.ndf_seconds = rep.total_seconds - sink.secondsInside();
     return okStatus();

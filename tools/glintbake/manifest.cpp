@@ -27,7 +27,7 @@ Error malformed(const std::string& where, const std::string& what) {
 
 // Tools the manifest may name, and the ones that take --shard.
 const std::set<std::string> kTools = {"ndfgen", "tensorpack", "mapgen", "ltcfit", "wangtile", "tinyexample"};
-const std::set<std::string> kShardedTools = {"ndfgen"};
+const std::set<std::string> kShardedTools = {"ndfgen", "tensorpack", "wangtile"};
 // Options glintbake sets itself.
 const std::set<std::string> kReserved = {"o", "output", "shard", "json", "quiet", "depfile", "j", "threads"};
 
