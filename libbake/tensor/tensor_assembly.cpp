@@ -69,9 +69,9 @@ BakeStatus TensorAssembler::level(const format::NdfLevelRecord& record) {
   next_region_ = 0;
   level_bytes_before_ = writer_.bytesWritten();
   try {
-    index_.assign(size_t(record.grid_width) * size_t(record.grid_height) * size_t(blocks_per_side_) *
-                      size_t(blocks_per_side_),
-                  format::TensorIndexEntry{});
+    index_.assign(
+        size_t(record.grid_width) * size_t(record.grid_height) * size_t(blocks_per_side_) * size_t(blocks_per_side_),
+        format::TensorIndexEntry{});
     level_sum_.assign(size_t(res) * size_t(res), 0.0);
   } catch (const std::bad_alloc&) {
     return makeError(ErrorCode::kRuntime, "out of memory allocating the index of level " + std::to_string(level_));

@@ -67,9 +67,9 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
     return makeError(ErrorCode::kIo, path + ": " + writer.errorString(st));
   WangTileNdfReport local;
   WangTileNdfReport& rep = report ? *report : local;
-  const BakeStatus s = o.uncompressed ? ndf::buildNdfPyramid(source, o.pyramid, writer, &rep.pyramid, {}, cancel)
-                                      : tensor::packTensorNdfFromSource(source, o.pyramid, o.pack, writer, &rep.pack,
-                                                                        {}, cancel);
+  const BakeStatus s = o.uncompressed
+                           ? ndf::buildNdfPyramid(source, o.pyramid, writer, &rep.pyramid, {}, cancel)
+                           : tensor::packTensorNdfFromSource(source, o.pyramid, o.pack, writer, &rep.pack, {}, cancel);
   if (!s) return s;
   if (format::ContainerStatus st = writer.addMetadata(metadata_json); st != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, path + ": " + writer.errorString(st));
@@ -78,8 +78,8 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
   return readAndRemove(path, bytes);
 }
 
-format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, uint64_t grid_seed,
-                              double flakes_up_to, double pyramid_from, double max_sigma) {
+format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, uint64_t grid_seed, double flakes_up_to,
+                              double pyramid_from, double max_sigma) {
   format::WangRecord rec;
   rec.colors = uint32_t(set.colors);
   rec.tile_count = uint32_t(set.tile_count);

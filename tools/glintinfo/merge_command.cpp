@@ -181,8 +181,9 @@ int mergeReplayed(cli::Tool& t, const MergeOptions& options, const std::vector<P
   bake::tensor::TensorPackReport report;
   bake::tensor::TensorAssembler assembler(out.writer(), pack, report);
   auto check = [&](bake::BakeStatus s, const std::string& where) {
-    if (!s) throw Error(s.error().code == bake::ErrorCode::kIo ? cli::kExitIo : cli::kExitInvalidInput,
-                        where + ": " + s.error().message);
+    if (!s)
+      throw Error(s.error().code == bake::ErrorCode::kIo ? cli::kExitIo : cli::kExitInvalidInput,
+                  where + ": " + s.error().message);
   };
   uint64_t unit = 0;
   for (const format::NdfLevelRecord& rec : levels) {

@@ -4,8 +4,8 @@
 // angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md
 // section 10.4).
 #include <glintbake/bake/glitter/glitter.h>
-#include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/ndf/flakes_section.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/bake/tensor/tensor_shard.h>
 #include <glintbake/cli/container_output.h>
@@ -14,8 +14,8 @@
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
-#include <glintbake/cli/stdin_input.h>
 #include <glintbake/cli/shard_output.h>
+#include <glintbake/cli/stdin_input.h>
 #include <glintbake/cli/tensor_asset.h>
 #include <glintbake/cli/tensor_options.h>
 #include <glintbake/cli/tool.h>
@@ -294,8 +294,7 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
 // the container into place.
 cli::TensorAssetResult writeAsset(const Options& o, const Input& in, const tensor::TensorPackReport& report,
                                   std::vector<uint8_t>& flakes, const Json& metadata, cli::ContainerOutput& out) {
-  cli::TensorAssetResult done =
-      cli::finishTensorAsset(out.writer(), report, &flakes, metadata, assetEnd(o, in));
+  cli::TensorAssetResult done = cli::finishTensorAsset(out.writer(), report, &flakes, metadata, assetEnd(o, in));
   out.finish(done.metadata);
   return done;
 }
@@ -303,7 +302,7 @@ cli::TensorAssetResult writeAsset(const Options& o, const Input& in, const tenso
 // tensorpack --shard I/N: the regions (and maybe the flakes) the plan gives this shard, their
 // results recorded for the merge to replay (bake/tensor/tensor_shard.h).
 cli::ExitCode bakeShard(cli::Tool& t, const Options& o, Input& in, const Json& metadata,
-              std::chrono::steady_clock::time_point t0) {
+                        std::chrono::steady_clock::time_point t0) {
   const cli::ShardCliOptions& shard = o.shard;
   const cli::PyramidShardPlan plan(in.map, o.pyramid.options, o.pyramid.flakes, shard.spec.count);
   bake::ndf::PyramidOptions opt = o.pyramid.options;

@@ -227,8 +227,8 @@ int main(int argc, char** argv) {
 
     // One unit per tile (equal cost), dealt out as libbake/shard/shard.h does.
     std::vector<int> owners(size_t(set.tile_count), 0);
-    if (o.shard.active()) owners = bake::shard::assignShards(std::vector<double>(size_t(set.tile_count), 1.0),
-                                                               o.shard.spec.count);
+    if (o.shard.active())
+      owners = bake::shard::assignShards(std::vector<double>(size_t(set.tile_count), 1.0), o.shard.spec.count);
     const int me = o.shard.active() ? o.shard.spec.index : 0;
     std::vector<std::vector<uint8_t>> tile_bytes(size_t(set.tile_count));
     TileTotals totals;
@@ -245,7 +245,8 @@ int main(int argc, char** argv) {
             wang::bakeWangTileNdf(set, i, nopt, path, tile_meta_text, &tile_bytes[size_t(i)], &rep);
         std::remove(path.c_str());
         cli::unregisterTemporary(path);
-        if (!s) throw Error(cli::exitCodeOf(s.error()), o.input + ": tile " + std::to_string(i) + ": " + s.error().message);
+        if (!s)
+          throw Error(cli::exitCodeOf(s.error()), o.input + ": tile " + std::to_string(i) + ": " + s.error().message);
         addTile(totals, rep, tile_bytes[size_t(i)].size(), o.uncompressed);
         if (totals.levels != o.pyramid.options.levels)
           throw Error(cli::kExitRuntime, o.input + ": tile " + std::to_string(i) + " has " +

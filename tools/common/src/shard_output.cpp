@@ -104,8 +104,8 @@ void ShardOutput::addUnit(uint64_t unit, const void* data, size_t size) {
   out_.addSection(format::kSectionShardUnit, unit, data, size);
 }
 
-void ShardOutput::finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units,
-                         uint64_t units_total, const Json& assembly) {
+void ShardOutput::finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units, uint64_t units_total,
+                         const Json& assembly) {
   const std::string text = asset_metadata.dump();
   out_.addSection(format::kSectionShardMetadata, 0, text.data(), text.size());
   Json params = asset_metadata.value("parameters", Json::object());

@@ -85,7 +85,7 @@ namespace {
 void checkMaxError(const tensor::TensorPackReport& r, const GatedError& g, double max_error, const std::string& input) {
   if (max_error < 0.0 || !(g.error > max_error)) return;
   throw Error(kExitRuntime, input + ": " + achievedText(r, g) + " exceeds --max-error " + errorText(max_error) +
-                                     "; no output written");
+                                "; no output written");
 }
 
 // One warning when the gated error misses --error-target (when given) or the default bound.
@@ -194,7 +194,8 @@ void readTensorShardAssembly(const Json& a, tensor::TensorPackOptions* pack, Ten
   } catch (const Json::exception&) {
     throw Error(kExitInvalidInput, "assembly fields of the wrong type");
   }
-  if (pack->block < 1 || pack->block > int(format::kTensorMaxBlockBins) || (pack->precision != 0 && pack->precision != 1) ||
+  if (pack->block < 1 || pack->block > int(format::kTensorMaxBlockBins) ||
+      (pack->precision != 0 && pack->precision != 1) ||
       !(pack->blank_threshold >= 0.0 && pack->blank_threshold <= 1.0) || end->lobes_per_tile < 0 ||
       end->lobes_per_tile > bake::ndf::kMaxLobesPerTile || end->rank < 1)
     throw Error(kExitInvalidInput, "assembly fields out of range");

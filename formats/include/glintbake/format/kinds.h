@@ -57,7 +57,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, "wangtile"},
     {AssetKind::kTinyExample, "tiny-example", 112, 127, "tinyexample"},
     {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
-    {AssetKind::kPartial, "partial", 144, 159, "ndfgen, tensorpack --shard"},
+    {AssetKind::kPartial, "partial", 144, 159, "ndfgen, tensorpack, wangtile --shard"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
 

@@ -72,7 +72,7 @@ struct TensorShardGroupRecord {
   uint32_t rank = 0, blocks = 0;
   uint32_t codec = 0, reserved = 0;
   uint64_t raw_size = 0, stored_size = 0;
-  double error_squared = 0.0, norm_squared = 0.0;  // |T - stored model|_F^2, |T|_F^2
+  double error_squared = 0.0, norm_squared = 0.0;   // |T - stored model|_F^2, |T|_F^2
   double negative_mass = 0.0, absolute_mass = 0.0;  // sums of max(0, -model) and |model|
 };
 static_assert(sizeof(TensorShardGroupRecord) == 64, "TensorShardGroupRecord is 64 bytes");

@@ -25,11 +25,11 @@ struct GatedError {
 
 // What the end of the bake needs besides the packer's report.
 struct TensorAssetEnd {
-  int lobes_per_tile = 0;     // of the clustered lobes (0: none)
-  double max_error = -1.0;    // --max-error (< 0: no gate)
-  double error_target = -1.0; // --error-target (< 0: unset)
-  int rank = 16;              // --rank, for the warnings
-  std::string label;          // names the input in messages
+  int lobes_per_tile = 0;      // of the clustered lobes (0: none)
+  double max_error = -1.0;     // --max-error (< 0: no gate)
+  double error_target = -1.0;  // --error-target (< 0: unset)
+  int rank = 16;               // --rank, for the warnings
+  std::string label;           // names the input in messages
 };
 
 struct TensorAssetResult {
