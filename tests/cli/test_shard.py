@@ -139,6 +139,14 @@ class Shards(ToolTestCase):
             self.run_ok("tensorpack", src, "-o", local, *PACK, *extra)
             parts = self.bake_shards("tensorpack", [src], 3, f"v{k}", *PACK, *extra)
             self.merge_matches(parts, local, " ".join(extra))
+        # The shard's --json summary, and the merge's.
+        part = self.path("j.part.gbk")
+        doc = self.run_json("tensorpack", flat, "-o", part, "--shard", "0/1", *PACK, schema="shard.schema.json")
+        self.assertEqual(doc["shard"], {"index": 0, "count": 1})
+        self.assertEqual(doc["units"], doc["units_total"])
+        doc = self.run_json("glintinfo", "merge", part, "-o", self.path("j.gbk"), schema="glintinfo-merge.schema.json")
+        self.assertEqual(doc["asset_kind"], "tensor-ndf")
+        self.assertEqual(doc["file_bytes"], os.path.getsize(self.path("j.gbk")))
 
     def test_tensorpack_max_error_gate_applies_at_the_merge(self):
         m = self.mapgen("flakes", "g.png", "--size", "32", "--seed", "6")
@@ -185,6 +193,9 @@ class Shards(ToolTestCase):
         self.run_ok("wangtile", ex, "-o", local, "--uncompressed", *WANG)
         parts = self.bake_shards("wangtile", [ex], 3, "u", "--uncompressed", *WANG)
         self.merge_matches(parts, local, "uncompressed")
+        doc = self.run_json("wangtile", ex, "-o", self.path("w.part.gbk"), "--shard", "2/3", "--uncompressed", *WANG,
+                            schema="shard.schema.json")
+        self.assertEqual(doc["units_total"], 16)
         out = self.path("x.part.gbk")
         self.assert_fails(1, "wangtile", ex, "-o", out, "--shard", "0/2", "--atlas", self.path("a.exr"), *WANG,
                           outputs=[out])

@@ -317,11 +317,14 @@ cli::ExitCode bakeShard(cli::Tool& t, const Options& o, Input& in, const Json& m
   progress.finish();
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
   cli::check(recorder.finish());
-  uint64_t units = recorder.regionsHeld();
+  // Units the plan gives this shard (as ndfgen counts them: those of levels the bake stopped
+  // before included); sections_held counts the units recorded.
+  const uint64_t units = plan.unitsOf(shard.spec.index);
+  uint64_t held = recorder.regionsHeld();
   if (o.pyramid.flakes && plan.flakesOwner() == shard.spec.index) {
     const std::vector<uint8_t> flakes = mapFlakes(o, in.map);
     out.addUnit(uint64_t(plan.flakesUnit()), flakes.data(), flakes.size());
-    ++units;
+    ++held;
   }
   const cli::TensorAssetEnd end = assetEnd(o, in);
   Json assembly = cli::tensorShardAssembly(o.pack, end, o.pyramid.flakes);
@@ -338,7 +341,7 @@ cli::ExitCode bakeShard(cli::Tool& t, const Options& o, Input& in, const Json& m
     double total = 0.0;
     for (int i = 0; i < shard.spec.count; ++i) total += plan.costOf(i);
     doc["estimated_cost_share"] = total > 0.0 ? plan.costOf(shard.spec.index) / total : 0.0;
-    doc["sections_held"] = units;
+    doc["sections_held"] = held;
     doc["positions"] = 0;
     doc["file_bytes"] = out.bytesWritten();
     doc["seconds"] = seconds;
