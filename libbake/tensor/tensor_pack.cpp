@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 #include <string>
 
 namespace glintbake::bake::tensor {
@@ -69,11 +70,13 @@ BakeStatus validateTensorPackOptions(const TensorPackOptions& o) {
 
 namespace {
 
-// The pyramid of a map or of a procedural source, compressed region by region as it is built.
+// The pyramid of a map or of a procedural source, compressed region by region as it is built,
+// into `consumer` (a shard's recorder; not finished here), or, when it is null, into the asset's
+// assembler over `writer`.
 template <typename Build>
 BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
-                            format::Writer& writer, TensorPackReport* report, const std::atomic<bool>* cancel,
-                            const Build& build) {
+                            format::Writer* writer, TensorRegionConsumer* consumer, TensorPackReport* report,
+                            const std::atomic<bool>* cancel, const Build& build) {
   const auto t0 = Clock::now();
   if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
   if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
@@ -85,38 +88,16 @@ BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPack
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
   return inArena(options.threads, [&]() -> BakeStatus {
-    TensorAssembler assembler(writer, options, rep);
-    detail::TensorPackSink sink(assembler, options, rep, cancel, &writer);
+    std::optional<TensorAssembler> assembler;
+    if (!consumer) consumer = &assembler.emplace(*writer, options, rep);
+    detail::TensorPackSink sink(*consumer, options, rep, cancel, writer);
     const auto t_build = Clock::now();
     if (BakeStatus s = build(sink, rep.pyramid); !s) return s;
     rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
     if (BakeStatus s = sink.finish(); !s) return s;
-    if (BakeStatus s = assembler.finish(); !s) return s;
-    rep.total_seconds = secondsSince(t0);
-    return okStatus();
-  });
-}
-
-// The same into any consumer (a shard's recorder); the consumer is not finished.
-BakeStatus packIntoConsumer(const NormalMap& map, const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
-                            TensorRegionConsumer& consumer, TensorPackReport* report,
-                            const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  const auto t0 = Clock::now();
-  if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
-  if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
-  if (pyramid.splat.ndf_res % options.block != 0) {
-    return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options.block) + " must divide --ndf-res " +
-                                                  std::to_string(pyramid.splat.ndf_res));
-  }
-  TensorPackReport local;
-  TensorPackReport& rep = report ? *report : local;
-  rep = TensorPackReport{};
-  return inArena(options.threads, [&]() -> BakeStatus {
-    detail::TensorPackSink sink(consumer, options, rep, cancel);
-    const auto t_build = Clock::now();
-    if (BakeStatus s = ndf::buildNdfPyramid(map, pyramid, sink, &rep.pyramid, progress, cancel); !s) return s;
-    rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
-    if (BakeStatus s = sink.finish(); !s) return s;
+    if (assembler) {
+      if (BakeStatus s = assembler->finish(); !s) return s;
+    }
     rep.total_seconds = secondsSince(t0);
     return okStatus();
   });
@@ -127,7 +108,7 @@ BakeStatus packIntoConsumer(const NormalMap& map, const ndf::PyramidOptions& pyr
 BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
                                 const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                 const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+  return packBuiltPyramid(pyramid, options, &writer, nullptr, report, cancel,
                           [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
                             return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
                           });
@@ -137,13 +118,16 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
                                 const TensorPackOptions& options, TensorRegionConsumer& consumer,
                                 TensorPackReport* report, const ndf::PyramidProgress& progress,
                                 const std::atomic<bool>* cancel) {
-  return packIntoConsumer(map, pyramid, options, consumer, report, progress, cancel);
+  return packBuiltPyramid(pyramid, options, nullptr, &consumer, report, cancel,
+                          [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
+                            return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
+                          });
 }
 
 BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
                                    const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                    const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+  return packBuiltPyramid(pyramid, options, &writer, nullptr, report, cancel,
                           [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
                             return ndf::buildNdfPyramid(source, pyramid, sink, &built, progress, cancel);
                           });

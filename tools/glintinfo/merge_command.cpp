@@ -108,6 +108,26 @@ format::ShardSectionHeader readHeader(const Part& p, size_t i) {
   return h;
 }
 
+// The merge's one-line summary, or its --json.
+void printSummary(cli::Tool& t, const std::string& output, format::AssetKind kind, int shards, uint64_t sections,
+                  uint64_t bytes, double seconds) {
+  if (t.common().json) {
+    Json doc;
+    doc["command"] = "merge";
+    doc["output"] = cli::baseName(output);
+    doc["asset_kind"] = format::assetKindString(kind);
+    doc["shards"] = shards;
+    doc["sections"] = sections;
+    doc["file_bytes"] = bytes;
+    doc["seconds"] = seconds;
+    t.printJson(doc);
+  } else {
+    t.info("wrote " + output + ": " + std::string(format::assetKindString(kind)) + " merged from " +
+           std::to_string(shards) + " shards, " + std::to_string(sections) + " sections, " + std::to_string(bytes) +
+           " bytes");
+  }
+}
+
 // The level records every part holds (shard-levels), identical in all of them.
 std::vector<format::NdfLevelRecord> readLevels(const std::vector<Part>& parts) {
   std::vector<uint8_t> first;
@@ -218,21 +238,7 @@ int mergeReplayed(cli::Tool& t, const MergeOptions& options, const std::vector<P
   // Levels and indexes, groups, the info record, the flakes and the metadata.
   const uint64_t sections = 2 * report.levels.size() + report.groups + 1 + (done.flake_bytes > 0 ? 1 : 0) + 1;
   const int shards = first.asset["shards"].get<int>();
-  if (t.common().json) {
-    Json doc;
-    doc["command"] = "merge";
-    doc["output"] = cli::baseName(options.output);
-    doc["asset_kind"] = format::assetKindString(kind);
-    doc["shards"] = shards;
-    doc["sections"] = sections;
-    doc["file_bytes"] = out.bytesWritten();
-    doc["seconds"] = seconds;
-    t.printJson(doc);
-  } else {
-    t.info("wrote " + options.output + ": " + std::string(format::assetKindString(kind)) + " merged from " +
-           std::to_string(shards) + " shards, " + std::to_string(sections) + " sections, " +
-           std::to_string(out.bytesWritten()) + " bytes");
-  }
+  printSummary(t, options.output, kind, shards, sections, out.bytesWritten(), seconds);
   return cli::kExitOk;
 }
 
@@ -331,21 +337,7 @@ int runMerge(cli::Tool& t, const MergeOptions& options) {
   }
   out.finishText(first.asset_metadata);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (t.common().json) {
-    Json doc;
-    doc["command"] = "merge";
-    doc["output"] = cli::baseName(options.output);
-    doc["asset_kind"] = format::assetKindString(kind);
-    doc["shards"] = shards;
-    doc["sections"] = positions + 1;
-    doc["file_bytes"] = out.bytesWritten();
-    doc["seconds"] = seconds;
-    t.printJson(doc);
-  } else {
-    t.info("wrote " + options.output + ": " + std::string(format::assetKindString(kind)) + " merged from " +
-           std::to_string(shards) + " shards, " + std::to_string(positions + 1) + " sections, " +
-           std::to_string(out.bytesWritten()) + " bytes");
-  }
+  printSummary(t, options.output, kind, shards, positions + 1, out.bytesWritten(), seconds);
   return cli::kExitOk;
 }
 
