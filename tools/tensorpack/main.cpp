@@ -104,7 +104,8 @@ void addOptions(CLI::App& app, Options& o) {
   cli::addTensorPackOptions(app, o.tensor);
   app.add_option("--max-error", o.max_error,
                  "Fail (exit 4, no output) when the relative error of the pyramid or of any group exceeds this "
-                 "(>= 0; unset: no gate). Without --error-target, errors above 0.5 warn");
+                 "(>= 0; unset: no gate; with --shard, glintinfo merge applies it). Without --error-target, errors "
+                 "above 0.5 warn");
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
   cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
   cli::addIngestOptions(app, o.ingest);
