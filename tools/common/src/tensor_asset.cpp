@@ -139,19 +139,37 @@ TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::Tensor
     out.flake_bytes = flakes->size();
   }
 
-  out.metadata = metadata;
-  Json& asset = out.metadata["asset"];
-  asset["ndf_res"] = report.ndf_res;
-  asset["blocks_per_side"] = report.blocks_per_side;
-  asset["levels"] = Json::array();
+  // The results, merged into the template's `asset` in the order the fields have always had (the
+  // metadata is an ordered object: its text, and so the file, depends on the order).
+  Json results = Json::object();
+  results["ndf_res"] = report.ndf_res;
+  results["blocks_per_side"] = report.blocks_per_side;
+  results["levels"] = Json::array();
   for (const auto& l : report.levels) {
-    asset["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
+    results["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
   }
-  asset["groups"] = report.groups;
-  asset["max_rank"] = report.max_rank;
-  asset["rank_histogram"] = rankHistogramJson(report);
-  if (out.flake_bytes > 0) asset["flakes"] = flakesJson(out.handover, out.flake_bytes);
-  asset["relative_error"] = report.relative_error;
+  results["groups"] = report.groups;
+  results["max_rank"] = report.max_rank;
+  results["rank_histogram"] = rankHistogramJson(report);
+  if (out.flake_bytes > 0) results["flakes"] = flakesJson(out.handover, out.flake_bytes);
+  results["relative_error"] = report.relative_error;
+  static const char* const kOrder[] = {"ndf_res", "block",           "blocks_per_side", "levels",
+                                       "groups",  "max_rank",        "rank_histogram",  "precision",
+                                       "nonneg",  "blank_threshold", "flakes",          "relative_error"};
+  const Json& given = metadata.contains("asset") ? metadata["asset"] : Json::object();
+  Json asset = Json::object();
+  for (const char* key : kOrder) {
+    if (results.contains(key)) {
+      asset[key] = results[key];
+    } else if (given.contains(key)) {
+      asset[key] = given[key];
+    }
+  }
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    if (!asset.contains(it.key())) asset[it.key()] = it.value();
+  }
+  out.metadata = metadata;
+  out.metadata["asset"] = asset;
   return out;
 }
 
