@@ -90,6 +90,20 @@ Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, 
   return section;
 }
 
+BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover& handover) {
+  format::FlakesRecord rec;
+  if (section.size() < sizeof(rec)) return makeError(ErrorCode::kInvalidInput, "the flakes section is truncated");
+  std::memcpy(&rec, section.data(), sizeof(rec));
+  rec.version = format::FlakesRecord().version;
+  rec.flakes_up_to = handover.flakes_up_to;
+  rec.pyramid_from = handover.pyramid_from;
+  rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
+  rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
+  if (const char* why = format::checkFlakesRecord(rec, section.size())) return makeError(ErrorCode::kInvalidInput, why);
+  std::memcpy(section.data(), &rec, sizeof(rec));
+  return okStatus();
+}
+
 BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
                               const FlakesHandover& handover, uint64_t* bytes) {
   Result<std::vector<uint8_t>> section = flakesSectionBytes(map, rate, sigma_r, handover);

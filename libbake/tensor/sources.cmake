@@ -10,4 +10,6 @@ list(APPEND GLINTBAKE_BAKE_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/synthetic_groups.cpp
   ${CMAKE_CURRENT_LIST_DIR}/tensor_pack_encode.cpp
   ${CMAKE_CURRENT_LIST_DIR}/tensor_pack_sink.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/tensor_assembly.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/tensor_shard.cpp
   ${CMAKE_CURRENT_LIST_DIR}/tensor_pack.cpp)

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Entry points of the tensor-ndf packer: option checks, packing while the pyramid is built from a
 // normal map, and packing an ndf-pyramid container chunk by chunk.
+#include <glintbake/bake/tensor/tensor_assembly.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
 
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 #include <string>
 
 namespace glintbake::bake::tensor {
@@ -68,11 +70,13 @@ BakeStatus validateTensorPackOptions(const TensorPackOptions& o) {
 
 namespace {
 
-// The pyramid of a map or of a procedural source, compressed region by region as it is built.
+// The pyramid of a map or of a procedural source, compressed region by region as it is built,
+// into `consumer` (a shard's recorder; not finished here), or, when it is null, into the asset's
+// assembler over `writer`.
 template <typename Build>
 BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPackOptions& options,
-                            format::Writer& writer, TensorPackReport* report, const std::atomic<bool>* cancel,
-                            const Build& build) {
+                            format::Writer* writer, TensorRegionConsumer* consumer, TensorPackReport* report,
+                            const std::atomic<bool>* cancel, const Build& build) {
   const auto t0 = Clock::now();
   if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
   if (BakeStatus s = ndf::validatePyramidOptions(pyramid); !s) return s;
@@ -84,11 +88,16 @@ BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPack
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
   return inArena(options.threads, [&]() -> BakeStatus {
-    detail::TensorPackSink sink(writer, options, rep, cancel);
+    std::optional<TensorAssembler> assembler;
+    if (!consumer) consumer = &assembler.emplace(*writer, options, rep);
+    detail::TensorPackSink sink(*consumer, options, rep, cancel, writer);
     const auto t_build = Clock::now();
     if (BakeStatus s = build(sink, rep.pyramid); !s) return s;
     rep.ndf_seconds = secondsSince(t_build) - sink.secondsInside();
     if (BakeStatus s = sink.finish(); !s) return s;
+    if (assembler) {
+      if (BakeStatus s = assembler->finish(); !s) return s;
+    }
     rep.total_seconds = secondsSince(t0);
     return okStatus();
   });
@@ -99,7 +108,17 @@ BakeStatus packBuiltPyramid(const ndf::PyramidOptions& pyramid, const TensorPack
 BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
                                 const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                 const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+  return packBuiltPyramid(pyramid, options, &writer, nullptr, report, cancel,
+                          [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
+                            return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
+                          });
+}
+
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, TensorRegionConsumer& consumer,
+                                TensorPackReport* report, const ndf::PyramidProgress& progress,
+                                const std::atomic<bool>* cancel) {
+  return packBuiltPyramid(pyramid, options, nullptr, &consumer, report, cancel,
                           [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
                             return ndf::buildNdfPyramid(map, pyramid, sink, &built, progress, cancel);
                           });
@@ -108,7 +127,7 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
 BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
                                    const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                    const ndf::PyramidProgress& progress, const std::atomic<bool>* cancel) {
-  return packBuiltPyramid(pyramid, options, writer, report, cancel,
+  return packBuiltPyramid(pyramid, options, &writer, nullptr, report, cancel,
                           [&](ndf::PyramidSink& sink, ndf::PyramidReport& built) {
                             return ndf::buildNdfPyramid(source, pyramid, sink, &built, progress, cancel);
                           });
@@ -126,7 +145,8 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
   TensorPackReport& rep = report ? *report : local;
   rep = TensorPackReport{};
   return inArena(options.threads, [&]() -> BakeStatus {
-    detail::TensorPackSink sink(writer, options, rep, cancel);
+    TensorAssembler assembler(writer, options, rep);
+    detail::TensorPackSink sink(assembler, options, rep, cancel, &writer);
     std::vector<uint8_t> bytes;
     std::vector<float> chunk_buffer;
     format::NdfLevelRecord below;
@@ -200,6 +220,7 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
     }
     if (level == 0) return invalid("the container has no ndf-level sections");
     if (BakeStatus s = sink.finish(); !s) return s;
+    if (BakeStatus s = assembler.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);
     rep.ndf_seconds = rep.total_seconds - sink.secondsInside();
     return okStatus();

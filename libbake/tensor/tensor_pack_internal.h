@@ -4,6 +4,7 @@
 #pragma once
 
 #include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/bake/tensor/tensor_assembly.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
 
@@ -43,38 +44,44 @@ Result<EncodedGroup> exactGroup(const GroupTensor& tensor, int level, int region
 size_t groupSectionBytes(int bins, int rank, int blocks, int precision);
 
 // The PyramidSink that turns regions into groups: extracts the non-blank blocks of each chunk,
-// compresses them on the TBB pool, and writes groups, level indexes and the info record in the
-// order tensor_pack.h documents. All methods run on the producer's thread.
+// compresses them on the TBB pool and hands every region's results, in region order, to a
+// TensorRegionConsumer (the asset's TensorAssembler, or a shard's recorder). All methods run on
+// the producer's thread.
 class TensorPackSink final : public ndf::PyramidSink {
  public:
-  TensorPackSink(format::Writer& writer, const TensorPackOptions& options, TensorPackReport& report,
-                 const std::atomic<bool>* cancel);
+  TensorPackSink(TensorRegionConsumer& consumer, const TensorPackOptions& options, TensorPackReport& report,
+                 const std::atomic<bool>* cancel, const format::Writer* writer = nullptr);
   ~TensorPackSink() override;
 
   BakeStatus addLevel(const format::NdfLevelRecord& record) override;
   BakeStatus addChunk(const ndf::PyramidChunk& chunk) override;
+  BakeStatus skipChunk(int level, int region) override;
   BakeStatus endLevel(int level) override;
-  uint64_t storedBytes() const override { return writer_.bytesWritten(); }
+  uint64_t storedBytes() const override { return writer_ ? writer_->bytesWritten() : 0; }
 
-  // Writes the tensor-info record and completes the report. kInvalidInput when no block was kept.
+  // Checks that every region went to the consumer.
   BakeStatus finish();
   // Time spent inside this sink (the rest of the producer's time made NDF images).
   double secondsInside() const { return seconds_inside_; }
 
  private:
+  // One region: its summary, and its kept blocks (one compressed group, or one exact group each).
   struct Pending {
+    bool skipped = false;
+    RegionSummary summary;
+    std::vector<double> image_sum;
+    std::vector<format::TensorIndexEntry> index;
     GroupTensor tensor;
-    int level = 0, region = 0;
+    bool exact = false;
     std::optional<Result<EncodedGroup>> result;
     tbb::task_group task;
   };
 
-  BakeStatus writeFront();  // waits for the oldest pending group and writes it
-  // The kept blocks of a chunk of an exact level, one exact group each, in (centre, block) order.
-  BakeStatus addExactBlocks(const ndf::PyramidChunk& chunk, const std::vector<uint8_t>& keep);
-  BakeStatus writeSection(uint32_t type, uint64_t key, const void* data, size_t size);
+  BakeStatus writeFront();  // waits for the oldest pending region and hands it to the consumer
+  BakeStatus push(std::unique_ptr<Pending> p);
 
-  format::Writer& writer_;
+  TensorRegionConsumer& consumer_;
+  const format::Writer* writer_;
   TensorPackOptions options_;
   TensorPackReport& report_;
   const std::atomic<bool>* cancel_;
@@ -83,18 +90,10 @@ class TensorPackSink final : public ndf::PyramidSink {
   int ndf_res_ = 0;
   int blocks_per_side_ = 0;
   int level_ = -1;
-  bool exact_level_ = false;      // the current level's blocks are stored exactly, one group each
-  format::NdfLevelRecord below_;  // the last level added (when level_ >= 0)
-  int grid_width_ = 0, grid_height_ = 0;
-  uint64_t level_bytes_before_ = 0;
-  std::vector<format::TensorIndexEntry> index_;  // of the current level
-  std::vector<double> level_sum_;                // sum of the current level's images, bin by bin
-  uint64_t level_images_ = 0;                    // images summed into it
-  uint32_t next_group_ = 0;
+  bool exact_level_ = false;  // the current level's blocks are stored exactly, one group each
+  int grid_width_ = 0;
   std::deque<std::unique_ptr<Pending>> pending_;
   double seconds_inside_ = 0.0;
-  double absolute_mass_ = 0.0;  // sum of |model| over every kept bin (for the negative-mass fraction)
-  uint64_t bytes_at_start_ = 0;
 };
 
 }  // namespace glintbake::bake::tensor::detail

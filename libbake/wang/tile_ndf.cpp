@@ -67,9 +67,9 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
     return makeError(ErrorCode::kIo, path + ": " + writer.errorString(st));
   WangTileNdfReport local;
   WangTileNdfReport& rep = report ? *report : local;
-  const BakeStatus s = o.uncompressed ? ndf::buildNdfPyramid(source, o.pyramid, writer, &rep.pyramid, {}, cancel)
-                                      : tensor::packTensorNdfFromSource(source, o.pyramid, o.pack, writer, &rep.pack,
-                                                                        {}, cancel);
+  const BakeStatus s = o.uncompressed
+                           ? ndf::buildNdfPyramid(source, o.pyramid, writer, &rep.pyramid, {}, cancel)
+                           : tensor::packTensorNdfFromSource(source, o.pyramid, o.pack, writer, &rep.pack, {}, cancel);
   if (!s) return s;
   if (format::ContainerStatus st = writer.addMetadata(metadata_json); st != format::ContainerStatus::kOk)
     return makeError(ErrorCode::kIo, path + ": " + writer.errorString(st));
@@ -78,8 +78,8 @@ BakeStatus bakeWangTileNdf(const WangTileSet& set, int t, const WangNdfOptions& 
   return readAndRemove(path, bytes);
 }
 
-format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, uint64_t grid_seed,
-                              double flakes_up_to, double pyramid_from, double max_sigma) {
+format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, uint64_t grid_seed, double flakes_up_to,
+                              double pyramid_from, double max_sigma) {
   format::WangRecord rec;
   rec.colors = uint32_t(set.colors);
   rec.tile_count = uint32_t(set.tile_count);
@@ -95,12 +95,17 @@ format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& o, u
   return rec;
 }
 
-BakeStatus writeWangSections(format::Writer& w, const WangTileSet& set, const format::WangRecord& rec,
-                             const std::vector<std::vector<uint8_t>>& tiles) {
+Result<std::vector<WangSection>> wangCommonSections(const WangTileSet& set, const format::WangRecord& rec) {
   if (const char* why = format::checkWangRecord(rec)) return makeError(ErrorCode::kBadArgument, why);
-  if (int(rec.tile_count) != set.tile_count || tiles.size() != size_t(set.tile_count))
-    return makeError(ErrorCode::kBadArgument, "the tile count of the record, the set and the assets differ");
-  std::vector<uint8_t> edges(format::wangEdgesBytes(rec));
+  if (int(rec.tile_count) != set.tile_count)
+    return makeError(ErrorCode::kBadArgument, "the tile count of the record and the set differ");
+  std::vector<WangSection> out(3);
+  out[0].type = format::kSectionWangInfo;
+  out[0].bytes.resize(sizeof rec);
+  std::memcpy(out[0].bytes.data(), &rec, sizeof rec);
+  std::vector<uint8_t>& edges = out[1].bytes;
+  out[1].type = format::kSectionWangEdges;
+  edges.resize(format::wangEdgesBytes(rec));
   for (uint32_t code = 0; code < rec.tile_count; ++code) std::memcpy(&edges[size_t(code) * 4], &code, 4);
   for (int i = 0; i < set.tile_count; ++i)
     std::copy_n(set.edges[size_t(i)].data(), 4, &edges[size_t(rec.tile_count) * 4 + size_t(i) * 4]);
@@ -109,10 +114,22 @@ BakeStatus writeWangSections(format::Writer& w, const WangTileSet& set, const fo
     texels[2 * k] = set.normals[3 * k];
     texels[2 * k + 1] = set.normals[3 * k + 1];
   }
-  format::ContainerStatus st = w.addSection(format::kSectionWangInfo, 0, &rec, sizeof rec);
-  if (st == format::ContainerStatus::kOk) st = w.addSection(format::kSectionWangEdges, 0, edges.data(), edges.size());
-  if (st == format::ContainerStatus::kOk)
-    st = w.addSection(format::kSectionWangTexels, 0, texels.data(), texels.size() * sizeof(float));
+  out[2].type = format::kSectionWangTexels;
+  out[2].bytes.resize(texels.size() * sizeof(float));
+  std::memcpy(out[2].bytes.data(), texels.data(), out[2].bytes.size());
+  return out;
+}
+
+BakeStatus writeWangSections(format::Writer& w, const WangTileSet& set, const format::WangRecord& rec,
+                             const std::vector<std::vector<uint8_t>>& tiles) {
+  Result<std::vector<WangSection>> common = wangCommonSections(set, rec);
+  if (!common) return common.error();
+  if (tiles.size() != size_t(set.tile_count))
+    return makeError(ErrorCode::kBadArgument, "the tile count of the record, the set and the assets differ");
+  format::ContainerStatus st = format::ContainerStatus::kOk;
+  for (const WangSection& c : common.value()) {
+    if (st == format::ContainerStatus::kOk) st = w.addSection(c.type, 0, c.bytes.data(), c.bytes.size());
+  }
   for (int i = 0; i < set.tile_count && st == format::ContainerStatus::kOk; ++i)
     st = w.addSection(format::kSectionWangTileNdf, uint64_t(i), tiles[size_t(i)].data(), tiles[size_t(i)].size());
   if (st != format::ContainerStatus::kOk) return makeError(ErrorCode::kIo, w.errorString(st));

@@ -113,6 +113,24 @@ class GlintBake(ToolTestCase):
         m = self.write_manifest([{"output": "x.gbk"}, {"output": "x.gbk"}])
         self.assertIn("twice", self.assert_fails(3, "glintbake", "bake", m))
 
+    def test_sharded_tensorpack_asset(self):
+        t = self.mapgen("scratches", "t.png", "--size", "40", "--seed", "5")
+        pack = {"block": 8, "rank": 4}
+        m = self.write_manifest([{"name": "t", "tool": "tensorpack", "inputs": ["t.png"], "output": "out/t.gbk",
+                                  "options": pack, "shards": 3}])
+        doc = self.run_json("glintbake", "bake", m, "-j", "2", schema="glintbake-bake.schema.json")
+        self.assertEqual(self.statuses(doc), {"t": "baked"})
+        ref = self.path("t.ref.gbk")
+        self.run_ok("tensorpack", t, "-o", ref, *SMALL_ARGS, "--block", "8", "--rank", "4", "--quiet")
+        self.assertEqual(clitest.file_hash(ref), clitest.file_hash(self.path("out/t.gbk")))
+        self.assertFalse(os.path.exists(self.path("out/t.gbk.shards")))
+        jobs = self.path("jobs")
+        os.remove(self.path("out/t.gbk"))
+        doc = self.run_json("glintbake", "bake", m, "--emit", "slurm", "--emit-dir", jobs,
+                            schema="glintbake-bake.schema.json")
+        tasks = read(os.path.join(jobs, "tasks.txt")).splitlines()
+        self.assertEqual(sum("tensorpack" in x and "--shard" in x for x in tasks), 3)
+
     def test_emit_slurm(self):
         self.mapgen("beckmann", "a.png", "--size", "16")
         self.mapgen("flakes", "b.png", "--size", "16")

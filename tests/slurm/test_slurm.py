@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """glintbake on a real Slurm cluster: starts munged, slurmctld and slurmd on localhost (config,
-state and logs in a temporary folder, loopback ports only), bakes a manifest of several maps and a
-sharded map with `glintbake bake --emit slurm`, kills one task's tool to show that its retry gives
+state and logs in a temporary folder, loopback ports only), bakes a manifest of several maps, a
+sharded ndfgen map and a sharded tensorpack map with `glintbake bake --emit slurm`, kills one task's tool to show that its retry gives
 the same bytes, and checks every output is byte-identical to the local bake. The daemons are
 stopped and the folder removed whatever happens."""
 
@@ -22,6 +22,7 @@ from clitest import ToolTestCase
 DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "squeue", "scontrol", "sinfo"]
 SKIP = 77
 SMALL = {"ndf-res": 16, "stride": 4, "sigma0": 2, "region": 2}
+PACK = {"block": 8, "rank": 4}
 
 
 def find(program):
@@ -145,6 +146,9 @@ class SlurmBake(ToolTestCase):
         assets.append({"name": "sharded", "tool": "ndfgen", "inputs": [sharded],
                        "output": os.path.join(out_dir, "sharded.gbk"), "shards": 3,
                        "options": {"ndf-res": 32}})
+        # A sharded tensorpack bake: its merge replays the final assembly (formats/SPEC.md 10.9).
+        assets.append({"name": "tsharded", "tool": "tensorpack", "inputs": [maps[1]],
+                       "output": os.path.join(out_dir, "tsharded.gbk"), "shards": 2, "options": PACK})
         path = self.path(name)
         with open(path, "w") as f:
             json.dump({"schema": "glintbake.manifest/1", "defaults": {"options": SMALL}, "assets": assets}, f)
@@ -162,7 +166,7 @@ class SlurmBake(ToolTestCase):
         self.run_ok("glintbake", "bake", local, "--quiet")
 
         doc = self.run_json("glintbake", "bake", farm, "--emit", "slurm", "--emit-dir", self.path("jobs"))
-        self.assertEqual(doc["tasks"], 3 + 3)
+        self.assertEqual(doc["tasks"], 3 + 3 + 2)
         root = tempfile.mkdtemp(prefix="glintbake-slurm-")
         cluster = Cluster(root)
         try:
@@ -181,6 +185,11 @@ class SlurmBake(ToolTestCase):
                     self.assertEqual(clitest.file_hash(os.path.join(self.path("farm"), name)),
                                      clitest.file_hash(os.path.join(self.path("local"), name)), name)
             self.assertFalse(os.path.exists(self.path("farm/sharded.gbk.shards")), "parts left behind")
+            # The sharded tensorpack asset is the file tensorpack writes on one machine.
+            one = self.path("tsharded.one.gbk")
+            self.run_ok("tensorpack", maps[1], "-o", one, "--quiet", *[f"--{k}={v}" for k, v in SMALL.items()],
+                        *[f"--{k}={v}" for k, v in PACK.items()])
+            self.assertEqual(clitest.file_hash(self.path("farm/tsharded.gbk")), clitest.file_hash(one))
             if killed:
                 logs = ""
                 for name in os.listdir(os.path.join(self.path("jobs"), "logs")):

@@ -27,7 +27,7 @@ Error malformed(const std::string& where, const std::string& what) {
 
 // Tools the manifest may name, and the ones that take --shard.
 const std::set<std::string> kTools = {"ndfgen", "tensorpack", "mapgen", "ltcfit", "wangtile", "tinyexample"};
-const std::set<std::string> kShardedTools = {"ndfgen"};
+const std::set<std::string> kShardedTools = {"ndfgen", "tensorpack", "wangtile"};
 // Options glintbake sets itself.
 const std::set<std::string> kReserved = {"o", "output", "shard", "json", "quiet", "depfile", "j", "threads"};
 
@@ -104,8 +104,9 @@ std::string shellQuote(const std::vector<std::string>& argv) {
   std::string s;
   for (const std::string& a : argv) {
     if (!s.empty()) s += ' ';
-    const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                                                         "_-+=/.,:@%") == std::string::npos;
+    const bool plain = !a.empty() && a.find_first_not_of(
+                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                         "_-+=/.,:@%") == std::string::npos;
     if (plain) {
       s += a;
       continue;
@@ -221,8 +222,8 @@ void computeKeys(Manifest& m) {
 std::string partsDir(const Asset& asset) { return asset.output + ".shards"; }
 
 std::string partPath(const Asset& asset, int shard) {
-  return (fs::path(partsDir(asset)) / (asset.name + "." + std::to_string(shard) + "of" +
-                                       std::to_string(asset.shards) + ".part.gbk"))
+  return (fs::path(partsDir(asset)) /
+          (asset.name + "." + std::to_string(shard) + "of" + std::to_string(asset.shards) + ".part.gbk"))
       .string();
 }
 
@@ -269,7 +270,8 @@ std::map<std::string, StateEntry> readState(const std::string& path) {
   if (doc.is_discarded() || !doc.is_object() || !doc.contains("assets") || !doc["assets"].is_object()) return state;
   for (auto it = doc["assets"].begin(); it != doc["assets"].end(); ++it) {
     if (!it.value().is_object()) continue;
-    state[it.key()] = StateEntry{it.value().value("key", std::string()), it.value().value("output_hash", std::string())};
+    state[it.key()] =
+        StateEntry{it.value().value("key", std::string()), it.value().value("output_hash", std::string())};
   }
   return state;
 }

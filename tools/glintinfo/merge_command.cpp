@@ -1,13 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
 // glintinfo merge: joins the partial containers of a sharded bake (ndfgen/tensorpack --shard I/N)
-// into the asset, byte-identical to the file one machine writes (formats/SPEC.md 10.9). Refuses,
+// into the asset, byte-identical to the file one machine writes (formats/SPEC.md 10.9): ndfgen's
+// parts by copying their sections in position order, tensorpack's by replaying its final assembly. Refuses,
 // before writing anything, parts that do not belong together: another tool or version, other
 // inputs or options, another shard count, a shard missing or given twice.
 #include "commands.h"
 #include "container_access.h"
 
+#include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/bake/tensor/tensor_assembly.h>
+#include <glintbake/bake/tensor/tensor_shard.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/tensor_asset.h>
 #include <glintbake/format/kinds/partial.h>
 
 #include <chrono>
@@ -79,7 +84,9 @@ void checkSameBake(const Part& a, const Part& b) {
     throw invalid(both + " split the bake into different shard counts (" + a.asset["shards"].dump() + " and " +
                   b.asset["shards"].dump() + ")");
   if (a.asset["asset_kind"] != b.asset["asset_kind"] || a.asset["positions"] != b.asset["positions"] ||
-      a.asset["zstd_level"] != b.asset["zstd_level"] || a.asset_metadata != b.asset_metadata)
+      a.asset["zstd_level"] != b.asset["zstd_level"] || a.asset_metadata != b.asset_metadata ||
+      a.asset.value("assembly", Json()) != b.asset.value("assembly", Json()) ||
+      a.asset.value("units_total", Json()) != b.asset.value("units_total", Json()))
     throw invalid(both + " disagree on the merged asset (its layout or metadata)");
 }
 
@@ -99,6 +106,140 @@ format::ShardSectionHeader readHeader(const Part& p, size_t i) {
   if (const char* why = format::checkShardSectionHeader(h, s.raw_size))
     throw invalid(p.path + ": " + why + " (position " + std::to_string(s.key) + ")");
   return h;
+}
+
+// The merge's one-line summary, or its --json.
+void printSummary(cli::Tool& t, const std::string& output, format::AssetKind kind, int shards, uint64_t sections,
+                  uint64_t bytes, double seconds) {
+  if (t.common().json) {
+    Json doc;
+    doc["command"] = "merge";
+    doc["output"] = cli::baseName(output);
+    doc["asset_kind"] = format::assetKindString(kind);
+    doc["shards"] = shards;
+    doc["sections"] = sections;
+    doc["file_bytes"] = bytes;
+    doc["seconds"] = seconds;
+    t.printJson(doc);
+  } else {
+    t.info("wrote " + output + ": " + std::string(format::assetKindString(kind)) + " merged from " +
+           std::to_string(shards) + " shards, " + std::to_string(sections) + " sections, " + std::to_string(bytes) +
+           " bytes");
+  }
+}
+
+// The level records every part holds (shard-levels), identical in all of them.
+std::vector<format::NdfLevelRecord> readLevels(const std::vector<Part>& parts) {
+  std::vector<uint8_t> first;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const int idx = parts[i].reader->find(format::kSectionShardLevels, 0);
+    if (idx < 0) throw invalid(parts[i].path + ": replayed partial without its level records (shard-levels)");
+    std::vector<uint8_t> bytes = readSectionOrThrow(*parts[i].reader, parts[i].path, size_t(idx));
+    if (i == 0) {
+      first = std::move(bytes);
+    } else if (bytes != first) {
+      throw invalid(parts[0].path + " and " + parts[i].path + " disagree on the merged asset (its levels)");
+    }
+  }
+  const size_t n = first.size() / sizeof(format::NdfLevelRecord);
+  if (n == 0 || n > size_t(bake::ndf::kMaxPyramidLevels) || first.size() % sizeof(format::NdfLevelRecord) != 0)
+    throw invalid(parts[0].path + ": shard-levels section of the wrong size");
+  std::vector<format::NdfLevelRecord> levels(n);
+  std::memcpy(static_cast<void*>(levels.data()), first.data(), first.size());
+  return levels;
+}
+
+// Replayed partials (tensorpack --shard): every unit's results, in the asset's order, through the
+// final assembly the one-machine bake uses (TensorAssembler, cli::finishTensorAsset).
+int mergeReplayed(cli::Tool& t, const MergeOptions& options, const std::vector<Part>& parts, format::AssetKind kind,
+                  std::chrono::steady_clock::time_point t0) {
+  const Part& first = parts.front();
+  if (kind != format::AssetKind::kTensorNdf)
+    throw invalid(first.path + ": replayed partials of a " + format::assetKindString(kind) + " asset");
+  bake::tensor::TensorPackOptions pack;
+  cli::TensorAssetEnd end;
+  bool flakes = false;
+  try {
+    cli::readTensorShardAssembly(first.asset["assembly"], &pack, &end, &flakes);
+  } catch (const Error& e) {
+    throw invalid(first.path + ": " + e.what());
+  }
+  if (!first.asset.contains("units_total") || !first.asset["units_total"].is_number_unsigned())
+    throw invalid(first.path + ": shard description lacks 'units_total'");
+  const uint64_t units_total = first.asset["units_total"].get<uint64_t>();
+  const std::vector<format::NdfLevelRecord> levels = readLevels(parts);
+
+  // Who holds each unit: exactly one part.
+  std::map<uint64_t, std::pair<size_t, size_t>> holder;
+  for (size_t pi = 0; pi < parts.size(); ++pi) {
+    const auto& sections = parts[pi].reader->sections();
+    for (size_t i = 0; i < sections.size(); ++i) {
+      if (sections[i].type == format::kSectionShardSection)
+        throw invalid(parts[pi].path + ": a replayed partial holds positioned sections");
+      if (sections[i].type != format::kSectionShardUnit) continue;
+      const uint64_t unit = sections[i].key;
+      if (unit >= units_total)
+        throw invalid(parts[pi].path + ": unit " + std::to_string(unit) + " beyond the bake's " +
+                      std::to_string(units_total));
+      auto [it, fresh] = holder.emplace(unit, std::make_pair(pi, i));
+      if (!fresh)
+        throw invalid("unit " + std::to_string(unit) + " is held by both " + parts[it->second.first].path + " and " +
+                      parts[pi].path);
+    }
+  }
+  auto unitBytes = [&](uint64_t unit, const std::string& what) {
+    const auto it = holder.find(unit);
+    if (it == holder.end()) throw invalid("no part holds unit " + std::to_string(unit) + " (" + what + ")");
+    const Part& p = parts[it->second.first];
+    return readSectionOrThrow(*p.reader, p.path, it->second.second);
+  };
+  uint64_t needed = flakes ? 1 : 0;
+  for (const format::NdfLevelRecord& rec : levels) needed += uint64_t(rec.regions_x) * rec.regions_y;
+  if (needed > units_total) throw invalid(first.path + ": the levels hold more units than the bake has");
+
+  cli::ContainerOutput out(t, options.output, kind, first.asset["zstd_level"].get<int>());
+  bake::tensor::TensorPackReport report;
+  bake::tensor::TensorAssembler assembler(out.writer(), pack, report);
+  auto check = [&](bake::BakeStatus s, const std::string& where) {
+    if (!s)
+      throw Error(s.error().code == bake::ErrorCode::kIo ? cli::kExitIo : cli::kExitInvalidInput,
+                  where + ": " + s.error().message);
+  };
+  uint64_t unit = 0;
+  for (const format::NdfLevelRecord& rec : levels) {
+    const std::string level = "level " + std::to_string(rec.level);
+    check(assembler.level(rec), level);
+    for (uint32_t r = 0; r < rec.regions_x * rec.regions_y; ++r, ++unit) {
+      const std::string what = "region " + std::to_string(r) + " of " + level;
+      const std::vector<uint8_t> bytes = unitBytes(unit, what);
+      check(bake::tensor::replayTensorRegion(bytes.data(), bytes.size(), assembler), "unit " + std::to_string(unit));
+    }
+    check(assembler.endLevel(), level);
+  }
+  check(assembler.finish(), "the merged asset");
+  // Units beyond the levels the bake reached hold nothing; the flakes are the last unit.
+  for (const auto& [u, at] : holder) {
+    if (u >= unit && !(flakes && u == units_total - 1))
+      throw invalid(parts[at.first].path + ": unit " + std::to_string(u) + " beyond the levels the bake reached");
+  }
+  std::vector<uint8_t> flake_section;
+  if (flakes) flake_section = unitBytes(units_total - 1, "the flakes");
+  const Json inputs = first.meta.value("inputs", Json::array());
+  end.label = inputs.is_array() && !inputs.empty() && inputs[0].contains("name") && inputs[0]["name"].is_string()
+                  ? inputs[0]["name"].get<std::string>()
+                  : options.output;
+  const Json metadata = Json::parse(first.asset_metadata, nullptr, false);
+  if (!metadata.is_object() || !metadata.contains("asset"))
+    throw invalid(first.path + ": the merged asset's metadata is not an object with 'asset'");
+  const cli::TensorAssetResult done = cli::finishTensorAsset(out.writer(), report, &flake_section, metadata, end);
+  out.finish(done.metadata);
+  for (const std::string& w : done.warnings) t.warning(end.label + ": " + w);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Levels and indexes, groups, the info record, the flakes and the metadata.
+  const uint64_t sections = 2 * report.levels.size() + report.groups + 1 + (done.flake_bytes > 0 ? 1 : 0) + 1;
+  const int shards = first.asset["shards"].get<int>();
+  printSummary(t, options.output, kind, shards, sections, out.bytesWritten(), seconds);
+  return cli::kExitOk;
 }
 
 }  // namespace
@@ -137,6 +278,8 @@ int runMerge(cli::Tool& t, const MergeOptions& options) {
   if (!format::assetKindFromString(first.asset["asset_kind"].get<std::string>(), &kind) ||
       kind == format::AssetKind::kPartial)
     throw invalid(first.path + ": unknown merged asset kind " + first.asset["asset_kind"].dump());
+
+  if (first.asset.contains("assembly")) return mergeReplayed(t, options, parts, kind, t0);
 
   // Who holds each position: one owner, or (common sections) every part with the same bytes.
   const uint64_t positions = first.asset["positions"].get<uint64_t>();
@@ -194,21 +337,7 @@ int runMerge(cli::Tool& t, const MergeOptions& options) {
   }
   out.finishText(first.asset_metadata);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (t.common().json) {
-    Json doc;
-    doc["command"] = "merge";
-    doc["output"] = cli::baseName(options.output);
-    doc["asset_kind"] = format::assetKindString(kind);
-    doc["shards"] = shards;
-    doc["sections"] = positions + 1;
-    doc["file_bytes"] = out.bytesWritten();
-    doc["seconds"] = seconds;
-    t.printJson(doc);
-  } else {
-    t.info("wrote " + options.output + ": " + std::string(format::assetKindString(kind)) + " merged from " +
-           std::to_string(shards) + " shards, " + std::to_string(positions + 1) + " sections, " +
-           std::to_string(out.bytesWritten()) + " bytes");
-  }
+  printSummary(t, options.output, kind, shards, positions + 1, out.bytesWritten(), seconds);
   return cli::kExitOk;
 }
 

@@ -4,14 +4,19 @@
 // angular blocks as one rank-R CP model (libbake/tensor/tensor_pack.h; layout in formats/SPEC.md
 // section 10.4).
 #include <glintbake/bake/glitter/glitter.h>
+#include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
+#include <glintbake/bake/tensor/tensor_shard.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/embed.h>
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/glitter_options.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/shard_output.h>
 #include <glintbake/cli/stdin_input.h>
+#include <glintbake/cli/tensor_asset.h>
 #include <glintbake/cli/tensor_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/container.h>
@@ -33,6 +38,7 @@
 namespace {
 
 using glintbake::cli::Error;
+using glintbake::cli::GatedError;
 using glintbake::cli::Json;
 namespace bake = glintbake::bake;
 namespace cli = glintbake::cli;
@@ -60,95 +66,6 @@ std::string defaultOutput(const std::string& input, bool container) {
 
 int exitCodeOf(const bake::Error& e) { return int(e.code); }
 
-// Relative error above which tensorpack warns when no --error-target is given (README, "tensorpack
-// defaults"). At rank 16 the real maps that CP compresses well land at 0.15-0.25
-// (brushed_blender_1024 0.164, scratches_straight_cutlery_512 0.151), while a sharp-flake map lands
-// at 0.93 (flakes_voronoi_sharp_snail_512; the example flakes asset 0.88): an asset that far off has
-// lost most of its glints. 0.5 separates the two with room on both sides.
-constexpr double kDefaultErrorBound = 0.5;
-// Relative error (Frobenius, over a level's images) up to which a compressed level answers its
-// footprints; below the first level from which every level meets it, the clustered lobes answer
-// (README, "How an NDF asset answers a footprint").
-constexpr double kFaithfulLevelError = 0.15;
-// ... and at most this share of the level's variation (|D - mean image| / |D|): the footprints of
-// a level differ from each other by about that much, which is what the smooth baseline misses, so
-// an error near it keeps no more of the glints than one smooth image would. On the real maps of
-// the fidelity table rank 16 stays near or above the variation at every level (README, "Figures").
-constexpr double kFaithfulVariationShare = 0.25;
-
-// How far a level is from faithful: at most 1 when it meets both bounds.
-double unfaithfulness(const tensor::TensorPackLevelReport& l) {
-  if (l.exact) return 0.0;
-  const double by_norm = l.relative_error / kFaithfulLevelError;
-  if (!(l.relative_error > 0.0)) return 0.0;
-  if (!(l.variation > 0.0)) return std::numeric_limits<double>::infinity();
-  return std::max(by_norm, l.relative_error / (kFaithfulVariationShare * l.variation));
-}
-
-std::string errorText(double e) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.4f", e);
-  return text;
-}
-
-// The error a gate compares: that of the compressed levels that answer footprints. Without lobes
-// every level answers: the larger of the whole pyramid's relative error (dropped blocks included)
-// and the largest group's (its kept blocks). With lobes, the levels the lobes stand in for never
-// answer (compressedHandover): the largest relative error of the levels the pyramid blends in
-// above lobes_up_to, or of the top level alone when the lobes answer every footprint their window
-// allows (the top level answers beyond it).
-struct GatedError {
-  double error = 0.0;
-  double from_sigma = 0.0;  // sigma of the first level gated
-  bool whole = true;        // every level answers
-};
-
-GatedError gatedError(const tensor::TensorPackReport& r, const bake::ndf::FlakesHandover& h) {
-  GatedError g;
-  if (h.lobes_per_tile <= 0 || r.levels.empty()) {
-    g.error = std::max(r.relative_error, r.max_group_error);
-    return g;
-  }
-  g.whole = false;
-  size_t first = r.levels.size() - 1;
-  while (first > 0 && 2.0 * r.levels[first - 1].sigma > h.lobes_up_to) --first;
-  g.from_sigma = r.levels[first].sigma;
-  for (size_t l = first; l < r.levels.size(); ++l) g.error = std::max(g.error, r.levels[l].relative_error);
-  return g;
-}
-
-std::string achievedText(const tensor::TensorPackReport& r, const GatedError& g) {
-  if (g.whole)
-    return "relative error " + errorText(r.relative_error) + " (largest group " + errorText(r.max_group_error) + ")";
-  char sigma[32];
-  std::snprintf(sigma, sizeof(sigma), "%g", g.from_sigma);
-  return "relative error " + errorText(g.error) + " of the levels that answer footprints (sigma " + sigma +
-         " and up; the clustered lobes answer below)";
-}
-
-// --max-error: fails (runtime failure, before anything is written) when the gated error exceeds E.
-void checkMaxError(const tensor::TensorPackReport& r, const GatedError& g, double max_error, const std::string& input) {
-  if (max_error < 0.0 || !(g.error > max_error)) return;
-  throw Error(cli::kExitRuntime, input + ": " + achievedText(r, g) + " exceeds --max-error " + errorText(max_error) +
-                                     "; no output written");
-}
-
-// One warning when the gated error misses --error-target (when given) or the default bound.
-std::vector<std::string> qualityWarnings(const tensor::TensorPackReport& r, const GatedError& g, double error_target,
-                                         int rank) {
-  std::vector<std::string> warnings;
-  if (error_target >= 0.0) {
-    if (g.error > error_target) {
-      warnings.push_back(achievedText(r, g) + " misses --error-target " + errorText(error_target) + " at --rank " +
-                         std::to_string(rank));
-    }
-  } else if (g.error > kDefaultErrorBound) {
-    warnings.push_back(achievedText(r, g) + " exceeds the default bound " + errorText(kDefaultErrorBound) +
-                       " (raise --rank, or gate with --max-error)");
-  }
-  return warnings;
-}
-
 Json levelJson(const tensor::TensorPackLevelReport& l) {
   Json j;
   j["level"] = l.level;
@@ -165,12 +82,6 @@ Json levelJson(const tensor::TensorPackLevelReport& l) {
   return j;
 }
 
-Json rankHistogramJson(const tensor::TensorPackReport& r) {
-  Json h = Json::object();
-  for (const auto& [rank, groups] : r.rank_histogram) h[std::to_string(rank)] = groups;
-  return h;
-}
-
 // Everything the command line sets; filled by CLI11 (addOptions) and checked by resolveOptions.
 struct Options {
   std::string input, output;
@@ -180,6 +91,7 @@ struct Options {
   cli::TensorCliOptions tensor;
   tensor::TensorPackOptions& pack = tensor.pack;
   double max_error = -1.0;
+  cli::ShardCliOptions shard;
 };
 
 // Stage 1a: registers the options.
@@ -192,10 +104,12 @@ void addOptions(CLI::App& app, Options& o) {
   cli::addTensorPackOptions(app, o.tensor);
   app.add_option("--max-error", o.max_error,
                  "Fail (exit 4, no output) when the relative error of the pyramid or of any group exceeds this "
-                 "(>= 0; unset: no gate). Without --error-target, errors above 0.5 warn");
+                 "(>= 0; unset: no gate; with --shard, glintinfo merge applies it). Without --error-target, errors "
+                 "above 0.5 warn");
   // Pyramid options: only for normal-map inputs (a container brings its own pyramid).
   cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
   cli::addIngestOptions(app, o.ingest);
+  cli::addShardOption(app, o.shard);
 }
 
 // Stage 1b: checks the parsed options and derives the library's (exit 1 on anything out of range).
@@ -204,6 +118,7 @@ void resolveOptions(const CLI::App& app, Options& o) {
   if (app.count("--max-error") && !(o.max_error >= 0.0 && std::isfinite(o.max_error))) {
     throw Error(cli::kExitBadArguments, "--max-error must be a finite number >= 0");
   }
+  cli::resolveShardOption(o.shard);
 }
 
 // Canonical parameters (container metadata and --json), in their recorded order; readInput adds
@@ -308,9 +223,48 @@ int sourceLobesPerTile(const format::Reader& reader, const std::string& input) {
   return rec.version >= 2 ? int(rec.lobes_per_tile) : 0;
 }
 
-// Stage 3: packs the input into the (temporary) output container; nothing is in place yet.
+// The raw flakes section of a map (unless --no-flakes), with the default hand-over in its record
+// until finishTensorAsset sets the one the compression calls for.
+std::vector<uint8_t> mapFlakes(const Options& o, const bake::NormalMap& map) {
+  if (!o.pyramid.flakes) return {};
+  return cli::unwrap(bake::ndf::flakesSectionBytes(map, o.pyramid.options.rate, o.pyramid.options.splat.sigma_r,
+                                                   cli::defaultFlakesHandover(o.pyramid)));
+}
+
+// What the end of the bake needs besides the report (the same on one machine and in the merge).
+cli::TensorAssetEnd assetEnd(const Options& o, const Input& in) {
+  cli::TensorAssetEnd end;
+  end.lobes_per_tile = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
+  end.max_error = o.max_error;
+  end.error_target = o.tensor.error_target;
+  end.rank = o.pack.cp.rank;
+  end.label = o.input;
+  return end;
+}
+
+// The asset's metadata without what the compression decides (finishTensorAsset adds it).
+Json metadataTemplate(cli::Tool& t, const Options& o, const Input& in, const Json& params) {
+  Json asset;
+  asset["block"] = o.pack.block;
+  asset["precision"] = o.tensor.precision_text;
+  asset["nonneg"] = o.pack.cp.nonneg;
+  asset["blank_threshold"] = o.pack.blank_threshold;
+  if (!in.map_json.is_null()) asset["map"] = in.map_json;
+  if (in.source_asset.is_object()) {
+    for (const char* key : {"map_size", "wrap", "sigma_r", "rate"}) {
+      if (in.source_asset.contains(key)) asset[key] = in.source_asset[key];
+    }
+  }
+  Json meta = t.makeMetadata("tensor-ndf", params);
+  meta["asset"] = asset;
+  return meta;
+}
+
+// Stage 3: packs the input into the (temporary) output container; nothing is in place yet. The
+// flakes section's raw bytes (from the map, or carried over from the source container) go to
+// *flakes, for finishTensorAsset to complete with the hand-over.
 tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cli::ContainerOutput& out,
-                                   bake::ndf::FlakesHandover& handover, uint64_t* flake_bytes) {
+                                   std::vector<uint8_t>* flakes) {
   tensor::TensorPackReport report;
   bake::BakeStatus s = bake::okStatus();
   if (in.source) {
@@ -327,76 +281,79 @@ tensor::TensorPackReport packAsset(cli::Tool& t, const Options& o, Input& in, cl
     progress.finish();
   }
   if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
-  // The flakes for exact small footprints (formats/SPEC.md 10.5), written from the map or carried
-  // over from the source container, with the hand-over this compression calls for: the pyramid
-  // answers only from the first level from which every level is faithful (unfaithfulness), the
-  // clustered lobes below it.
-  std::vector<double> sigmas, errors;
-  std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
-  for (size_t l = 0; l < report.levels.size(); ++l) {
-    sigmas.push_back(report.levels[l].sigma);
-    errors.push_back(unfaithfulness(report.levels[l]));
-    exact[l] = report.levels[l].exact;
-  }
-  const int lobes = in.from_container ? sourceLobesPerTile(in.reader, o.input) : o.pyramid.lobes;
-  handover = bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes, exact.get());
-  if (in.source) {
-    *flake_bytes = 0;  // a procedural surface has no map to carry
-  } else if (!in.from_container) {
-    *flake_bytes = cli::writeFlakes(out.writer(), in.map, o.pyramid, handover);
+  if (in.source) return report;  // a procedural surface has no map to carry
+  if (!in.from_container) {
+    *flakes = mapFlakes(o, in.map);
   } else if (const int idx = in.reader.find(format::kSectionFlakes, 0); idx >= 0) {
-    std::vector<uint8_t> flakes;
-    format::ContainerStatus st = in.reader.readSection(size_t(idx), &flakes);
-    if (st == format::ContainerStatus::kOk) {
-      format::FlakesRecord rec;
-      if (flakes.size() < sizeof(rec))
-        throw Error(cli::kExitInvalidInput, o.input + ": the flakes section is truncated");
-      std::memcpy(&rec, flakes.data(), sizeof(rec));
-      rec.version = format::FlakesRecord().version;
-      rec.flakes_up_to = handover.flakes_up_to;
-      rec.lobes_per_tile = uint32_t(handover.lobes_per_tile);
-      rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
-      rec.pyramid_from = handover.pyramid_from;
-      if (const char* why = format::checkFlakesRecord(rec, flakes.size()))
-        throw Error(cli::kExitInvalidInput, o.input + ": " + why);
-      std::memcpy(flakes.data(), &rec, sizeof(rec));
-      st = out.writer().addSection(format::kSectionFlakes, 0, flakes.data(), flakes.size());
-      *flake_bytes = flakes.size();
-    }
-    if (st != format::ContainerStatus::kOk)
+    if (format::ContainerStatus st = in.reader.readSection(size_t(idx), flakes); st != format::ContainerStatus::kOk)
       throw Error(cli::kExitIo, o.input + ": cannot carry over the flakes section: " + format::statusString(st));
   }
   return report;
 }
 
-// Stage 4: the asset's metadata; adds it and renames the container into place.
-void writeAsset(cli::Tool& t, const Options& o, const Input& in, const Json& params,
-                const tensor::TensorPackReport& report, const Json& flakes, cli::ContainerOutput& out) {
-  Json asset;
-  asset["ndf_res"] = report.ndf_res;
-  asset["block"] = o.pack.block;
-  asset["blocks_per_side"] = report.blocks_per_side;
-  asset["levels"] = Json::array();
-  for (const auto& l : report.levels) {
-    asset["levels"].push_back({{"level", l.level}, {"grid", {l.grid_width, l.grid_height}}, {"groups", l.groups}});
+// Stage 4: completes the asset (hand-over, gate, flakes, metadata), adds the metadata and renames
+// the container into place.
+cli::TensorAssetResult writeAsset(const Options& o, const Input& in, const tensor::TensorPackReport& report,
+                                  std::vector<uint8_t>& flakes, const Json& metadata, cli::ContainerOutput& out) {
+  cli::TensorAssetResult done = cli::finishTensorAsset(out.writer(), report, &flakes, metadata, assetEnd(o, in));
+  out.finish(done.metadata);
+  return done;
+}
+
+// tensorpack --shard I/N: the regions (and maybe the flakes) the plan gives this shard, their
+// results recorded for the merge to replay (bake/tensor/tensor_shard.h).
+cli::ExitCode bakeShard(cli::Tool& t, const Options& o, Input& in, const Json& metadata,
+                        std::chrono::steady_clock::time_point t0) {
+  const cli::ShardCliOptions& shard = o.shard;
+  const cli::PyramidShardPlan plan(in.map, o.pyramid.options, o.pyramid.flakes, shard.spec.count);
+  bake::ndf::PyramidOptions opt = o.pyramid.options;
+  opt.region_filter = plan.filter(shard.spec.index);
+  cli::ShardOutput out(t, o.output, shard.spec, o.tensor.zstd_level);
+  tensor::TensorShardRecorder recorder(out.writer(), o.tensor.zstd_level, o.pack.block,
+                                       [&plan](int level, int region) { return plan.unit(level, region); });
+  tensor::TensorPackReport report;
+  cli::LevelProgress progress(t);
+  const bake::BakeStatus s =
+      tensor::packTensorNdfFromMap(in.map, opt, o.pack, recorder, &report, progress.callback(), cli::cancelFlag());
+  progress.finish();
+  if (!s) throw Error(exitCodeOf(s.error()), o.input + ": " + s.error().message);
+  cli::check(recorder.finish());
+  // Units the plan gives this shard (as ndfgen counts them: those of levels the bake stopped
+  // before included); sections_held counts the units recorded.
+  const uint64_t units = plan.unitsOf(shard.spec.index);
+  uint64_t held = recorder.regionsHeld();
+  if (o.pyramid.flakes && plan.flakesOwner() == shard.spec.index) {
+    const std::vector<uint8_t> flakes = mapFlakes(o, in.map);
+    out.addUnit(uint64_t(plan.flakesUnit()), flakes.data(), flakes.size());
+    ++held;
   }
-  asset["groups"] = report.groups;
-  asset["max_rank"] = report.max_rank;
-  asset["rank_histogram"] = rankHistogramJson(report);
-  asset["precision"] = o.tensor.precision_text;
-  asset["nonneg"] = o.pack.cp.nonneg;
-  asset["blank_threshold"] = o.pack.blank_threshold;
-  if (!flakes.is_null()) asset["flakes"] = flakes;
-  asset["relative_error"] = report.relative_error;
-  if (!in.map_json.is_null()) asset["map"] = in.map_json;
-  if (in.source_asset.is_object()) {
-    for (const char* key : {"map_size", "wrap", "sigma_r", "rate"}) {
-      if (in.source_asset.contains(key)) asset[key] = in.source_asset[key];
-    }
+  const cli::TensorAssetEnd end = assetEnd(o, in);
+  Json assembly = cli::tensorShardAssembly(o.pack, end, o.pyramid.flakes);
+  out.finish(metadata, format::AssetKind::kTensorNdf, units, plan.units(), assembly);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (t.common().json) {
+    Json doc;
+    doc["tool"] = "tensorpack";
+    doc["output"] = cli::baseName(o.output);
+    doc["kind"] = "partial";
+    doc["shard"] = {{"index", shard.spec.index}, {"count", shard.spec.count}};
+    doc["units"] = units;
+    doc["units_total"] = plan.units();
+    double total = 0.0;
+    for (int i = 0; i < shard.spec.count; ++i) total += plan.costOf(i);
+    doc["estimated_cost_share"] = total > 0.0 ? plan.costOf(shard.spec.index) / total : 0.0;
+    doc["sections_held"] = held;
+    doc["positions"] = 0;
+    doc["file_bytes"] = out.bytesWritten();
+    doc["seconds"] = seconds;
+    t.printJson(doc);
+  } else {
+    t.info("wrote " + o.output + ": shard " + std::to_string(shard.spec.index) + "/" +
+           std::to_string(shard.spec.count) + " of a tensor-ndf, " + std::to_string(units) + " of " +
+           std::to_string(plan.units()) + " units, " + std::to_string(out.bytesWritten()) + " bytes in " +
+           std::to_string(seconds) + " s");
   }
-  Json meta = t.makeMetadata("tensor-ndf", params);
-  meta["asset"] = asset;
-  out.finish(meta);
+  return cli::kExitOk;
 }
 
 // Stage 5: the warnings, then the --json summary or the one-line summary.
@@ -429,7 +386,7 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
   doc["groups"] = report.groups;
   doc["blocks_kept"] = report.blocks_kept;
   doc["blocks_dropped"] = report.blocks_dropped;
-  doc["rank_histogram"] = rankHistogramJson(report);
+  doc["rank_histogram"] = cli::rankHistogramJson(report);
   doc["max_rank"] = report.max_rank;
   doc["gated_error"] = {{"error", gated.error}, {"from_sigma", gated.whole ? Json(nullptr) : Json(gated.from_sigma)}};
   doc["raw_bytes"] = report.raw_bytes;
@@ -456,6 +413,8 @@ int glintbake::cli::tensorpackMain(int argc, char** argv) {
                   "Bake and compress a normal map into a tensor-ndf asset in one step.");
   tool.addExample("tensorpack brushed.gbk --rank 16 --strict",
                   "Compress an ndf-pyramid asset; fail if the fit misses its error bound.");
+  tool.addExample("tensorpack hero.png -o hero.2.part.gbk --shard 2/8",
+                  "Bake shard 2 of 8 of a map; glintinfo merge joins the 8 parts into hero.gbk.");
   addOptions(tool.app(), o);
   return tool.run(argc, argv, [&](cli::Tool& t) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -463,18 +422,16 @@ int glintbake::cli::tensorpackMain(int argc, char** argv) {
     Json params = parametersJson(o);
     Input in;
     readInput(t, o, in, params);
+    if (o.shard.active() && (in.source || in.from_container))
+      throw Error(cli::kExitUnsupported, "--shard bakes normal maps only (not --procedural or a container)");
+    const Json metadata = metadataTemplate(t, o, in, params);
+    if (o.shard.active()) return bakeShard(t, o, in, metadata, t0);
     cli::ContainerOutput out(t, o.output, format::AssetKind::kTensorNdf, o.tensor.zstd_level);
-    bake::ndf::FlakesHandover handover;
-    uint64_t flake_bytes = 0;
-    const tensor::TensorPackReport report = packAsset(t, o, in, out, handover, &flake_bytes);
-    // The gate runs before anything is in place: a failure leaves no output.
-    const GatedError gated = gatedError(report, handover);
-    checkMaxError(report, gated, o.max_error, o.input);
-    const std::vector<std::string> warnings = qualityWarnings(report, gated, o.tensor.error_target, o.pack.cp.rank);
-    const Json flakes = flake_bytes > 0 ? cli::flakesJson(handover, flake_bytes) : Json(nullptr);
-    writeAsset(t, o, in, params, report, flakes, out);
+    std::vector<uint8_t> flakes;
+    const tensor::TensorPackReport report = packAsset(t, o, in, out, &flakes);
+    const cli::TensorAssetResult done = writeAsset(o, in, report, flakes, metadata, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    printReport(t, o, in, params, report, gated, warnings, out.bytesWritten(), seconds);
+    printReport(t, o, in, params, report, done.gated, done.warnings, out.bytesWritten(), seconds);
     return cli::kExitOk;
   });
 }

@@ -11,6 +11,7 @@
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/ingest_options.h>
 #include <glintbake/cli/pyramid_options.h>
+#include <glintbake/cli/shard_output.h>
 #include <glintbake/cli/tensor_options.h>
 #include <glintbake/cli/tool.h>
 #include <glintbake/format/kinds/wang.h>
@@ -49,6 +50,7 @@ struct Options {
     t.exact_mib = 4.0;
     return t;
   }();
+  cli::ShardCliOptions shard;
 };
 
 void addOptions(CLI::App& app, Options& o) {
@@ -67,6 +69,7 @@ void addOptions(CLI::App& app, Options& o) {
   cli::addTensorPackOptions(app, o.tensor, "--cp-seed");
   cli::addPyramidOptions(app, o.pyramid, "Footprint centres per group side (1..256)");
   cli::addIngestOptions(app, o.ingest);
+  cli::addShardOption(app, o.shard);
 }
 
 // The pyramid and hand-over of every tile: levels up to the largest footprint (unless --levels),
@@ -160,6 +163,9 @@ int main(int argc, char** argv) {
                   "--block " + std::to_string(o.tensor.pack.block) + " must divide --ndf-res " + std::to_string(res));
     if (!o.atlas.empty() && bake::imageExtension(o.atlas).empty())
       throw Error(cli::kExitBadArguments, "--atlas needs an image extension (.exr, .png, ...)");
+    cli::resolveShardOption(o.shard);
+    if (o.shard.active() && !o.atlas.empty())
+      throw Error(cli::kExitBadArguments, "--atlas is written by the bake without --shard");
     Plan plan = planTiles(o);
 
     bake::IngestReport ingest_report;
@@ -201,12 +207,37 @@ int main(int argc, char** argv) {
     Json tile_meta = t.makeMetadata(tile_kind, params);
     tile_meta["asset"] = {{"wang_tile_margin", plan.margin}};
     const std::string tile_meta_text = tile_meta.dump();
+    // The container: record, edges, texels, then the tiles' assets in tile order; its metadata
+    // depends on the options and the tile set only, so every shard of a sharded bake knows it.
+    const format::WangRecord rec =
+        wang::wangRecord(set, nopt, o.grid_seed, plan.flakes_up_to, plan.pyramid_from, plan.max_sigma);
+    Json asset;
+    asset["tile_count"] = set.tile_count;
+    asset["tile_size"] = set.tile_size;
+    asset["colors"] = set.colors;
+    asset["ndf_res"] = res;
+    asset["max_sigma"] = plan.max_sigma;
+    asset["flakes_up_to"] = plan.flakes_up_to;
+    asset["pyramid_from"] = plan.pyramid_from;
+    asset["levels"] = o.pyramid.options.levels;  // every tile's pyramid has exactly these
+    asset["seam"] = seamJson(set.seam);
+    asset["plain_seam"] = seamJson(set.plain_seam);
+    Json meta = t.makeMetadata(format::AssetKind::kWangTiles, params);
+    meta["asset"] = asset;
+
+    // One unit per tile (equal cost), dealt out as libbake/shard/shard.h does.
+    std::vector<int> owners(size_t(set.tile_count), 0);
+    if (o.shard.active())
+      owners = bake::shard::assignShards(std::vector<double>(size_t(set.tile_count), 1.0), o.shard.spec.count);
+    const int me = o.shard.active() ? o.shard.spec.index : 0;
     std::vector<std::vector<uint8_t>> tile_bytes(size_t(set.tile_count));
     TileTotals totals;
+    uint64_t units = 0;
     const auto t_ndf = std::chrono::steady_clock::now();
     {
       std::unique_ptr<cli::Progress> bar = t.progress("tiles", uint64_t(set.tile_count));
       for (int i = 0; i < set.tile_count; ++i) {
+        if (owners[size_t(i)] != me) continue;
         const std::string path = o.output + ".tile" + std::to_string(i) + ".tmp";
         cli::registerTemporary(path);
         wang::WangTileNdfReport rep;
@@ -214,16 +245,58 @@ int main(int argc, char** argv) {
             wang::bakeWangTileNdf(set, i, nopt, path, tile_meta_text, &tile_bytes[size_t(i)], &rep);
         std::remove(path.c_str());
         cli::unregisterTemporary(path);
-        if (!s) throw Error(cli::exitCodeOf(s.error()), o.input + ": tile " + std::to_string(i) + ": " + s.error().message);
+        if (!s)
+          throw Error(cli::exitCodeOf(s.error()), o.input + ": tile " + std::to_string(i) + ": " + s.error().message);
         addTile(totals, rep, tile_bytes[size_t(i)].size(), o.uncompressed);
+        if (totals.levels != o.pyramid.options.levels)
+          throw Error(cli::kExitRuntime, o.input + ": tile " + std::to_string(i) + " has " +
+                                             std::to_string(totals.levels) + " levels, not the planned " +
+                                             std::to_string(o.pyramid.options.levels));
+        ++units;
         if (bar) bar->advance();
       }
     }
     const double ndf_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ndf).count();
+    if (o.shard.active()) {
+      // The shard's partial: the common sections at their positions in every part, its own tiles'
+      // assets at theirs; glintinfo merge copies them back in order.
+      cli::ShardOutput part(t, o.output, o.shard.spec, o.tensor.zstd_level);
+      const std::vector<wang::WangSection> common = cli::unwrap(wang::wangCommonSections(set, rec));
+      for (const wang::WangSection& c : common)
+        cli::check(part.partial().add(c.type, 0, c.bytes.data(), c.bytes.size(), /*common=*/true));
+      for (int i = 0; i < set.tile_count; ++i) {
+        if (owners[size_t(i)] != me) {
+          part.partial().skip();
+          continue;
+        }
+        cli::check(part.partial().add(format::kSectionWangTileNdf, uint64_t(i), tile_bytes[size_t(i)].data(),
+                                      tile_bytes[size_t(i)].size()));
+      }
+      part.finish(meta, format::AssetKind::kWangTiles, units, uint64_t(set.tile_count));
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (t.common().json) {
+        Json doc;
+        doc["tool"] = "wangtile";
+        doc["output"] = cli::baseName(o.output);
+        doc["kind"] = "partial";
+        doc["shard"] = {{"index", o.shard.spec.index}, {"count", o.shard.spec.count}};
+        doc["units"] = units;
+        doc["units_total"] = set.tile_count;
+        doc["estimated_cost_share"] = double(units) / double(set.tile_count);
+        doc["sections_held"] = part.partial().held();
+        doc["positions"] = part.partial().positions();
+        doc["file_bytes"] = part.bytesWritten();
+        doc["seconds"] = seconds;
+        t.printJson(doc);
+      } else {
+        t.info("wrote " + o.output + ": shard " + std::to_string(o.shard.spec.index) + "/" +
+               std::to_string(o.shard.spec.count) + " of a wang-tiles asset, " + std::to_string(units) + " of " +
+               std::to_string(set.tile_count) + " tiles, " + std::to_string(part.bytesWritten()) + " bytes in " +
+               std::to_string(seconds) + " s");
+      }
+      return cli::kExitOk;
+    }
 
-    // The container: record, edges, texels, then the tiles' assets in tile order.
-    const format::WangRecord rec =
-        wang::wangRecord(set, nopt, o.grid_seed, plan.flakes_up_to, plan.pyramid_from, plan.max_sigma);
     cli::ContainerOutput out(t, o.output, format::AssetKind::kWangTiles, o.tensor.zstd_level);
     if (bake::BakeStatus s = wang::writeWangSections(out.writer(), set, rec, tile_bytes); !s)
       throw Error(cli::exitCodeOf(s.error()), o.output + ": " + s.error().message);
@@ -236,19 +309,6 @@ int main(int argc, char** argv) {
     const double ndf_bytes_per_texel = double(totals.ndf_bytes) / (double(set.tile_count) * E * E);
     const double map16k = 16384.0 * 16384.0;
     const double map16k_bytes = map16k * (ndf_bytes_per_texel + 8.0);
-    Json asset;
-    asset["tile_count"] = set.tile_count;
-    asset["tile_size"] = set.tile_size;
-    asset["colors"] = set.colors;
-    asset["ndf_res"] = res;
-    asset["max_sigma"] = plan.max_sigma;
-    asset["flakes_up_to"] = plan.flakes_up_to;
-    asset["pyramid_from"] = plan.pyramid_from;
-    asset["levels"] = totals.levels;
-    asset["seam"] = seamJson(set.seam);
-    asset["plain_seam"] = seamJson(set.plain_seam);
-    Json meta = out.makeMetadata(params);
-    meta["asset"] = asset;
     out.finish(meta);
 
     if (!o.atlas.empty()) {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <glintbake/cli/shard_output.h>
+#include <glintbake/format/kinds/partial.h>
 
 #include <algorithm>
 #include <cmath>
@@ -99,8 +100,12 @@ ShardOutput::ShardOutput(Tool& tool, const std::string& path, const bake::shard:
       out_(tool, path, format::AssetKind::kPartial, 3),
       partial_(out_.writer(), zstd_level) {}
 
-void ShardOutput::finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units,
-                         uint64_t units_total) {
+void ShardOutput::addUnit(uint64_t unit, const void* data, size_t size) {
+  out_.addSection(format::kSectionShardUnit, unit, data, size);
+}
+
+void ShardOutput::finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units, uint64_t units_total,
+                         const Json& assembly) {
   const std::string text = asset_metadata.dump();
   out_.addSection(format::kSectionShardMetadata, 0, text.data(), text.size());
   Json params = asset_metadata.value("parameters", Json::object());
@@ -116,6 +121,7 @@ void ShardOutput::finish(const Json& asset_metadata, format::AssetKind asset_kin
   asset["units_total"] = units_total;
   asset["zstd_level"] = zstd_level_;
   asset["asset_metadata_hash"] = format::hash128Hex(text.data(), text.size());
+  if (!assembly.is_null()) asset["assembly"] = assembly;
   meta["asset"] = asset;
   out_.finish(meta);
 }

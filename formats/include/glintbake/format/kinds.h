@@ -7,6 +7,7 @@
 #pragma once
 
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/partial.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -56,7 +57,7 @@ constexpr KindInfo kKindRegistry[] = {
     {AssetKind::kWangTiles, "wang-tiles", 96, 111, "wangtile"},
     {AssetKind::kTinyExample, "tiny-example", 112, 127, "tinyexample"},
     {AssetKind::kGlitter, "glitter", 128, 143, "ndfgen"},
-    {AssetKind::kPartial, "partial", 144, 159, "ndfgen --shard"},
+    {AssetKind::kPartial, "partial", 144, 159, "ndfgen, tensorpack, wangtile --shard"},
     {AssetKind::kTest, "test", 0, 0, ""},
 };
 
@@ -90,6 +91,8 @@ constexpr SectionTypeInfo kSectionTypeRegistry[] = {
     {kSectionGlitterIntegrals, "glitter-integrals"},
     {kSectionShardMetadata, "shard-metadata"},
     {kSectionShardSection, "shard-section"},
+    {kSectionShardUnit, "shard-unit"},
+    {kSectionShardLevels, "shard-levels"},
     {kSectionImage, "image"},
 };
 

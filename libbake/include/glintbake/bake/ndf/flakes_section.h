@@ -58,4 +58,10 @@ BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int 
 Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
                                                 const FlakesHandover& handover);
 
+// Rewrites the hand-over of a flakes section's record in place (and its version to the current
+// one), as flakesSectionBytes would have written it with `handover`: tools whose hand-over depends
+// on the finished pyramid (tensorpack, and the merge of its shards) write the section through this.
+// kInvalidInput when the section is truncated or the record fails format::checkFlakesRecord.
+BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover& handover);
+
 }  // namespace glintbake::bake::ndf

@@ -134,6 +134,16 @@ BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions&
                                 const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,
                                 const ndf::PyramidProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
 
+// The same into any TensorRegionConsumer (tensor_assembly.h) instead of a writer: a sharded bake
+// passes pyramid.region_filter and a consumer that records its regions' results (the regions the
+// filter refuses reach it as skipRegion). The consumer is not finished; the report holds timings
+// and the pyramid's report only.
+class TensorRegionConsumer;
+BakeStatus packTensorNdfFromMap(const NormalMap& map, const ndf::PyramidOptions& pyramid,
+                                const TensorPackOptions& options, TensorRegionConsumer& consumer,
+                                TensorPackReport* report, const ndf::PyramidProgress& progress = {},
+                                const std::atomic<bool>* cancel = nullptr);
+
 // The same from a procedural source of NDF images (ndf::FootprintImageSource, e.g. glitter).
 BakeStatus packTensorNdfFromSource(const ndf::FootprintImageSource& source, const ndf::PyramidOptions& pyramid,
                                    const TensorPackOptions& options, format::Writer& writer, TensorPackReport* report,

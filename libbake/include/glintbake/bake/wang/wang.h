@@ -111,4 +111,13 @@ format::WangRecord wangRecord(const WangTileSet& set, const WangNdfOptions& opti
 BakeStatus writeWangSections(format::Writer& writer, const WangTileSet& set, const format::WangRecord& record,
                              const std::vector<std::vector<uint8_t>>& tile_assets);
 
+// The sections before the tiles' assets (record, edges, texels), in the order writeWangSections
+// adds them: for writers that place them themselves (sharded bakes). kBadArgument when the record
+// fails its check or its tile count differs from the set's.
+struct WangSection {
+  uint32_t type = 0;
+  std::vector<uint8_t> bytes;
+};
+Result<std::vector<WangSection>> wangCommonSections(const WangTileSet& set, const format::WangRecord& record);
+
 }  // namespace glintbake::bake::wang

@@ -38,6 +38,10 @@ class PyramidShardPlan {
   size_t units() const { return owners_.size(); }
   int owner(int level, int region) const;
   int flakesOwner() const { return flakes_owner_; }  // -1 without a flakes unit
+  // The unit number of a region (level-major, region order; shard-unit keys) and of the flakes
+  // (the last unit; -1 without one).
+  uint64_t unit(int level, int region) const { return level_base_[size_t(level)] + uint64_t(region); }
+  int64_t flakesUnit() const { return flakes_owner_ < 0 ? -1 : int64_t(owners_.size()) - 1; }
   // Units of shard i and their summed cost estimate.
   uint64_t unitsOf(int shard) const;
   double costOf(int shard) const;
@@ -61,8 +65,15 @@ class ShardOutput {
   ShardOutput(Tool& tool, const std::string& path, const bake::shard::ShardSpec& spec, int zstd_level);
 
   bake::shard::PartialWriter& partial() { return partial_; }
-  // asset_metadata: exactly the metadata the one-machine bake writes; units: this shard's units.
-  void finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units, uint64_t units_total);
+  // The partial container itself (replayed partials write their shard-unit sections through it).
+  format::Writer& writer() { return out_.writer(); }
+  // A unit's results as one shard-unit section (zstd).
+  void addUnit(uint64_t unit, const void* data, size_t size);
+  // asset_metadata: exactly the metadata the one-machine bake writes (replayed partials: what the
+  // merge completes); units: this shard's units. assembly (replayed partials): what the merge needs
+  // to replay the final assembly, recorded as the shard description's `assembly`.
+  void finish(const Json& asset_metadata, format::AssetKind asset_kind, uint64_t units, uint64_t units_total,
+              const Json& assembly = nullptr);
   uint64_t bytesWritten() const { return out_.bytesWritten(); }
 
  private:
