@@ -80,7 +80,9 @@ void packShard(const NormalMap& map, int i, int n, const std::string& path) {
 std::vector<uint8_t> section(const format::Reader& r, uint32_t type, uint64_t key) {
   std::vector<uint8_t> bytes;
   const int idx = r.find(type, key);
-  if (idx >= 0) EXPECT_EQ(r.readSection(size_t(idx), &bytes), format::ContainerStatus::kOk);
+  if (idx >= 0) {
+    EXPECT_EQ(r.readSection(size_t(idx), &bytes), format::ContainerStatus::kOk);
+  }
   return bytes;
 }
 
