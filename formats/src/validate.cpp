@@ -328,16 +328,11 @@ void noteGlitterPayload(size_t index, const SectionInfo& s, const Payload& raw, 
 }
 
 // The layout of a glitter asset: one valid record and one integral table of its integral_count.
-void checkGlitterLayout(const GlitterSeen& seen, std::vector<ValidationMessage>* messages) {
-  if (seen.info != 1) {
+void checkGlitterSections(const GlitterSeen& seen, std::vector<ValidationMessage>* messages) {
+  if (const char* why = checkGlitterLayout(size_t(seen.info), size_t(seen.tables))) {
     addError(messages, 6007,
-             "a glitter asset holds " + std::to_string(seen.info) + " glitter-info sections (type 128), not one");
-    return;
-  }
-  if (seen.tables != 1) {
-    addError(
-        messages, 6007,
-        "a glitter asset holds " + std::to_string(seen.tables) + " glitter-integrals sections (type 129), not one");
+             std::string(why) + "; this one holds " + std::to_string(seen.info) + " glitter-info and " +
+                 std::to_string(seen.tables) + " glitter-integrals sections");
     return;
   }
   if (seen.record_ok && seen.table_entries >= 0 && uint64_t(seen.table_entries) != seen.record.integral_count)
@@ -620,7 +615,7 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
   if (kind == AssetKind::kTinyExample && index_sound && options.check_payloads)
     checkTinyExampleLayout(sections, tiny, &report.messages);
   if (kind == AssetKind::kGlitter && index_sound && options.check_payloads)
-    checkGlitterLayout(glitter, &report.messages);
+    checkGlitterSections(glitter, &report.messages);
   uint32_t first = 0, last = 0;
   if (kindTypeRange(kind, &first, &last) && std::none_of(sections.begin(), sections.end(), [&](const SectionInfo& s) {
         return s.type >= first && s.type <= last;

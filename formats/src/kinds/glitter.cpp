@@ -40,6 +40,12 @@ const char* checkGlitterRecord(const GlitterRecord& r) {
   return nullptr;
 }
 
+const char* checkGlitterLayout(size_t info_sections, size_t integral_sections) {
+  if (info_sections != 1) return "a glitter asset holds one glitter-info section (type 128)";
+  if (integral_sections != 1) return "a glitter asset holds one glitter-integrals section (type 129)";
+  return nullptr;
+}
+
 const char* checkGlitterIntegrals(const GlitterIntegral* t, size_t count) {
   if (!t || count < 4 || count > kMaxGlitterIntegrals) return "glitter integrals: entry count out of range";
   size_t next = 4;  // the first child index the next parent must have

@@ -50,13 +50,13 @@ RuntimeStatus GlitterNdf::load(const format::Reader& reader) {
   table_.reset();
   if (reader.kind() == format::AssetKind::kPartial) return RuntimeStatus::kPartialBake;
   if (reader.kind() != format::AssetKind::kGlitter) return RuntimeStatus::kWrongKind;
-  // Exactly one record and one table (SPEC.md 10.6), as glintinfo validate requires (6007).
+  // The layout rule glintinfo validate applies too (6007): one record and one table.
   size_t infos = 0, tables = 0;
   for (const format::SectionInfo& s : reader.sections()) {
     infos += s.type == format::kSectionGlitterInfo;
     tables += s.type == format::kSectionGlitterIntegrals;
   }
-  if (infos != 1 || tables != 1) return RuntimeStatus::kInvalidAsset;
+  if (format::checkGlitterLayout(infos, tables)) return RuntimeStatus::kInvalidAsset;
   format::GlitterRecord rec;
   if (RuntimeStatus s = readExact(reader, format::kSectionGlitterInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
     return s;

@@ -58,6 +58,13 @@ TEST(GlitterIntegrals, TableIsValidAndSumsToOne) {
   EXPECT_NE(format::checkGlitterIntegrals(table.data(), table.size()), nullptr);
 }
 
+// The section layout rule shared by the runtime's loader and the validator: one of each.
+TEST(GlitterIntegrals, LayoutIsOneRecordAndOneTable) {
+  EXPECT_EQ(format::checkGlitterLayout(1, 1), nullptr);
+  for (size_t infos : {0u, 2u}) EXPECT_NE(format::checkGlitterLayout(infos, 1), nullptr) << infos;
+  for (size_t tables : {0u, 3u}) EXPECT_NE(format::checkGlitterLayout(1, tables), nullptr) << tables;
+}
+
 TEST(GlitterHierarchy, CountsAreConservedAtEverySplit) {
   for (uint64_t n : {uint64_t(5), uint64_t(1000), uint64_t(1000000000)}) {
     bake::glitter::GlitterModel model(params(n, 0.2));

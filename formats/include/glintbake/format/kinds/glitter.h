@@ -68,4 +68,9 @@ const char* checkGlitterRecord(const GlitterRecord& record);
 // 1e-6) and the roots summing to 1 within 1e-3. Null when valid. Safe on untrusted input.
 const char* checkGlitterIntegrals(const GlitterIntegral* table, size_t count);
 
+// Checks the section layout of a glitter asset against SPEC.md 10.6: exactly one glitter-info
+// section and one glitter-integrals section, given how many of each the container holds. Null when
+// it fits, otherwise which of the two is not there exactly once.
+const char* checkGlitterLayout(size_t info_sections, size_t integral_sections);
+
 }  // namespace glintbake::format
