@@ -172,6 +172,146 @@ TinyExampleNdf::Frame makeFrame(const double m[4]) {
 
 const double kIdentity[4] = {1.0, 0.0, 0.0, 1.0};
 
+// ---------------------------------------------------------------------------------------------
+// Overlapping layouts: the examples that may take points of one example, and the share of a tile
+// the example owns under the nearest-centre rule (format::tinyNearer).
+
+constexpr int kMaxNeighbours = (4 * format::kMaxTinyOverlapReach + 1) * (4 * format::kMaxTinyOverlapReach + 1);
+
+struct Neighbour {
+  format::TinyPlacement p;
+  double box[4];  // x0, x1, y0, y1 of its square on the plane
+};
+
+struct OwnedExample {
+  format::TinyPlacement self;
+  Neighbour others[kMaxNeighbours];
+  int count = 0;
+};
+
+// Bounding box of the example's square on the plane.
+void exampleBox(const format::TinyExampleRecord& r, const format::TinyPlacement& p, double box[4]) {
+  const double half = 0.5 * double(r.example_size);
+  const double ex = (std::fabs(p.matrix[0]) + std::fabs(p.matrix[1])) * half;
+  const double ey = (std::fabs(p.matrix[2]) + std::fabs(p.matrix[3])) * half;
+  box[0] = p.centre[0] - ex;
+  box[1] = p.centre[0] + ex;
+  box[2] = p.centre[1] - ey;
+  box[3] = p.centre[1] + ey;
+}
+
+bool boxesMeet(const double a[4], const double b[4]) {
+  return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3];
+}
+
+// The examples whose squares meet p's (their cells lie within twice the reach of p's cell). False
+// when there are none: p owns all of its square.
+bool gatherNeighbours(const format::TinyExampleRecord& r, const format::TinyLayout* layout,
+                      const format::TinyPlacement& p, int reach, OwnedExample* out) {
+  out->self = p;
+  out->count = 0;
+  double own[4];
+  exampleBox(r, p, own);
+  const int span = 2 * reach;
+  for (int64_t j = p.cell_y - span; j <= p.cell_y + span; ++j) {
+    for (int64_t i = p.cell_x - span; i <= p.cell_x + span; ++i) {
+      if (i == p.cell_x && j == p.cell_y) continue;
+      const format::TinyPlacement q = format::tinyCellPlacement(r, i, j, layout);
+      if (!q.present) continue;
+      Neighbour& nb = out->others[out->count];
+      exampleBox(r, q, nb.box);
+      if (!boxesMeet(own, nb.box)) continue;
+      nb.p = q;
+      ++out->count;
+    }
+  }
+  return out->count > 0;
+}
+
+double dist2(const double c[2], double x, double y) {
+  const double dx = x - c[0], dy = y - c[1];
+  return dx * dx + dy * dy;
+}
+
+// The plane point of example frame point (vx, vy).
+void toPlane(const format::TinyExampleRecord& r, const format::TinyPlacement& p, double vx, double vy, double* x,
+             double* y) {
+  const double h = 0.5 * double(r.example_size);
+  *x = p.centre[0] + p.matrix[0] * (vx - h) + p.matrix[1] * (vy - h);
+  *y = p.centre[1] + p.matrix[2] * (vx - h) + p.matrix[3] * (vy - h);
+}
+
+// Whether the example owns the plane point (x, y) of its own square.
+bool ownsPoint(const format::TinyExampleRecord& r, const OwnedExample& e, double x, double y) {
+  const double de = dist2(e.self.centre, x, y);
+  double local[2];
+  for (int k = 0; k < e.count; ++k) {
+    const Neighbour& nb = e.others[k];
+    if (x < nb.box[0] || x > nb.box[1] || y < nb.box[2] || y > nb.box[3]) continue;
+    if (format::tinyNearer(de, e.self, dist2(nb.p.centre, x, y), nb.p)) continue;
+    if (format::tinyContains(r, nb.p, x, y, local)) return false;
+  }
+  return true;
+}
+
+enum class Ownership { kFull, kNone, kMixed };
+
+// The tile [x0, x0 + t]^2 of the example's frame: owned wholly, taken wholly by one other example,
+// or shared. Half-planes of nearer points and the squares are convex: the corners decide.
+Ownership classifyTile(const format::TinyExampleRecord& r, const OwnedExample& e, double x0, double y0, double t) {
+  double cx[4], cy[4], quad[4] = {1e300, -1e300, 1e300, -1e300};
+  for (int k = 0; k < 4; ++k) {
+    toPlane(r, e.self, x0 + (k & 1) * t, y0 + (k >> 1) * t, &cx[k], &cy[k]);
+    quad[0] = std::min(quad[0], cx[k]);
+    quad[1] = std::max(quad[1], cx[k]);
+    quad[2] = std::min(quad[2], cy[k]);
+    quad[3] = std::max(quad[3], cy[k]);
+  }
+  bool mixed = false;
+  double local[2];
+  for (int k = 0; k < e.count; ++k) {
+    const Neighbour& nb = e.others[k];
+    if (!boxesMeet(quad, nb.box)) continue;
+    int self_wins = 0, inside = 0;
+    for (int c = 0; c < 4; ++c) {
+      self_wins +=
+          format::tinyNearer(dist2(e.self.centre, cx[c], cy[c]), e.self, dist2(nb.p.centre, cx[c], cy[c]), nb.p) ? 1
+                                                                                                                 : 0;
+      inside += format::tinyContains(r, nb.p, cx[c], cy[c], local) ? 1 : 0;
+    }
+    if (self_wins == 4) continue;
+    if (self_wins == 0 && inside == 4) return Ownership::kNone;
+    mixed = true;
+  }
+  return mixed ? Ownership::kMixed : Ownership::kFull;
+}
+
+// The footprint-weighted share of the tile the example owns, from s x s points of the tile.
+double ownedShare(const format::TinyExampleRecord& r, const OwnedExample& e, const Gauss& g, double x0, double y0,
+                  double t, int s) {
+  const double det = g.cxx * g.cyy - g.cxy * g.cxy;
+  const double ixx = g.cyy / det, ixy = -g.cxy / det, iyy = g.cxx / det;
+  double total = 0.0, owned = 0.0;
+  int count = 0, owned_count = 0;
+  for (int b = 0; b < s; ++b) {
+    for (int a = 0; a < s; ++a) {
+      const double vx = x0 + (a + 0.5) * t / s, vy = y0 + (b + 0.5) * t / s;
+      const double dx = vx - g.mx, dy = vy - g.my;
+      const double w = det > 0.0 ? std::exp(-0.5 * (ixx * dx * dx + 2.0 * ixy * dx * dy + iyy * dy * dy)) : 0.0;
+      double x, y;
+      toPlane(r, e.self, vx, vy, &x, &y);
+      const bool mine = ownsPoint(r, e, x, y);
+      total += w;
+      ++count;
+      if (mine) {
+        owned += w;
+        ++owned_count;
+      }
+    }
+  }
+  return total > 1e-300 ? owned / total : double(owned_count) / double(count);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -226,6 +366,48 @@ void TransformedExampleTexels::normal(int x, int y, float out[2]) const {
   const double a0 = m_[0], a1 = -m_[1], a2 = -m_[2], a3 = m_[3];
   out[0] = float(a0 * t[0] + a1 * t[1]);
   out[1] = float(a2 * t[0] + a3 * t[1]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// A rectangle of the plane as a normal map.
+
+TinyPlaneTexels::TinyPlaneTexels(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int width, int height)
+    : asset_(asset), x0_(x0), y0_(y0), width_(std::max(1, width)), height_(std::max(1, height)) {}
+
+bool TinyPlaneTexels::texel(int x, int y, float out[2]) const {
+  out[0] = out[1] = 0.0f;
+  const float* texels = asset_.texels();
+  if (!texels) return false;
+  const format::TinyExampleRecord& r = asset_.record();
+  const int n = int(r.example_size);
+  double local[2];
+  const format::TinyPlacement p =
+      format::tinyOwner(r, double(x0_ + x) + 0.5, double(y0_ + y) + 0.5, local, asset_.layout());
+  if (!p.present) return false;
+  // Bilinear between the texel centres (k + 1/2), the example repeating with its size.
+  const double fx = local[0] - 0.5, fy = local[1] - 0.5;
+  const double ix = std::floor(fx), iy = std::floor(fy);
+  const double tx = fx - ix, ty = fy - iy;
+  const int x_lo = ((int(ix) % n) + n) % n, y_lo = ((int(iy) % n) + n) % n;
+  const int x_hi = (x_lo + 1) % n, y_hi = (y_lo + 1) % n;
+  double e[2];
+  for (int c = 0; c < 2; ++c) {
+    const double a = texels[(size_t(y_lo) * n + x_lo) * 2 + c], b = texels[(size_t(y_lo) * n + x_hi) * 2 + c];
+    const double d = texels[(size_t(y_hi) * n + x_lo) * 2 + c], f = texels[(size_t(y_hi) * n + x_hi) * 2 + c];
+    // Exact at texel centres (tx = ty = 0): no rounding from the weights.
+    const double top = tx == 0.0 ? a : a + tx * (b - a), bottom = tx == 0.0 ? d : d + tx * (f - d);
+    e[c] = ty == 0.0 ? top : top + ty * (bottom - top);
+  }
+  const TinyExampleNdf::Frame frame = makeFrame(p.matrix);
+  double sx = frame.a[0] * e[0] + frame.a[1] * e[1], sy = frame.a[2] * e[0] + frame.a[3] * e[1];
+  const double len = std::sqrt(sx * sx + sy * sy);
+  if (len > kTinyMaxMaterialisedSlope) {
+    sx *= kTinyMaxMaterialisedSlope / len;
+    sy *= kTinyMaxMaterialisedSlope / len;
+  }
+  out[0] = float(sx);
+  out[1] = float(sy);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -284,7 +466,7 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
       s != RuntimeStatus::kOk)
     return s;
   std::memcpy(&rec, bytes.data(), sizeof rec);
-  if (rec.magic == TinyExampleRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
+  if (rec.magic == TinyExampleRecord().magic && rec.version > 2) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkTinyExampleRecord(rec)) return RuntimeStatus::kInvalidAsset;
   const int n = int(rec.example_size), res = int(rec.ndf_res);
   if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleTexels, 0, uint64_t(n) * n * 8, &bytes);
@@ -316,6 +498,23 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
     row_mass_[l].resize(size_t(m * m) * res);
     for (size_t t = 0; t < m * m; ++t)
       tile_mass_[l][t] = rowIntegrals(levels_[l].data() + t * image, res, row_mass_[l].data() + t * res);
+  }
+  layout_ = format::TinyLayout();
+  layout_values_.clear();
+  if ((rec.flags & format::kTinyFlagLayout) != 0) {
+    const int idx = reader.find(format::kSectionTinyExampleLayout, 0);
+    if (idx < 0 || reader.sections()[size_t(idx)].raw_size < 32) return RuntimeStatus::kInvalidAsset;
+    if (RuntimeStatus s = fromFormatStatus(reader.readSection(size_t(idx), &bytes)); s != RuntimeStatus::kOk) return s;
+    format::ImageSectionHeader h;
+    if (!format::parseImageSection(bytes.data(), bytes.size(), &h) || h.layers != 1 || h.width < 1 || h.height < 1 ||
+        h.width > format::kMaxTinyLayoutSide || h.height > format::kMaxTinyLayoutSide || h.channels < 1 ||
+        h.channels > format::kMaxTinyLayoutChannels ||
+        bytes.size() != 32 + uint64_t(h.width) * h.height * h.channels * 4)
+      return RuntimeStatus::kInvalidAsset;
+    layout_values_.resize(size_t(h.width) * h.height * h.channels);
+    std::memcpy(layout_values_.data(), bytes.data() + 32, layout_values_.size() * 4);
+    layout_ = {h.width, h.height, h.channels, layout_values_.data()};
+    if (format::checkTinyLayout(layout_)) return RuntimeStatus::kInvalidAsset;
   }
   std::vector<uint8_t>().swap(bytes);
   // The flat base of stochastic layouts: N(0, sigma_r^2 I), bin-integrated.
@@ -391,6 +590,14 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
   const size_t image = size_t(r.ndf_res) * r.ndf_res;
   const int res = int(r.ndf_res);
   const double sigma = std::max(fp.sigma, kMinSigma);
+  // Overlapping layouts: the probability of the footprint on covered ground is the sum of the kept
+  // tiles' (owned) weights.
+  const bool overlap = format::tinyOverlapReach(r) > 0;
+  double owned_weight = 0.0;
+  auto emit = [&](const Visit& v) {
+    if (overlap) owned_weight += v.weight;
+    visit(v);
+  };
 
   // Descends from the top tile of one example (example frame offset ox, oy; Gaussian g).
   auto descend = [&](const Frame& frame, const Gauss& g, double ox, double oy, auto&& self, int level, int ix,
@@ -409,8 +616,8 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     }
     const int m = int(n) >> (level + 1);
     const size_t tile = size_t(iy) * size_t(m) + size_t(ix);
-    visit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
-                tile_mass_[size_t(level)][tile], w});
+    emit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
+               tile_mass_[size_t(level)][tile], w});
   };
 
   if (r.type == uint32_t(TinyExampleType::kTiled)) {
@@ -447,18 +654,22 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     return true;
   }
 
-  // Stochastic: the cells of the window, each example in its own frame, then the flat base.
+  // Stochastic: the cells of the window (overlapping layouts: and the cells whose examples reach
+  // into it), each example in its own frame, then the flat base.
   const double cell = r.cell_size;
   const double reach = kTinyWindowSigmas * sigma;
+  const int cells_out = format::tinyOverlapReach(r);
   if (!windowInRange(fp.x, reach, cell) || !windowInRange(fp.y, reach, cell)) return false;
-  const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)), i1 = int64_t(std::floor((fp.x + reach) / cell));
-  const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)), j1 = int64_t(std::floor((fp.y + reach) / cell));
+  const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)) - cells_out,
+                i1 = int64_t(std::floor((fp.x + reach) / cell)) + cells_out;
+  const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)) - cells_out,
+                j1 = int64_t(std::floor((fp.y + reach) / cell)) + cells_out;
   if (i1 - i0 >= kTinyMaxCells || j1 - j0 >= kTinyMaxCells || (i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells)
     return false;
   double covered = 0.0;
   for (int64_t j = j0; j <= j1; ++j) {
     for (int64_t i = i0; i <= i1; ++i) {
-      const format::TinyPlacement p = format::tinyCellPlacement(r, i, j);
+      const format::TinyPlacement p = format::tinyCellPlacement(r, i, j, layout());
       if (!p.present) continue;
       double inv[4];
       if (!format::tinyInvert(p.matrix, inv)) continue;
@@ -472,12 +683,47 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
       if (mx + kTinyWindowSigmas * g.sx < 0.0 || mx - kTinyWindowSigmas * g.sx > n ||
           my + kTinyWindowSigmas * g.sy < 0.0 || my - kTinyWindowSigmas * g.sy > n)
         continue;
-      covered += boxProbability(g, 0.0, n, 0.0, n);
       const Frame frame = makeFrame(p.matrix);
       if (entered) ++*entered;
-      descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+      if (!overlap) {
+        covered += boxProbability(g, 0.0, n, 0.0, n);
+        descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+        continue;
+      }
+      OwnedExample e;
+      if (!gatherNeighbours(r, layout(), p, cells_out, &e)) {
+        descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+        continue;
+      }
+      // Tiles wholly owned descend as without overlaps; tiles others take wholly are dropped; tiles
+      // on the boundary are split while the rule asks, then kept with the owned share of their weight.
+      auto owned = [&](int level, int ix, int iy, auto&& self) -> void {
+        const double t = double(2 << level);
+        const double x0 = ix * t, y0 = iy * t;
+        const double w = boxProbability(g, x0, x0 + t, y0, y0 + t);
+        if (!(w > kNegligible)) return;
+        const Ownership own = classifyTile(r, e, x0, y0, t);
+        if (own == Ownership::kNone) return;
+        if (own == Ownership::kFull) {
+          descend(frame, g, 0.0, 0.0, descend, level, ix, iy);
+          return;
+        }
+        const double dx = x0 + 0.5 * t - g.mx, dy = y0 + 0.5 * t - g.my;
+        if (level > 0 && w * t * (std::sqrt(dx * dx + dy * dy) + t) > kTinyRefine * g.lambda_min) {
+          for (int c = 0; c < 4; ++c) self(level - 1, 2 * ix + (c & 1), 2 * iy + (c >> 1), self);
+          return;
+        }
+        const double share = ownedShare(r, e, g, x0, y0, t, level > 0 ? 8 : 4);
+        if (!(share > 0.0)) return;
+        const int m = int(n) >> (level + 1);
+        const size_t tile = size_t(iy) * size_t(m) + size_t(ix);
+        emit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
+                   tile_mass_[size_t(level)][tile], w * share});
+      };
+      owned(top, 0, 0, owned);
     }
   }
+  if (overlap) covered = owned_weight;
   const double rest = 1.0 - covered;
   if (rest > kNegligible) {
     static const Frame base_frame = makeFrame(kIdentity);

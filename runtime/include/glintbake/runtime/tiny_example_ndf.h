@@ -83,6 +83,36 @@ class TransformedExampleTexels final : public TexelSource {
   double off_[2];
 };
 
+class TinyExampleNdf;
+
+// Largest |(n_x, n_y)| a materialised texel keeps: a slope the transform pushes out of the unit disk
+// (scales below 1 steepen slopes) is shortened to this length, keeping its direction.
+constexpr double kTinyMaxMaterialisedSlope = 0.999;
+
+// The texels [x0, x0 + width) x [y0, y0 + height) of an asset's plane (texels, y down) as a normal
+// map: the surface the asset answers for, for the reference evaluator and the renderer. Texel
+// (x, y) is the plane point p = (x0 + x + 1/2, y0 + y + 1/2): the example owning p (format::tinyOwner)
+// is read at p's position in its frame, bilinearly between texel centres with the example repeating
+// (so a transform that maps the texel grid onto itself reproduces the texels exactly), and its
+// (n_x, n_y) is mapped by A = F M^-T F as the runtime maps slopes (at most
+// kTinyMaxMaterialisedSlope long); points no example owns are flat (0, 0). Continues with its edge
+// texels beyond the rectangle. The asset must be open and outlive the source.
+class TinyPlaneTexels final : public TexelSource {
+ public:
+  TinyPlaneTexels(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int width, int height);
+  int width() const override { return width_; }
+  int height() const override { return height_; }
+  bool repeats() const override { return false; }
+  void normal(int x, int y, float out[2]) const override { texel(x, y, out); }
+  // normal(), and whether an example owns the texel (false: flat).
+  bool texel(int x, int y, float out[2]) const;
+
+ private:
+  const TinyExampleNdf& asset_;
+  int64_t x0_, y0_;
+  int width_, height_;
+};
+
 class TinyExampleNdf final : public NdfSource {
  public:
   TinyExampleNdf();
@@ -97,6 +127,10 @@ class TinyExampleNdf final : public NdfSource {
   bool isOpen() const { return open_; }
 
   const format::TinyExampleRecord& record() const { return record_; }
+  // The example's n * n (n_x, n_y) texels (row-major), or null when closed.
+  const float* texels() const { return open_ ? texels_.data() : nullptr; }
+  // The stochastic layout image (format::TinyLayout), or null when the asset has none.
+  const format::TinyLayout* layout() const { return open_ && layout_.values ? &layout_ : nullptr; }
   // The stored tile image of (level, tile index row-major) (R * R floats), or null.
   const float* tileImage(int level, int tile) const;
   bool hasFlakes() const { return flakes_ && flakes_->isBuilt(); }
@@ -139,7 +173,9 @@ class TinyExampleNdf final : public NdfSource {
   std::vector<std::vector<float>> levels_;  // per level: tiles^2 images of R^2
   std::vector<std::vector<double>> tile_mass_;
   std::vector<std::vector<double>> row_mass_;  // per level: tiles^2 x R row integrals
-  std::vector<float> base_;                    // the flat lobe (stochastic surfaces)
+  std::vector<float> layout_values_;           // section 115 (version 2 with a layout)
+  format::TinyLayout layout_;
+  std::vector<float> base_;  // the flat lobe (stochastic surfaces)
   std::vector<double> base_rows_;
   double base_mass_ = 0.0;
   std::unique_ptr<FlakeNdf> flakes_;
