@@ -202,6 +202,26 @@ inline std::vector<uint8_t> tinyLevel(uint32_t level) {
   });
 }
 
+// --- tiny-example, record version 2 (SPEC 10.8): the same example, texels and levels, stochastic
+// with flags layout | overlap: seed 7, density 0.5, cell 2 texels, occupancy 1, rotations 0-180
+// degrees, scale 1, and a 2 x 1 layout of two channels (presence 1 and 0, rotation 0.5 and 0). --
+
+inline std::vector<uint8_t> tinyRecordV2() {
+  Bytes b(168);
+  b.u32(0, 0x594E5447).u32(4, 2).u32(8, 4).u32(12, 2).u32(16, 4).u32(20, 1).u32(24, 3).u32(28, 0);
+  b.f64(32, 0.05);
+  b.f64(40, 1.0).f64(48, 0.0).f64(56, 0.0).f64(64, 1.0);  // matrix
+  b.u64(88, 7).f64(96, 0.5).f64(104, 2.0).f64(112, 1.0);  // seed, density, cell_size, occupancy
+  b.f64(120, 0.0).f64(128, 180.0);                        // rotate_range
+  b.f64(136, 1.0).f64(144, 1.0);                          // scale_range
+  return b.bytes();
+}
+
+inline std::vector<uint8_t> tinyLayoutV2() {
+  const float values[2][2] = {{1.0f, 0.5f}, {0.0f, 0.0f}};
+  return imageSection(2, 1, 2, 1, [&values](uint32_t x, uint32_t, uint32_t c, uint32_t) { return values[x][c]; });
+}
+
 }  // namespace glintbake::format::frozen
 
 namespace glintbake::format::frozen {
