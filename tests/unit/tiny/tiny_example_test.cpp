@@ -6,6 +6,7 @@
 #include <glintbake/bake/tiny/tiny_example.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/format/validate.h>
 #include <glintbake/reference/flakes.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/layered_brdf.h>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -372,6 +374,118 @@ TEST(TinyExample, OverlappingCoverageIsANearestCentrePartition) {
     ASSERT_EQ(asset->mass({123.0, 45.0, 40.0}, &mass), RuntimeStatus::kOk);
     EXPECT_NEAR(mass, 1.0, 0.02);
   }
+}
+
+// A layout image is part of the asset: the validator and the runtime refuse a record asking for one
+// without it, a layout the record does not ask for, and layout values outside [0, 1].
+TEST(TinyExample, LayoutSectionIsValidated) {
+  const bake::NormalMap map = example(8);
+  const std::vector<float> texels = bake::tiny::tinyTexels(map);
+  const auto levels = bake::tiny::bakeTinyLevels(texels, 8, kSigmaR, 8);
+  std::vector<float> values = {1.0f, 0.25f, 0.0f, 0.75f, 0.5f, 1.0f};  // 3 x 1 cells, 2 channels
+  TinyPlacementOptions p;
+  p.type = format::TinyExampleType::kStochastic;
+  p.rotate_range[1] = 90.0;
+  p.layout = {3, 1, 2, values.data()};
+  const auto rec = bake::tiny::makeTinyRecord(8, 8, kSigmaR, p);
+  ASSERT_TRUE(rec.ok()) << rec.error().message;
+  EXPECT_EQ(rec.value().version, 2u);
+  EXPECT_EQ(rec.value().flags, format::kTinyFlagLayout);
+  EXPECT_EQ(rec.value().occupancy, 1.0);
+  // Presence 1, 0, 0.5: half the covered fraction of a full layout.
+  format::TinyExampleRecord full = rec.value();
+  full.flags = 0;
+  full.version = 1;
+  EXPECT_NEAR(format::tinyCoveredFraction(rec.value(), &p.layout), 0.5 * format::tinyCoveredFraction(full), 1e-12);
+  // Writes the sections by hand, so that a record and its layout section can disagree.
+  auto write = [&](const std::string& name, const format::TinyExampleRecord& r, const std::vector<float>* layout) {
+    const std::string path = glintbake::testing::processTempDir() + name + ".gbk";
+    format::Writer w;
+    EXPECT_EQ(w.open(path, format::AssetKind::kTinyExample), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionTinyExampleInfo, 0, &r, sizeof r), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionTinyExampleTexels, 0, texels.data(), texels.size() * 4),
+              format::ContainerStatus::kOk);
+    auto image = [&](uint32_t width, uint32_t height, uint32_t channels, uint32_t layers, const float* v) {
+      format::ImageSectionHeader h;
+      h.width = width;
+      h.height = height;
+      h.channels = channels;
+      h.layers = layers;
+      std::vector<uint8_t> bytes(sizeof h + size_t(width) * height * channels * layers * 4);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      std::memcpy(bytes.data() + sizeof h, v, bytes.size() - sizeof h);
+      return bytes;
+    };
+    for (uint32_t l = 0; l < r.levels; ++l) {
+      const uint32_t m = format::tinyTilesPerSide(r.example_size, l);
+      const auto bytes = image(8, 8, 1, m * m, levels[l].data());
+      EXPECT_EQ(w.addSection(format::kSectionTinyExampleLevel, l, bytes.data(), bytes.size()),
+                format::ContainerStatus::kOk);
+    }
+    if (layout) {
+      const auto bytes = image(3, 1, 2, 1, layout->data());
+      EXPECT_EQ(w.addSection(format::kSectionTinyExampleLayout, 0, bytes.data(), bytes.size()),
+                format::ContainerStatus::kOk);
+    }
+    EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
+    return path;
+  };
+  auto has6006 = [](const std::string& path) {
+    for (const auto& m : format::validateFile(path).messages)
+      if (m.id == 6006) return true;
+    return false;
+  };
+  const std::string good = write("layout_good", rec.value(), &values);
+  EXPECT_FALSE(has6006(good));
+  TinyExampleNdf ok;
+  ASSERT_EQ(ok.open(good.c_str()), RuntimeStatus::kOk);
+  ASSERT_NE(ok.layout(), nullptr);
+  EXPECT_EQ(ok.layout()->values[3], 0.75f);
+  // Cells of presence 0 never hold an example.
+  for (int64_t j = -2; j <= 2; ++j)
+    for (int64_t i = -6; i <= 6; ++i)
+      if (((i % 3) + 3) % 3 == 1) EXPECT_FALSE(format::tinyCellPlacement(rec.value(), i, j, ok.layout()).present);
+  // The record asks for a layout the asset lacks.
+  const std::string missing = write("layout_missing", rec.value(), nullptr);
+  EXPECT_TRUE(has6006(missing));
+  TinyExampleNdf refused;
+  EXPECT_EQ(refused.open(missing.c_str()), RuntimeStatus::kInvalidAsset);
+  // A layout section beside a version 1 record.
+  format::TinyExampleRecord v1 = rec.value();
+  v1.flags = 0;
+  v1.version = 1;
+  EXPECT_TRUE(has6006(write("layout_extra", v1, &values)));
+  // A value outside [0, 1] in the stored layout.
+  std::vector<float> bad = values;
+  bad[4] = 1.5f;
+  const std::string outside = write("layout_outside", rec.value(), &bad);
+  EXPECT_TRUE(has6006(outside));
+  EXPECT_EQ(refused.open(outside.c_str()), RuntimeStatus::kInvalidAsset);
+  const format::TinyLayout bad_layout{3, 1, 2, bad.data()};
+  EXPECT_NE(format::checkTinyLayout(bad_layout), nullptr);
+  TinyPlacementOptions q = p;
+  q.layout = bad_layout;
+  EXPECT_FALSE(bake::tiny::makeTinyRecord(8, 8, kSigmaR, q).ok());
+  std::vector<float> nan = values;
+  nan[0] = std::nanf("");
+  uint64_t at = 99;
+  EXPECT_NE(format::checkTinyLayout({3, 1, 2, nan.data()}, &at), nullptr);
+  EXPECT_EQ(at, 0u);
+  EXPECT_NE(format::checkTinyLayout({3, 1, 4, values.data()}), nullptr);
+  EXPECT_NE(format::checkTinyLayout({2000, 1, 1, values.data()}), nullptr);
+  // Version 2 without flags, a layout flag on a tiled record, unknown flags.
+  format::TinyExampleRecord r2 = rec.value();
+  r2.flags = 0;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2.flags = 4;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2 = rec.value();
+  r2.type = uint32_t(format::TinyExampleType::kTiled);
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2 = rec.value();
+  r2.version = 3;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
 }
 
 struct SPt {
