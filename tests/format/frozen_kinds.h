@@ -218,8 +218,10 @@ inline std::vector<uint8_t> tinyRecordV2() {
 }
 
 inline std::vector<uint8_t> tinyLayoutV2() {
-  const float values[2][2] = {{1.0f, 0.5f}, {0.0f, 0.0f}};
-  return imageSection(2, 1, 2, 1, [&values](uint32_t x, uint32_t, uint32_t c, uint32_t) { return values[x][c]; });
+  Bytes b(32 + 2 * 2 * 4);  // image header (SPEC 3.1), then (presence, rotation) of cells 0 and 1
+  b.u32(0, 0x474D4947).u32(4, 2).u32(8, 1).u32(12, 2).u32(16, 1);
+  b.f32(32, 1.0f).f32(36, 0.5f).f32(40, 0.0f).f32(44, 0.0f);
+  return b.bytes();
 }
 
 }  // namespace glintbake::format::frozen

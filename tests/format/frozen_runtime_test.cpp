@@ -127,10 +127,12 @@ TEST(FrozenRuntimeV1_0, TinyExampleVersion2) {
   TinyExampleNdf tiny;
   ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example_v2.gbk").c_str()), RuntimeStatus::kOk);
   EXPECT_FALSE(tiny.hasFlakes());
-  ASSERT_NE(tiny.layout(), nullptr);
-  EXPECT_EQ(tiny.layout()->width, 2u);
-  EXPECT_EQ(tiny.layout()->channels, 2u);
-  EXPECT_EQ(tiny.layout()->values[1], 0.5f);
+  const format::TinyLayout* layout = tiny.layout();
+  ASSERT_TRUE(layout != nullptr);
+  if (layout == nullptr) return;
+  EXPECT_EQ(layout->width, 2u);
+  EXPECT_EQ(layout->channels, 2u);
+  EXPECT_EQ(layout->values[1], 0.5f);
   double mass = 0.0;
   ASSERT_EQ(tiny.mass(Footprint{3.0, -5.0, 6.0}, &mass), RuntimeStatus::kOk);
   EXPECT_GT(mass, 0.0);

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 
 namespace glintbake::runtime {
 
@@ -206,8 +207,34 @@ bool boxesMeet(const double a[4], const double b[4]) {
 
 // The examples whose squares meet p's (their cells lie within twice the reach of p's cell). False
 // when there are none: p owns all of its square.
-bool gatherNeighbours(const format::TinyExampleRecord& r, const format::TinyLayout* layout,
-                      const format::TinyPlacement& p, int reach, OwnedExample* out) {
+// The placements of a rectangle of cells, computed once per query when the rectangle fits (the
+// window's cells and those their examples' neighbours lie in), else each time they are asked for.
+struct PlacementCache {
+  static constexpr int kCells = 576;
+  const format::TinyExampleRecord* record = nullptr;
+  const format::TinyLayout* layout = nullptr;
+  int64_t i0 = 0, j0 = 0, width = 0, height = 0;  // width 0: nothing cached
+  format::TinyPlacement cells[kCells];
+
+  void fill(int64_t ci0, int64_t ci1, int64_t cj0, int64_t cj1) {
+    width = height = 0;
+    if ((ci1 - ci0 + 1) * (cj1 - cj0 + 1) > kCells) return;
+    i0 = ci0;
+    j0 = cj0;
+    width = ci1 - ci0 + 1;
+    height = cj1 - cj0 + 1;
+    for (int64_t j = 0; j < height; ++j)
+      for (int64_t i = 0; i < width; ++i)
+        cells[j * width + i] = format::tinyCellPlacement(*record, i0 + i, j0 + j, layout);
+  }
+  format::TinyPlacement at(int64_t i, int64_t j) const {
+    if (i >= i0 && i < i0 + width && j >= j0 && j < j0 + height) return cells[(j - j0) * width + (i - i0)];
+    return format::tinyCellPlacement(*record, i, j, layout);
+  }
+};
+
+bool gatherNeighbours(const format::TinyExampleRecord& r, const PlacementCache& cache, const format::TinyPlacement& p,
+                      int reach, OwnedExample* out) {
   out->self = p;
   out->count = 0;
   double own[4];
@@ -216,7 +243,7 @@ bool gatherNeighbours(const format::TinyExampleRecord& r, const format::TinyLayo
   for (int64_t j = p.cell_y - span; j <= p.cell_y + span; ++j) {
     for (int64_t i = p.cell_x - span; i <= p.cell_x + span; ++i) {
       if (i == p.cell_x && j == p.cell_y) continue;
-      const format::TinyPlacement q = format::tinyCellPlacement(r, i, j, layout);
+      const format::TinyPlacement q = cache.at(i, j);
       if (!q.present) continue;
       Neighbour& nb = out->others[out->count];
       exampleBox(r, q, nb.box);
@@ -546,9 +573,12 @@ FootprintRange TinyExampleNdf::footprintRange() const {
   FootprintRange r;
   if (!open_) return r;
   r.pyramid_min_sigma = 2.0;
+  // Stochastic: the widest footprint whose window (and, with overlaps, the cells around it) stays
+  // within kTinyMaxCells cells.
+  const double side_cells = std::sqrt(double(kTinyMaxCells)) - 2.0 * format::tinyOverlapReach(record_) - 1.0;
   r.pyramid_max_sigma = record_.type == uint32_t(TinyExampleType::kTiled)
                             ? 1e300
-                            : std::sqrt(double(kTinyMaxCells)) * record_.cell_size / (2.0 * kTinyWindowSigmas);
+                            : side_cells * record_.cell_size / (2.0 * kTinyWindowSigmas);
   if (hasFlakes()) r.exact_max_sigma = kTinyFlakesUpTo;
   return r;
 }
@@ -667,9 +697,17 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
   if (i1 - i0 >= kTinyMaxCells || j1 - j0 >= kTinyMaxCells || (i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells)
     return false;
   double covered = 0.0;
+  // Built only for overlapping layouts (it is large: no cost for the others).
+  std::optional<PlacementCache> cache;
+  if (overlap) {
+    cache.emplace();
+    cache->record = &r;
+    cache->layout = layout();
+    cache->fill(i0 - 2 * cells_out, i1 + 2 * cells_out, j0 - 2 * cells_out, j1 + 2 * cells_out);
+  }
   for (int64_t j = j0; j <= j1; ++j) {
     for (int64_t i = i0; i <= i1; ++i) {
-      const format::TinyPlacement p = format::tinyCellPlacement(r, i, j, layout());
+      const format::TinyPlacement p = overlap ? cache->at(i, j) : format::tinyCellPlacement(r, i, j, layout());
       if (!p.present) continue;
       double inv[4];
       if (!format::tinyInvert(p.matrix, inv)) continue;
@@ -691,7 +729,7 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
         continue;
       }
       OwnedExample e;
-      if (!gatherNeighbours(r, layout(), p, cells_out, &e)) {
+      if (!gatherNeighbours(r, *cache, p, cells_out, &e)) {
         descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
         continue;
       }
@@ -708,8 +746,8 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
           descend(frame, g, 0.0, 0.0, descend, level, ix, iy);
           return;
         }
-        const double dx = x0 + 0.5 * t - g.mx, dy = y0 + 0.5 * t - g.my;
-        if (level > 0 && w * t * (std::sqrt(dx * dx + dy * dy) + t) > kTinyRefine * g.lambda_min) {
+        const double ox = x0 + 0.5 * t - g.mx, oy = y0 + 0.5 * t - g.my;
+        if (level > 0 && w * t * (std::sqrt(ox * ox + oy * oy) + t) > kTinyRefine * g.lambda_min) {
           for (int c = 0; c < 4; ++c) self(level - 1, 2 * ix + (c & 1), 2 * iy + (c >> 1), self);
           return;
         }

@@ -440,12 +440,18 @@ TEST(TinyExample, LayoutSectionIsValidated) {
   EXPECT_FALSE(has6006(good));
   TinyExampleNdf ok;
   ASSERT_EQ(ok.open(good.c_str()), RuntimeStatus::kOk);
-  ASSERT_NE(ok.layout(), nullptr);
-  EXPECT_EQ(ok.layout()->values[3], 0.75f);
+  const format::TinyLayout* stored = ok.layout();
+  ASSERT_TRUE(stored != nullptr);
+  if (stored == nullptr) return;
+  EXPECT_EQ(stored->values[3], 0.75f);
   // Cells of presence 0 never hold an example.
-  for (int64_t j = -2; j <= 2; ++j)
-    for (int64_t i = -6; i <= 6; ++i)
-      if (((i % 3) + 3) % 3 == 1) EXPECT_FALSE(format::tinyCellPlacement(rec.value(), i, j, ok.layout()).present);
+  for (int64_t j = -2; j <= 2; ++j) {
+    for (int64_t i = -6; i <= 6; ++i) {
+      if (((i % 3) + 3) % 3 == 1) {
+        EXPECT_FALSE(format::tinyCellPlacement(rec.value(), i, j, stored).present);
+      }
+    }
+  }
   // The record asks for a layout the asset lacks.
   const std::string missing = write("layout_missing", rec.value(), nullptr);
   EXPECT_TRUE(has6006(missing));
