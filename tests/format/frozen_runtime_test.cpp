@@ -126,7 +126,8 @@ TEST(FrozenRuntimeV1_0, TinyExample) {
 TEST(FrozenRuntimeV1_0, TinyExampleVersion2) {
   TinyExampleNdf tiny;
   ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example_v2.gbk").c_str()), RuntimeStatus::kOk);
-  EXPECT_FALSE(tiny.hasFlakes());
+  EXPECT_TRUE(tiny.hasFlakes());  // the plane flakes
+  EXPECT_FALSE(tiny.hasGridFlakes());
   const format::TinyLayout* layout = tiny.layout();
   ASSERT_TRUE(layout != nullptr);
   if (layout == nullptr) return;

@@ -579,7 +579,8 @@ FootprintRange TinyExampleNdf::footprintRange() const {
   r.pyramid_max_sigma = record_.type == uint32_t(TinyExampleType::kTiled)
                             ? 1e300
                             : side_cells * record_.cell_size / (2.0 * kTinyWindowSigmas);
-  if (hasFlakes()) r.exact_max_sigma = kTinyFlakesUpTo;
+  r.exact_max_sigma = kTinyFlakesExactUpTo;
+  r.handover_max_sigma = kTinyFlakesUpTo;
   return r;
 }
 
@@ -593,7 +594,15 @@ bool TinyExampleNdf::validFootprint(const Footprint& f) const {
   return f.sigma <= footprintRange().pyramid_max_sigma;
 }
 
-bool TinyExampleNdf::useFlakes(const Footprint& f) const { return hasFlakes() && f.sigma < kTinyFlakesUpTo; }
+// The flakes' share of a footprint's answer: 1 up to kTinyFlakesExactUpTo, 0 from kTinyFlakesUpTo on,
+// linear in log(sigma) between (the tiles take the rest).
+double tinyFlakeShare(double sigma) {
+  if (!(sigma > kTinyFlakesExactUpTo)) return 1.0;
+  if (sigma >= kTinyFlakesUpTo) return 0.0;
+  return std::log(kTinyFlakesUpTo / sigma) / std::log(kTinyFlakesUpTo / kTinyFlakesExactUpTo);
+}
+
+bool TinyExampleNdf::useFlakes(const Footprint& f) const { return open_ && f.sigma < kTinyFlakesUpTo; }
 
 // The footprint in the transformed example's grid (the flakes' coordinates).
 Footprint TinyExampleNdf::flakeFootprint(const Footprint& f) const {
@@ -784,11 +793,7 @@ RuntimeStatus TinyExampleNdf::traversalCount(const Footprint& fp, int64_t* examp
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->eval(flakeFootprint(fp), s, value);
-  }
+RuntimeStatus TinyExampleNdf::tileEval(const Footprint& fp, const SPoint& s, double* value) const {
   if (!inSquare(s)) {
     *value = 0.0;
     return RuntimeStatus::kOk;
@@ -806,23 +811,10 @@ RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double*
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
-  if (!value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->mass(flakeFootprint(fp), value);
-  }
+RuntimeStatus TinyExampleNdf::tileMass(const Footprint& fp, double* value) const {
   double sum = 0.0;
   if (!traverse(fp, [&](const Visit& v) { sum += v.weight * v.mass; })) return RuntimeStatus::kInvalidArgument;
   *value = sum;
-  return RuntimeStatus::kOk;
-}
-
-RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  double e = 0.0, m = 0.0;
-  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
-  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
-  *value = m > 0.0 ? e / m : 0.0;
   return RuntimeStatus::kOk;
 }
 
@@ -874,11 +866,7 @@ bool TinyExampleNdf::batched(const Footprint& fp, F&& flush) const {
   return true;
 }
 
-RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
-  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->average(flakeFootprint(fp), rect, value);
-  }
+RuntimeStatus TinyExampleNdf::tileAverage(const Footprint& fp, const SRect& rect, double* value) const {
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   const double out_area = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
@@ -896,14 +884,9 @@ RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, do
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_count) const {
+// Adds weight times the tiles' image to out (R * R floats).
+RuntimeStatus TinyExampleNdf::addTileImage(const Footprint& fp, double weight, float* out) const {
   const int res = resolution();
-  const size_t count = size_t(res) * size_t(res);
-  if (!out || count == 0 || out_count < count || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->image(flakeFootprint(fp), out, out_count);
-  }
-  std::fill(out, out + count, 0.0f);
   const double bin = 2.0 / res;
   if (!batched(fp, [&](const Batch& batch) {
         const Frame& f = batch.frame;
@@ -922,7 +905,7 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
                                   batch.images, batch.count, res) /
                   (bin * bin);
             }
-            out[size_t(j) * res + i] += float(v);
+            out[size_t(j) * res + i] += float(weight * v);
           }
         }
       }))
@@ -930,14 +913,10 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
-  if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->sample(flakeFootprint(fp), u1, u2, out);
-  }
+// Draws from the tiles' answer; the point only (the caller sets the pdf).
+RuntimeStatus TinyExampleNdf::tileSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
   double total = 0.0;
-  if (RuntimeStatus st = mass(fp, &total); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = tileMass(fp, &total); st != RuntimeStatus::kOk) return st;
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The tile, in proportion to weight x mass, in the traversal's order.
   double target = u1 * total, acc = 0.0;
@@ -985,6 +964,242 @@ RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, 
   const double ex = -1.0 + (i + u2) * bin, ey = 1.0 - (j + rest) * bin;
   out->s.x = frame.a[0] * ex + frame.a[1] * ey;
   out->s.y = frame.a[2] * ex + frame.a[3] * ey;
+  out->pdf = 0.0;
+  return RuntimeStatus::kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small footprints: the flakes of the plane as the asset lays it (TinyPlaneTexels).
+
+namespace {
+
+// Texels per side of the largest window the plane flakes read: flakes within
+// 6 sqrt(sigma_h^2 + sigma^2) of the centre for sigma < kTinyFlakesUpTo, and one texel on each side
+// for the central differences.
+constexpr int kPlaneWindow = 2 * int(6.0 * kTinyFlakesUpTo + 2.0) + 4;
+
+struct PlaneWindow {
+  int64_t x0 = 0, y0 = 0;  // plane texel of entry (0, 0)
+  int w = 0, h = 0;
+  float t[kPlaneWindow * kPlaneWindow * 2];
+  const float* at(int64_t x, int64_t y) const { return t + (size_t(y - y0) * size_t(w) + size_t(x - x0)) * 2; }
+};
+
+}  // namespace
+
+// Calls lobe(weight, Lobe) for every flake of the plane within the footprint's window: flake k at
+// plane texel centre u_k = (X + 1/2, Y + 1/2) has the materialised texel's normal n_k and the central
+// differences J_k of its neighbours (formats/SPEC.md 10.5 at rate 1), weight N(u_k; u, (sigma_h^2 +
+// sigma^2) I) and lobe N(n_k + J_k c (u - u_k), sigma_r^2 I + sigma^2 c J_k J_k^T), c = sigma_h^2 /
+// (sigma_h^2 + sigma^2). False when the window does not fit (not reached for sigma < kTinyFlakesUpTo).
+template <typename F>
+bool TinyExampleNdf::planeFlakes(const Footprint& fp, F&& lobe) const {
+  const double sp2 = fp.sigma * fp.sigma, h2 = kSigmaH * kSigmaH, v = h2 + sp2;
+  const double reach = 6.0 * std::sqrt(v);
+  const int64_t fx0 = int64_t(std::ceil(fp.x - reach - 0.5)), fx1 = int64_t(std::floor(fp.x + reach - 0.5));
+  const int64_t fy0 = int64_t(std::ceil(fp.y - reach - 0.5)), fy1 = int64_t(std::floor(fp.y + reach - 0.5));
+  if (fx1 < fx0 || fy1 < fy0) return true;
+  PlaneWindow win;
+  win.x0 = fx0 - 1;
+  win.y0 = fy0 - 1;
+  win.w = int(fx1 - fx0 + 3);
+  win.h = int(fy1 - fy0 + 3);
+  if (win.w > kPlaneWindow || win.h > kPlaneWindow) return false;
+  const TinyPlaneTexels plane(*this, win.x0, win.y0, win.w, win.h);
+  for (int y = 0; y < win.h; ++y)
+    for (int x = 0; x < win.w; ++x) plane.texel(x, y, win.t + (size_t(y) * win.w + x) * 2);
+  const double c = h2 / v, spread = sp2 * c, r2 = record_.sigma_r * record_.sigma_r;
+  const double norm = 1.0 / (2.0 * 3.14159265358979323846 * v);
+  for (int64_t y = fy0; y <= fy1; ++y) {
+    const double dy = fp.y - (double(y) + 0.5);
+    for (int64_t x = fx0; x <= fx1; ++x) {
+      const double dx = fp.x - (double(x) + 0.5);
+      const double w = norm * std::exp(-0.5 * (dx * dx + dy * dy) / v);
+      const float* nk = win.at(x, y);
+      const float *l = win.at(x - 1, y), *r = win.at(x + 1, y), *u = win.at(x, y - 1), *d = win.at(x, y + 1);
+      // As the flake model stores them: float normals and Jacobians.
+      const double j0 = double(float((double(r[0]) - double(l[0])) * 0.5)),
+                   j1 = double(float((double(d[0]) - double(u[0])) * 0.5));
+      const double j2 = double(float((double(r[1]) - double(l[1])) * 0.5)),
+                   j3 = double(float((double(d[1]) - double(u[1])) * 0.5));
+      const flakes::Lobe g{double(nk[0]) + c * (j0 * dx + j1 * dy), double(nk[1]) + c * (j2 * dx + j3 * dy),
+                           r2 + spread * (j0 * j0 + j1 * j1), spread * (j0 * j2 + j1 * j3),
+                           r2 + spread * (j2 * j2 + j3 * j3)};
+      lobe(w, g);
+    }
+  }
+  return true;
+}
+
+namespace {
+
+double lobeDensity(const flakes::Lobe& g, double sx, double sy) {
+  const double det = g.cxx * g.cyy - g.cxy * g.cxy;
+  const double dx = sx - g.mx, dy = sy - g.my;
+  const double q = (g.cyy * dx * dx - 2.0 * g.cxy * dx * dy + g.cxx * dy * dy) / det;
+  return std::exp(-0.5 * q) / (2.0 * 3.14159265358979323846 * std::sqrt(det));
+}
+
+}  // namespace
+
+// The flakes' answers: the grid-preserving tiled transforms through FlakeNdf over the transformed
+// example, every other asset through the plane flakes above (the same model and texels).
+RuntimeStatus TinyExampleNdf::flakeEval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (hasGridFlakes()) return flakes_->eval(flakeFootprint(fp), s, value);
+  double sum = 0.0;
+  if (inSquare(s) && !planeFlakes(fp, [&](double w, const flakes::Lobe& g) { sum += w * lobeDensity(g, s.x, s.y); }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::flakeMass(const Footprint& fp, double* value) const {
+  if (hasGridFlakes()) return flakes_->mass(flakeFootprint(fp), value);
+  double sum = 0.0;
+  if (!planeFlakes(fp, [&](double w, const flakes::Lobe&) { sum += w; })) return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::flakeAverage(const Footprint& fp, const SRect& rect, double* value) const {
+  if (hasGridFlakes()) return flakes_->average(flakeFootprint(fp), rect, value);
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  double sum = 0.0;
+  if (x1 > x0 && y1 > y0 && !planeFlakes(fp, [&](double w, const flakes::Lobe& g) {
+        sum += w * flakes::lobeRectProbability(g, x0, x1, y0, y1);
+      }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::addFlakeImage(const Footprint& fp, double weight, float* out) const {
+  const int res = resolution();
+  if (hasGridFlakes()) return flakes_->addImage(flakeFootprint(fp), weight, out, size_t(res) * res);
+  const double bin = 2.0 / res;
+  if (!planeFlakes(fp,
+                   [&](double w, const flakes::Lobe& g) { flakes::splatLobe(g, weight * w / (bin * bin), res, out); }))
+    return RuntimeStatus::kInvalidArgument;
+  return RuntimeStatus::kOk;
+}
+
+// Draws from the flakes' answer; the point only (the caller sets the pdf).
+RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (hasGridFlakes()) return flakes_->sample(flakeFootprint(fp), u1, u2, out);
+  double total = 0.0;
+  if (RuntimeStatus st = flakeMass(fp, &total); st != RuntimeStatus::kOk) return st;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+  // The flake in proportion to its weight, in the window's order, then a point of its lobe (Box-Muller
+  // on the rescaled u1 and u2).
+  const double target = u1 * total;
+  double acc = 0.0, rest = 0.5;
+  bool found = false;
+  flakes::Lobe chosen{0.0, 0.0, 1.0, 0.0, 1.0};
+  planeFlakes(fp, [&](double w, const flakes::Lobe& g) {
+    if (found || !(w > 0.0)) return;
+    chosen = g;
+    if (target < acc + w) {
+      found = true;
+      rest = (target - acc) / w;
+      return;
+    }
+    acc += w;
+  });
+  rest = std::clamp(rest, 0.0, 0.99999999999999989);
+  const double radius = std::sqrt(-2.0 * std::log1p(-rest)), phi = 2.0 * 3.14159265358979323846 * u2;
+  const double z0 = radius * std::cos(phi), z1 = radius * std::sin(phi);
+  const double l00 = std::sqrt(chosen.cxx), l10 = chosen.cxy / l00;
+  const double l11 = std::sqrt(std::max(chosen.cyy - l10 * l10, 0.0));
+  out->s.x = chosen.mx + l00 * z0;
+  out->s.y = chosen.my + l10 * z0 + l11 * z1;
+  out->pdf = 0.0;
+  return RuntimeStatus::kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The queries: the flakes below kTinyFlakesExactUpTo, the tiles from kTinyFlakesUpTo, blended
+// linearly in log(sigma) between.
+
+RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeEval(fp, s, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileEval(fp, s, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
+  if (!value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeMass(fp, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileMass(fp, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  double e = 0.0, m = 0.0;
+  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
+  *value = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
+  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeAverage(fp, rect, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileAverage(fp, rect, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_count) const {
+  const int res = resolution();
+  const size_t count = size_t(res) * size_t(res);
+  if (!out || count == 0 || out_count < count || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  if (hasGridFlakes() && tinyFlakeShare(fp.sigma) >= 1.0) return flakes_->image(flakeFootprint(fp), out, out_count);
+  std::fill(out, out + count, 0.0f);
+  const double a = tinyFlakeShare(fp.sigma);
+  if (a > 0.0)
+    if (RuntimeStatus st = addFlakeImage(fp, a, out); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = addTileImage(fp, 1.0 - a, out); st != RuntimeStatus::kOk) return st;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return RuntimeStatus::kInvalidArgument;
+  // The path in proportion to its share of the mass, u1 rescaled for the chosen one.
+  const double a = tinyFlakeShare(fp.sigma);
+  double mf = 0.0, mt = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeMass(fp, &mf); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileMass(fp, &mt); st != RuntimeStatus::kOk) return st;
+  const double pf = a * mf, pt = (1.0 - a) * mt;
+  if (!(pf + pt > 0.0)) return RuntimeStatus::kInvalidArgument;
+  const double split = pf / (pf + pt);
+  RuntimeStatus st;
+  if (u1 < split || !(pt > 0.0)) {
+    st = flakeSample(fp, std::clamp(u1 / split, 0.0, 0.99999999999999989), u2, out);
+  } else {
+    st = tileSample(fp, std::clamp((u1 - split) / (1.0 - split), 0.0, 0.99999999999999989), u2, out);
+  }
+  if (st != RuntimeStatus::kOk) return st;
   if (!inSquare(out->s)) {
     out->pdf = 0.0;
     return RuntimeStatus::kOk;

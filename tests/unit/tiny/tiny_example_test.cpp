@@ -190,7 +190,8 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
   // sigma 64, where the reference takes minutes).
   // GLINTBAKE_TINY_WIDE=1 adds the footprints of many examples (minutes of reference time).
   std::vector<double> sigmas = {0.5, 1.0, 2.0, 4.0, 5.5, 6.0, 8.0, 11.0};
-  std::vector<double> bounds = {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 0.01, 5e-3, 5e-3};
+  // 5.5 lies in the hand-over band (flakes and tiles blended).
+  std::vector<double> bounds = {1e-4, 1e-4, 1e-4, 1e-4, 0.01, 0.01, 5e-3, 5e-3};
   if (const char* wide = std::getenv("GLINTBAKE_TINY_WIDE"); wide && wide[0] == '1') {
     sigmas.insert(sigmas.end(), {16.0, 32.0, 64.0});
     bounds.insert(bounds.end(), {5e-3, 5e-3, 5e-3});
@@ -206,6 +207,77 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
       std::printf("tiled identity: sigma %5.1f at (%.1f, %.1f): relative L1 %.2e\n", fp.sigma, fp.x, fp.y, l1);
       std::fflush(stdout);
       EXPECT_LT(l1, bounds[k]) << "sigma " << fp.sigma;
+    }
+  }
+}
+
+// The plane texels [x0, x0 + side)^2 as the asset lays them (what glintquery materialise writes), as a
+// normal map continuing with its edge texels.
+bake::NormalMap materialised(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int side) {
+  const runtime::TinyPlaneTexels plane(asset, x0, y0, side, side);
+  bake::NormalMap m;
+  m.width = m.height = side;
+  m.wrap = bake::Wrap::kClamp;
+  m.normals.resize(size_t(side) * side * 3);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      float t[2];
+      plane.texel(x, y, t);
+      float* o = m.at(x, y);
+      o[0] = t[0];
+      o[1] = t[1];
+      o[2] = std::sqrt(std::max(0.0f, 1.0f - t[0] * t[0] - t[1] * t[1]));
+    }
+  return m;
+}
+
+// Below the finest tile every placement answers from the flakes of the plane it lays: a 30-degree
+// rotation, a scale and a stochastic layout (rotations, scales, 30% covered) against the reference
+// evaluator on the materialised region; between kTinyFlakesExactUpTo and kTinyFlakesUpTo the blend.
+TEST(TinyExample, SmallFootprintsAgainstTheMaterialisedPlane) {
+  const int n = 16, res = 32;
+  const bake::NormalMap map = example(n);
+  TinyPlacementOptions rot;
+  rot.rotate_range[0] = rot.rotate_range[1] = 30.0;
+  TinyPlacementOptions scaled;
+  scaled.scale_range[0] = scaled.scale_range[1] = 1.5;
+  scaled.shear[0] = 0.3;
+  TinyPlacementOptions sto;
+  sto.type = format::TinyExampleType::kStochastic;
+  sto.rotate_range[1] = 360.0;
+  sto.scale_range[0] = 0.8;
+  sto.scale_range[1] = 1.25;
+  sto.density = 0.3;
+  sto.seed = 5;
+  TinyPlacementOptions ovl = sto;
+  ovl.density = 0.8;
+  ovl.overlap = true;
+  const struct {
+    const char* name;
+    TinyPlacementOptions place;
+  } cases[] = {{"rotated 30", rot}, {"scaled 1.5, sheared", scaled}, {"stochastic", sto}, {"overlapping", ovl}};
+  for (const auto& c : cases) {
+    const auto asset = bakeAsset(map, res, c.place, std::string("small_") + c.name[0] + c.name[1]);
+    ASSERT_TRUE(asset);
+    EXPECT_TRUE(asset->hasFlakes());
+    EXPECT_FALSE(asset->hasGridFlakes());
+    const int64_t x0 = 1000, y0 = -700;
+    const int side = 96;
+    const reference::FlakeSet ref_set = reference::buildFlakes(materialised(*asset, x0, y0, side), 1);
+    for (const double sigma : {0.25, 0.5, 1.0, 2.0, 3.9, 4.5, 5.5, 6.5}) {
+      for (const double at : {37.3, 52.9}) {
+        if (sigma > runtime::kTinyFlakesExactUpTo && at > 40.0) continue;  // the blend: one point
+        const Footprint fp{double(x0) + at, double(y0) + 0.8 * at + 9.1, sigma};
+        const std::vector<double> got = imageOf(*asset, fp);
+        const std::vector<double> ref =
+            reference::binAveragedImage(ref_set, reference::Footprint{at, 0.8 * at + 9.1, sigma}, kSigmaR, res);
+        const double l1 = relativeL1(got, ref);
+        std::printf("%s: sigma %4.1f at %.1f: relative L1 %.2e\n", c.name, sigma, at, l1);
+        std::fflush(stdout);
+        if (sigma < runtime::kTinyFlakesExactUpTo) {
+          EXPECT_LT(l1, 1e-4) << c.name << " sigma " << sigma;
+        }
+      }
     }
   }
 }
@@ -227,7 +299,7 @@ TEST(TinyExample, TransformsActOnTheSlopes) {
   ASSERT_TRUE(id && rot && mir && big);
   EXPECT_TRUE(rot->hasFlakes());
   EXPECT_TRUE(mir->hasFlakes());
-  EXPECT_FALSE(big->hasFlakes());
+  EXPECT_FALSE(big->hasGridFlakes());
   for (const double sigma : {2.0, 8.0, 24.0}) {
     // The same example-frame footprint: u = M v for each transform (corner at the origin).
     const double vx = 5.3, vy = 9.7;

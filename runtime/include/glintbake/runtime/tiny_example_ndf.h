@@ -46,8 +46,11 @@
 
 namespace glintbake::runtime {
 
-constexpr double kTinyRefine = 0.005;    // split a tile while w t (d + t) > kTinyRefine lambda_min
-constexpr double kTinyFlakesUpTo = 6.0;  // texels: smaller footprints use the flakes (when available)
+constexpr double kTinyRefine = 0.005;  // split a tile while w t (d + t) > kTinyRefine lambda_min
+// Footprints (sigma, texels) below kTinyFlakesExactUpTo are answered by the flakes alone, from
+// kTinyFlakesUpTo on by the tiles alone, and between by both, blended linearly in log(sigma).
+constexpr double kTinyFlakesExactUpTo = 4.0;
+constexpr double kTinyFlakesUpTo = 6.0;
 constexpr double kTinyWindowSigmas = 6.0;
 constexpr int64_t kTinyMaxCells = 1 << 18;  // stochastic: most layout cells one query visits
 
@@ -133,7 +136,12 @@ class TinyExampleNdf final : public NdfSource {
   const format::TinyLayout* layout() const { return open_ && layout_.values ? &layout_ : nullptr; }
   // The stored tile image of (level, tile index row-major) (R * R floats), or null.
   const float* tileImage(int level, int tile) const;
-  bool hasFlakes() const { return flakes_ && flakes_->isBuilt(); }
+  // Every open asset answers small footprints from flakes (exactly: the flake model of the plane
+  // as TinyPlaneTexels lays it).
+  bool hasFlakes() const { return open_; }
+  // Whether they come from a FlakeNdf over the transformed example (tiled assets whose transform
+  // maps the texel grid onto itself: faster, the same answer) rather than the plane texels.
+  bool hasGridFlakes() const { return open_ && flakes_ && flakes_->isBuilt(); }
 
   format::AssetKind kind() const override { return format::AssetKind::kTinyExample; }
   int resolution() const override { return open_ ? int(record_.ndf_res) : 0; }
@@ -161,6 +169,18 @@ class TinyExampleNdf final : public NdfSource {
   bool validFootprint(const Footprint& f) const;
   bool useFlakes(const Footprint& f) const;
   Footprint flakeFootprint(const Footprint& f) const;
+  template <typename F>
+  bool planeFlakes(const Footprint& f, F&& lobe) const;
+  RuntimeStatus flakeEval(const Footprint& f, const SPoint& s, double* value) const;
+  RuntimeStatus flakeMass(const Footprint& f, double* value) const;
+  RuntimeStatus flakeAverage(const Footprint& f, const SRect& rect, double* value) const;
+  RuntimeStatus addFlakeImage(const Footprint& f, double weight, float* out) const;
+  RuntimeStatus flakeSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
+  RuntimeStatus tileEval(const Footprint& f, const SPoint& s, double* value) const;
+  RuntimeStatus tileMass(const Footprint& f, double* value) const;
+  RuntimeStatus tileAverage(const Footprint& f, const SRect& rect, double* value) const;
+  RuntimeStatus addTileImage(const Footprint& f, double weight, float* out) const;
+  RuntimeStatus tileSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
   template <typename F>
   bool traverse(const Footprint& f, F&& visit, int64_t* entered = nullptr) const;
   // traverse(), handing the tiles over in batches of one frame.
