@@ -282,6 +282,58 @@ TEST(TinyExample, SmallFootprintsAgainstTheMaterialisedPlane) {
   }
 }
 
+// The hand-over from the flakes to the tiles is continuous: the NDF image changes little across
+// either end of the band and between neighbouring footprints inside it. The tiles' own error at 6
+// texels against the reference (what a hard switch there jumps by) is printed beside.
+TEST(TinyExample, HandOverIsContinuous) {
+  const int res = 64;
+  const bake::NormalMap map = example(32, bake::MapKind::kBrushed, 13);
+  TinyPlacementOptions tiled;
+  tiled.rotate_range[0] = tiled.rotate_range[1] = 90.0;
+  TinyPlacementOptions sto;
+  sto.type = format::TinyExampleType::kStochastic;
+  sto.rotate_range[1] = 360.0;
+  sto.scale_range[0] = 0.8;
+  sto.scale_range[1] = 1.25;
+  sto.density = 0.3;
+  sto.seed = 5;
+  const struct {
+    const char* name;
+    TinyPlacementOptions place;
+  } cases[] = {{"tiled, rotated 90", tiled}, {"stochastic", sto}};
+  for (const auto& c : cases) {
+    const auto asset = bakeAsset(map, res, c.place, std::string("handover_") + c.name[0]);
+    ASSERT_TRUE(asset);
+    const double x = 200.0, y = 120.0;
+    const double lo = runtime::kTinyFlakesExactUpTo, hi = runtime::kTinyFlakesUpTo;
+    for (const double edge : {lo, hi}) {
+      const double l1 =
+          relativeL1(imageOf(*asset, {x, y, edge * (1.0 - 1e-6)}), imageOf(*asset, {x, y, edge * (1.0 + 1e-6)}));
+      std::printf("%s: change across sigma %.1f: relative L1 %.2e\n", c.name, edge, l1);
+      EXPECT_LT(l1, 1e-3) << c.name << " at " << edge;
+    }
+    double inside = 0.0, outside = 0.0;
+    std::vector<double> prev = imageOf(*asset, {x, y, 3.5});
+    for (int k = 1; k <= 28; ++k) {
+      const std::vector<double> cur = imageOf(*asset, {x, y, 3.5 * std::pow(2.0, k / 28.0)});
+      const double sigma = 3.5 * std::pow(2.0, k / 28.0);
+      (sigma > lo && sigma < hi ? inside : outside) =
+          std::max(sigma > lo && sigma < hi ? inside : outside, relativeL1(cur, prev));
+      prev = cur;
+    }
+    std::printf(
+        "%s: largest change between footprints 2^(1/28) apart, sigma 3.5-7: %.2e inside the band, %.2e outside\n",
+        c.name, inside, outside);
+    const reference::FlakeSet ref_set = reference::buildFlakes(materialised(*asset, 150, 70, 100), 1);
+    const std::vector<double> ref =
+        reference::binAveragedImage(ref_set, reference::Footprint{50.0, 50.0, hi}, kSigmaR, res);
+    std::printf("%s: tiles at sigma %.1f against the reference: relative L1 %.2e; flakes at %.1f: %.2e\n", c.name, hi,
+                relativeL1(imageOf(*asset, {x, y, hi}), ref), lo,
+                relativeL1(imageOf(*asset, {x, y, lo}),
+                           reference::binAveragedImage(ref_set, reference::Footprint{50.0, 50.0, lo}, kSigmaR, res)));
+  }
+}
+
 // A 90-degree rotation rotates the NDF, a mirror mirrors it, a scale by 2 halves the slopes' spread.
 TEST(TinyExample, TransformsActOnTheSlopes) {
   const int n = 16, res = 64;
