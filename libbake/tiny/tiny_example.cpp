@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tiny examples: records, tile images and the asset's sections (see bake/tiny/tiny_example.h).
 #include <glintbake/bake/tiny/tiny_example.h>
+#include <glintbake/format/binary16.h>
 #include <glintbake/runtime/tiny_example_ndf.h>
 
 #include <tbb/parallel_for.h>
@@ -228,6 +229,19 @@ std::vector<std::vector<float>> bakeTinyLevels(const std::vector<float>& texels,
   return out;
 }
 
+bool tinyLevelsFitHalf(const std::vector<std::vector<float>>& levels) {
+  for (const auto& level : levels)
+    for (float v : level)
+      if (!(v <= format::kTinyHalfMax)) return false;
+  return true;
+}
+
+format::TinyExampleRecord withHalfLevels(format::TinyExampleRecord record) {
+  record.version = 2;
+  record.flags |= format::kTinyFlagHalf;
+  return record;
+}
+
 BakeStatus writeTinyExampleSections(format::Writer& writer, const format::TinyExampleRecord& record,
                                     const std::vector<float>& texels, const std::vector<std::vector<float>>& levels,
                                     const format::TinyLayout* layout) {
@@ -248,11 +262,22 @@ BakeStatus writeTinyExampleSections(format::Writer& writer, const format::TinyEx
     h.width = h.height = record.ndf_res;
     h.channels = 1;
     h.layers = m * m;
-    bytes.resize(sizeof h + levels[l].size() * 4);
-    std::memcpy(bytes.data(), &h, sizeof h);
-    std::memcpy(bytes.data() + sizeof h, levels[l].data(), levels[l].size() * 4);
-    if (writer.addSection(format::kSectionTinyExampleLevel, l, bytes.data(), bytes.size()) !=
-        format::ContainerStatus::kOk)
+    const bool half = (record.flags & format::kTinyFlagHalf) != 0;
+    if (half) {
+      h.magic = format::kTinyHalfImageMagic;
+      bytes.resize(sizeof h + levels[l].size() * 2);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      for (size_t i = 0; i < levels[l].size(); ++i) {
+        const uint16_t v = format::floatToHalf(levels[l][i]);
+        std::memcpy(bytes.data() + sizeof h + 2 * i, &v, 2);
+      }
+    } else {
+      bytes.resize(sizeof h + levels[l].size() * 4);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      std::memcpy(bytes.data() + sizeof h, levels[l].data(), levels[l].size() * 4);
+    }
+    if (writer.addSection(half ? format::kSectionTinyExampleLevelHalf : format::kSectionTinyExampleLevel, l,
+                          bytes.data(), bytes.size()) != format::ContainerStatus::kOk)
       return failed();
   }
   if ((record.flags & format::kTinyFlagLayout) != 0) {

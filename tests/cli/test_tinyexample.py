@@ -59,6 +59,18 @@ class TinyExample(ToolTestCase):
         self.assertEqual(info["asset_kind"], "tiny-example")
         q = self.run_json("glintquery", "point", out, "--at", "1000,-70", "--sigma", "40", "--s", "0.05,0.0")
         self.assertGreaterEqual(q["value"], 0.0)
+        # float16 tile images by default; --precision float32 keeps them whole, in a larger file.
+        self.assertEqual(doc["precision"], "float16")
+        out32, doc32 = self.bake("t32.gbk", "--precision", "float32", json=True)
+        self.assertEqual(doc32["precision"], "float32")
+        self.assertLess(doc["file_bytes"], doc32["file_bytes"])
+        self.run_ok("glintinfo", "validate", out32)
+        p16 = self.run_json("glintquery", "point", out, "--at", "30,7", "--sigma", "9", "--s", "0.05,0.0")
+        p32 = self.run_json("glintquery", "point", out32, "--at", "30,7", "--sigma", "9", "--s", "0.05,0.0")
+        self.assertAlmostEqual(p16["value"], p32["value"], delta=1e-3 * abs(p32["value"]) + 1e-6)
+        err = self.assert_fails(1, "tinyexample", self.map, "--crop", "8,16,16", "-o", self.path("bad.gbk"), "--precision", "float8",
+                                outputs=[self.path("bad.gbk")])
+        self.assertIn("--precision", err)
 
     def test_stochastic_json(self):
         out, doc = self.bake("s.gbk", "--type", "stochastic", "--rotate-range", "0,360", "--scale-range", "0.8,1.2",
@@ -66,7 +78,8 @@ class TinyExample(ToolTestCase):
         a = doc["asset"]
         self.assertEqual(a["type"], "stochastic")
         self.assertAlmostEqual(a["covered_fraction"], 0.3, places=9)
-        self.assertFalse(doc["flakes"])
+        self.assertTrue(doc["flakes"])  # every placement: the plane's flakes
+        self.assertEqual(doc["precision"], "float16")
         self.run_ok("glintinfo", "validate", out)
 
     def test_deterministic_for_thread_counts(self):

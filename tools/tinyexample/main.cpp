@@ -131,7 +131,8 @@ int main(int argc, char** argv) {
                   "Randomly rotated copies of the example covering 30% of the plane.");
   tool.addExample("tinyexample flake.png --type stochastic --rotate-range 0,180 --layout layout.png -o painted.gbk",
                   "Presence (red) and rotation (green) of the example in each layout cell painted in an image.");
-  std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G";
+  std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G",
+                             precision = "float16";
   double rotate = 0.0, density = 1.0, sigma_r = 0.005;
   bool rotate_given = false, mirror = false, overlap = false;
   int ndf_res = 128, zstd_level = 3;
@@ -170,6 +171,10 @@ int main(int argc, char** argv) {
   app.add_option("--crop", crop_box, "Use the SIZE x SIZE texels at X,Y of the map as the example")
       ->delimiter(',')
       ->expected(3);
+  app.add_option("--precision", precision,
+                 "Storage of the tile images: float16 (binary16, half the bytes; float32 is used, with a warning, "
+                 "when a value exceeds 65504) or float32")
+      ->capture_default_str();
   app.add_option("--zstd-level", zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   app.add_option("--max-memory", max_memory,
                  "Refuse the bake when its tile images would need more than this many bytes (suffix K, M, G, T)")
@@ -180,6 +185,8 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     rotate_given = rot->count() > 0;
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
+    if (precision != "float16" && precision != "float32")
+      throw Error(cli::kExitBadArguments, "--precision must be float16 or float32, not \"" + precision + "\"");
     bake::tiny::TinyPlacementOptions place;
     if (type == "tiled") {
       place.type = format::TinyExampleType::kTiled;
@@ -221,7 +228,7 @@ int main(int argc, char** argv) {
     const bake::NormalMap example = crop(map, crop_box);
     cli::check(bake::tiny::checkTinyExample(example), input + ": ");
     const int n = example.width;
-    const format::TinyExampleRecord record = cli::unwrap(bake::tiny::makeTinyRecord(n, ndf_res, sigma_r, place));
+    format::TinyExampleRecord record = cli::unwrap(bake::tiny::makeTinyRecord(n, ndf_res, sigma_r, place));
 
     // Tile images in memory: (n^2 - 1) / 3 tiles of R^2 floats, plus the section being written.
     uint64_t tiles = 0;
@@ -241,6 +248,13 @@ int main(int argc, char** argv) {
     const std::vector<float> texels = bake::tiny::tinyTexels(example);
     const std::vector<std::vector<float>> levels = bake::tiny::bakeTinyLevels(texels, n, sigma_r, ndf_res);
     const double tile_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    if (precision == "float16") {
+      if (bake::tiny::tinyLevelsFitHalf(levels)) {
+        record = bake::tiny::withHalfLevels(record);
+      } else {
+        t.warning("a tile density exceeds 65504 (the largest float16): the tile images are stored as float32");
+      }
+    }
 
     cli::ContainerOutput out(t, output, format::AssetKind::kTinyExample, zstd_level);
     cli::check(bake::tiny::writeTinyExampleSections(out.writer(), record, texels, levels,
@@ -265,6 +279,7 @@ int main(int argc, char** argv) {
       }
     }
     if (!crop_box.empty()) params["crop"] = crop_box;
+    params["precision"] = precision;
     params["zstd_level"] = zstd_level;
     params["ingest"] = cli::ingestOptionsJson(ingest);
     Json meta = out.makeMetadata(params);
@@ -289,7 +304,8 @@ int main(int argc, char** argv) {
       doc["tiles"] = tiles;
       doc["raw_bytes"] = raw_bytes;
       doc["file_bytes"] = out.bytesWritten();
-      doc["flakes"] = tiled && glintbake::runtime::TransformedExampleTexels::isGridTransform(record.matrix);
+      doc["flakes"] = true;  // every placement answers small footprints from the plane's flakes
+      doc["precision"] = (record.flags & format::kTinyFlagHalf) != 0 ? "float16" : "float32";
       doc["tile_seconds"] = tile_seconds;
       doc["seconds"] = seconds;
       t.printJson(doc);

@@ -77,7 +77,7 @@ uint32_t tinyTilesPerSide(uint32_t n, uint32_t level) {
 
 uint64_t tinyLevelSectionSize(const TinyExampleRecord& r, uint32_t level) {
   const uint64_t m = tinyTilesPerSide(r.example_size, level);
-  return 32 + m * m * uint64_t(r.ndf_res) * uint64_t(r.ndf_res) * 4;
+  return 32 + m * m * uint64_t(r.ndf_res) * uint64_t(r.ndf_res) * ((r.flags & kTinyFlagHalf) != 0 ? 2 : 4);
 }
 
 bool tinyInvert(const double m[4], double inv[4]) {
@@ -101,10 +101,11 @@ const char* checkTinyExampleRecord(const TinyExampleRecord& r) {
   if (r.levels != levels) return "tiny-example record: levels is not log2(example_size)";
   if (r.ndf_res < 2 || r.ndf_res > kMaxTinyNdfRes) return "tiny-example record: ndf_res out of range";
   if (r.type > uint32_t(TinyExampleType::kStochastic)) return "tiny-example record: unknown type";
-  if (r.reserved != 0 || (r.version == 1 && r.flags != 0) || (r.flags & ~(kTinyFlagLayout | kTinyFlagOverlap)) != 0)
+  if (r.reserved != 0 || (r.version == 1 && r.flags != 0) ||
+      (r.flags & ~(kTinyFlagLayout | kTinyFlagOverlap | kTinyFlagHalf)) != 0)
     return "tiny-example record: reserved fields are not zero";
   if (r.version == 2 && r.flags == 0) return "tiny-example record: version 2 without flags";
-  if (r.flags != 0 && r.type != uint32_t(TinyExampleType::kStochastic))
+  if ((r.flags & (kTinyFlagLayout | kTinyFlagOverlap)) != 0 && r.type != uint32_t(TinyExampleType::kStochastic))
     return "tiny-example record: layout images and overlaps need the stochastic type";
   if (!(finite(r.sigma_r) && r.sigma_r > 0.0 && r.sigma_r <= 1.0)) return "tiny-example record: sigma_r out of range";
   for (double v : r.matrix)

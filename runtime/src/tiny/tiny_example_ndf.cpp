@@ -3,6 +3,7 @@
 // examples a footprint reaches and the NdfSource queries over the tiles it keeps.
 #include <glintbake/runtime/tiny_example_ndf.h>
 
+#include <glintbake/format/binary16.h>
 #include <glintbake/format/validate.h>
 
 #include "../flakes/flake_model.h"
@@ -507,18 +508,38 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
   tile_mass_.assign(rec.levels, {});
   row_mass_.assign(rec.levels, {});
   const size_t image = size_t(res) * res;
+  const bool half = (rec.flags & format::kTinyFlagHalf) != 0;
   for (uint32_t l = 0; l < rec.levels; ++l) {
     const uint64_t m = format::tinyTilesPerSide(rec.example_size, l);
     if (RuntimeStatus s =
-            readSized(reader, format::kSectionTinyExampleLevel, l, format::tinyLevelSectionSize(rec, l), &bytes);
+            readSized(reader, half ? format::kSectionTinyExampleLevelHalf : format::kSectionTinyExampleLevel, l,
+                      format::tinyLevelSectionSize(rec, l), &bytes);
         s != RuntimeStatus::kOk)
       return s;
     format::ImageSectionHeader h;
-    if (!format::parseImageSection(bytes.data(), bytes.size(), &h) || h.width != rec.ndf_res ||
-        h.height != rec.ndf_res || h.channels != 1 || h.layers != m * m)
+    if (half) {
+      uint32_t head[5];
+      std::memcpy(head, bytes.data(), sizeof head);
+      h.width = head[1];
+      h.height = head[2];
+      h.channels = head[3];
+      h.layers = head[4];
+      if (head[0] != format::kTinyHalfImageMagic) return RuntimeStatus::kInvalidAsset;
+    } else if (!format::parseImageSection(bytes.data(), bytes.size(), &h)) {
+      return RuntimeStatus::kInvalidAsset;
+    }
+    if (h.width != rec.ndf_res || h.height != rec.ndf_res || h.channels != 1 || h.layers != m * m)
       return RuntimeStatus::kInvalidAsset;
     levels_[l].resize(size_t(m * m) * image);
-    std::memcpy(levels_[l].data(), bytes.data() + 32, levels_[l].size() * 4);
+    if (half) {
+      for (size_t i = 0; i < levels_[l].size(); ++i) {
+        uint16_t v;
+        std::memcpy(&v, bytes.data() + 32 + 2 * i, 2);
+        levels_[l][i] = format::halfToFloat(v);
+      }
+    } else {
+      std::memcpy(levels_[l].data(), bytes.data() + 32, levels_[l].size() * 4);
+    }
     for (float v : levels_[l])
       if (!(std::isfinite(v) && v >= 0.0f)) return RuntimeStatus::kInvalidAsset;
     tile_mass_[l].resize(size_t(m * m));

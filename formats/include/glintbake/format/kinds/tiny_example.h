@@ -22,6 +22,13 @@ const char* tinyExampleTypeString(TinyExampleType type);  // "tiled", "stochasti
 // Record flags (version 2; a version 1 record has none).
 constexpr uint32_t kTinyFlagLayout = 1u;   // stochastic: section kSectionTinyExampleLayout holds a layout image
 constexpr uint32_t kTinyFlagOverlap = 2u;  // stochastic: examples may overlap; the nearest centre owns a point
+// Either type: the tile images are stored as binary16 in sections kSectionTinyExampleLevelHalf
+// (instead of float32 in kSectionTinyExampleLevel).
+constexpr uint32_t kTinyFlagHalf = 4u;
+// Magic of the 32-byte header of a binary16 level section ("GIMH"; otherwise the image header of
+// SPEC.md 3.1, values 2 bytes each).
+constexpr uint32_t kTinyHalfImageMagic = 0x484D4947;
+constexpr float kTinyHalfMax = 65504.0f;  // the largest finite binary16
 
 // Section kSectionTinyExampleInfo (key 0, exactly one), 168 bytes little-endian.
 struct TinyExampleRecord {
@@ -87,7 +94,8 @@ const char* checkTinyLayout(const TinyLayout& layout, uint64_t* bad_index = null
 
 // Tiles per side of level l of an n x n example: n / 2^(l+1); 0 when l >= levels.
 uint32_t tinyTilesPerSide(uint32_t example_size, uint32_t level);
-// Bytes of the level section of level l: the 32-byte image header plus tiles^2 x R^2 float32.
+// Bytes of the level section of level l: the 32-byte image header plus tiles^2 x R^2 float32 (or
+// binary16 with kTinyFlagHalf).
 uint64_t tinyLevelSectionSize(const TinyExampleRecord& record, uint32_t level);
 
 // Checks every field of a record against SPEC.md 10.8 (null when valid, otherwise a short message

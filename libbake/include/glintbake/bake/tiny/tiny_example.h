@@ -57,8 +57,14 @@ std::vector<float> tinyTexels(const NormalMap& example);
 // Parallel over tiles (TBB, honouring the caller's arena); the same bytes for any thread count.
 std::vector<std::vector<float>> bakeTinyLevels(const std::vector<float>& texels, int n, double sigma_r, int ndf_res);
 
-// Adds the info, texels and level sections (checked by format::checkTinyExampleRecord first), and
-// the layout section when the record has kTinyFlagLayout (layout then required and checked).
+// Whether every tile value fits binary16 (at most format::kTinyHalfMax), as kTinyFlagHalf needs.
+bool tinyLevelsFitHalf(const std::vector<std::vector<float>>& levels);
+// The record with its levels stored as binary16 (version 2, kTinyFlagHalf).
+format::TinyExampleRecord withHalfLevels(format::TinyExampleRecord record);
+
+// Adds the info, texels and level sections (binary16 when the record has kTinyFlagHalf) (checked by
+// format::checkTinyExampleRecord first), and the layout section when the record has kTinyFlagLayout (layout then
+// required and checked).
 BakeStatus writeTinyExampleSections(format::Writer& writer, const format::TinyExampleRecord& record,
                                     const std::vector<float>& texels, const std::vector<std::vector<float>>& levels,
                                     const format::TinyLayout* layout = nullptr);
