@@ -880,10 +880,13 @@ mapped by the inverse transpose as the runtime maps them). Relative MSE and heat
 covered texels: the fraction of the materialised region some example covers; NDF image relative L1:
 the asset's NDF image (<code>glintquery image</code>, 128 x 128 bins) against the reference
 evaluator's on the materialised region (<code>glintref image</code>) at the view's footprint, near
-the region's centre. The tiled asset answers footprints below 6 texels exactly from the rotated
-example's flakes; above, and for the stochastic asset everywhere, it answers from its tile images:
-piecewise constant over bins 2/128 wide, so a render, which reads one half vector per pixel, shows
-the bins where the NDF is as sharp as the brushed streak (the NDF images agree far better).</p>
+the region's centre. Both assets answer footprints below 4 texels exactly from the flakes of the plane
+they lay (the rotated and rescaled examples as the materialised map holds them), blend them with the
+tiles up to 6 texels and answer larger footprints from the tile images alone: piecewise constant over
+bins 2/128 wide, so a render, which reads one half vector per pixel, shows the bins where the NDF is
+as sharp as the brushed streak (the NDF images agree far better). Near, the stochastic render differs
+from the reference only at the region's edges, where the reference repeats the region while the
+plane goes on.</p>
 <table>
 <tr><th class='l'>asset</th><th class='l'>bake (tinyexample)</th><th>tiles</th><th>tile NDF time (s)</th>
 <th>size (bytes)</th><th>raw tile images (bytes)</th><th>exact flakes</th><th>covered fraction asked</th></tr>

@@ -153,18 +153,22 @@ class ReportTest(clitest.ToolTestCase):
                 self.assertEqual(v["covered_texels"], 1.0)
             else:
                 self.assertAlmostEqual(v["covered_texels"], 0.3, delta=0.03 if view == "far" else 0.08)
-        # Flakes path: the reference's render and NDF to float rounding.
+        # Flakes path: the reference's render and NDF to float rounding (the stochastic plane's render
+        # differs only at the region's edges, where the reference repeats the region and the plane goes
+        # on: measured 0.045, NDF image 9e-8).
         self.assertLess(views[("tiled", "near")]["relative_mse"], 1e-6)
         self.assertLess(views[("tiled", "near")]["ndf_relative_l1"], 1e-4)
+        self.assertLess(views[("stochastic", "near")]["ndf_relative_l1"], 1e-4)
         # Tile path (measured 0.085 and 0.081: the bins of 2/128 against point values of a sharp streak;
-        # NDF images 0.010 and 0.13); the stochastic asset near has no flakes path (0.30, NDF 0.58).
+        # NDF images 0.010 and 0.13).
         self.assertLess(views[("tiled", "far")]["relative_mse"], 0.15)
         self.assertLess(views[("tiled", "far")]["ndf_relative_l1"], 0.03)
         self.assertLess(views[("stochastic", "far")]["relative_mse"], 0.15)
         self.assertLess(views[("stochastic", "far")]["ndf_relative_l1"], 0.25)
-        self.assertLess(views[("stochastic", "near")]["relative_mse"], 0.5)
+        self.assertLess(views[("stochastic", "near")]["relative_mse"], 0.1)
         for kind in ("tiled", "stochastic"):
             self.assertGreater(views[(kind, "far")]["speedup"], 2.0)
+        self.assertTrue(tiny["assets"]["stochastic"]["flakes"])
         self.assertTrue(tiny["assets"]["tiled"]["flakes"])
         self.assertLess(tiny["assets"]["tiled"]["tile_seconds"], 5.0)
         with open(os.path.join(out, "index.html")) as f:

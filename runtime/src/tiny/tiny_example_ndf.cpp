@@ -617,13 +617,11 @@ bool TinyExampleNdf::validFootprint(const Footprint& f) const {
 
 // The flakes' share of a footprint's answer: 1 up to kTinyFlakesExactUpTo, 0 from kTinyFlakesUpTo on,
 // linear in log(sigma) between (the tiles take the rest).
-double tinyFlakeShare(double sigma) {
+static double tinyFlakeShare(double sigma) {
   if (!(sigma > kTinyFlakesExactUpTo)) return 1.0;
   if (sigma >= kTinyFlakesUpTo) return 0.0;
   return std::log(kTinyFlakesUpTo / sigma) / std::log(kTinyFlakesUpTo / kTinyFlakesExactUpTo);
 }
-
-bool TinyExampleNdf::useFlakes(const Footprint& f) const { return open_ && f.sigma < kTinyFlakesUpTo; }
 
 // The footprint in the transformed example's grid (the flakes' coordinates).
 Footprint TinyExampleNdf::flakeFootprint(const Footprint& f) const {

@@ -723,6 +723,8 @@ TEST(TinyExample, SamplingMatchesEval) {
   checkSampling(*stochastic, {50.0, 70.0, 20.0});
   const auto tiled = bakeAsset(map, 16, TinyPlacementOptions(), "chi_tiled");
   checkSampling(*tiled, {3.0, 7.0, 12.0});
+  // Inside the hand-over band: the flakes or the tiles in proportion to their share of the mass.
+  checkSampling(*tiled, {3.0, 7.0, 5.0});
 }
 
 // average() over a bin equals image()'s bin; queries refuse bad arguments.

@@ -19,10 +19,19 @@
 // kept tile T adds w_T D_T(M' s) |det M|, w_T the footprint's probability over the tile (exact:
 // erf products, or the correlated-Gaussian rectangle integral for anisotropic frames), D_T the
 // stored bin-averaged image read as piecewise constant. Stochastic surfaces add the flat base
-// lobe N(0, sigma_r^2) with the probability no example holds. Tiled surfaces whose transform maps
-// the texel grid onto itself (rotations by multiples of 90 degrees and mirrors) answer footprints
-// with sigma below kTinyFlakesUpTo from the exact flakes of the transformed example
-// (TransformedExampleTexels through FlakeNdf); above n sigma the periodic sum is the top tile.
+// lobe N(0, sigma_r^2) with the probability no example holds. Above n sigma the periodic sum is the
+// top tile.
+//
+// Small footprints. Below kTinyFlakesExactUpTo every asset answers from the flakes of the plane it
+// lays (formats/SPEC.md 10.5 at rate 1): a flake at each plane texel centre with the texel that
+// TinyPlaneTexels (and glintquery materialise) gives it and the central differences of its
+// neighbours, so the answer equals the reference evaluator on the materialised plane to float
+// rounding, for every transform, layout and overlap. Tiled assets whose transform maps the texel
+// grid onto itself (multiples of 90 degrees, mirrors) get the same flakes faster from a FlakeNdf
+// over the transformed example (TransformedExampleTexels); the others sum the window's flakes per
+// query (up to 73 x 73 of them; the texels are read into a 50 kB buffer on the stack). From
+// kTinyFlakesExactUpTo to kTinyFlakesUpTo the flakes' answer and the tiles' are blended linearly in
+// log(sigma); sample() picks one of the two in proportion to its share of the mass.
 //
 // Contract (NdfSource): eval() is the sum above inside [-1, 1]^2 and 0 outside; average() its
 // exact mean over a rectangle (the transformed rectangle clipped against the stored bins);
@@ -167,7 +176,6 @@ class TinyExampleNdf final : public NdfSource {
 
  private:
   bool validFootprint(const Footprint& f) const;
-  bool useFlakes(const Footprint& f) const;
   Footprint flakeFootprint(const Footprint& f) const;
   template <typename F>
   bool planeFlakes(const Footprint& f, F&& lobe) const;
