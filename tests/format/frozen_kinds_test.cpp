@@ -208,6 +208,21 @@ TEST(FrozenKindsV1_0, TinyExample) {
 }
 
 // Record version 2: a layout image and overlapping examples; the placement rules pinned on it.
+// Levels as binary16 (flag half, section 116): the record and the sections' bytes.
+TEST(FrozenKindsV1_0, TinyExampleHalf) {
+  Reader reader;
+  openFrozen("v1_0_tiny_example_half.gbk", AssetKind::kTinyExample, &reader);
+  const std::vector<uint8_t> rec = section(reader, kSectionTinyExampleInfo, 0);
+  EXPECT_EQ(rec, frozen::tinyRecordHalf());
+  const TinyExampleRecord r = as<TinyExampleRecord>(rec);
+  EXPECT_EQ(checkTinyExampleRecord(r), nullptr);
+  EXPECT_EQ(r.flags, kTinyFlagHalf);
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevelHalf, 0), frozen::tinyLevelHalf(0));
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevelHalf, 1), frozen::tinyLevelHalf(1));
+  EXPECT_EQ(tinyLevelSectionSize(r, 0), 32u + 2u * 16u * 4u);
+  EXPECT_LT(reader.find(kSectionTinyExampleLevel, 0), 0);
+}
+
 TEST(FrozenKindsV1_0, TinyExampleVersion2) {
   Reader reader;
   openFrozen("v1_0_tiny_example_v2.gbk", AssetKind::kTinyExample, &reader);

@@ -122,6 +122,17 @@ TEST(FrozenRuntimeV1_0, TinyExample) {
   EXPECT_EQ(v, 0.0);
 }
 
+// Levels stored as binary16 (flag half): the runtime widens them to the float32 values of the
+// version 1 asset.
+TEST(FrozenRuntimeV1_0, TinyExampleHalf) {
+  TinyExampleNdf tiny;
+  ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example_half.gbk").c_str()), RuntimeStatus::kOk);
+  EXPECT_EQ(tiny.record().flags, 4u);
+  double v = 0.0;
+  ASSERT_EQ(tiny.eval(Footprint{1.0, 2.0, 100.0}, SPoint{-0.25, 0.25}, &v), RuntimeStatus::kOk);
+  EXPECT_DOUBLE_EQ(v, 0.125 * 6 + 0.5);
+}
+
 // Record version 2 (layout image, overlaps): the runtime reads the layout and answers on it.
 TEST(FrozenRuntimeV1_0, TinyExampleVersion2) {
   TinyExampleNdf tiny;
