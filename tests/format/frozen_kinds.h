@@ -7,8 +7,8 @@
 
 #include <glintbake/format/container.h>
 
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
