@@ -90,6 +90,19 @@ GLITTER_FACETS_PER_TEXEL = (int(GLITTER_ARGS[GLITTER_ARGS.index("--particles") +
 WANG_BAKE = ["--tile-size", "64", "--ndf-res", "64"]
 WANG_CELLS = "0,0,32,32"
 WANG_REPEATS = 8  # example periods across the image: the repeated render's period is width / 8
+# Tiny examples (Xing et al.): the example build's two tiny-example assets of a 32 x 32 crop of the
+# brushed map (the arguments of examples/Makefile), on a plane seen from straight above under one
+# directional light at two distances (scenes tiny_{near,far}.json, 128 x 128 pixels: 8 x 8 and
+# 64 x 64 examples across, footprints of about 1 and 8 texels: the tiled asset's flakes path and its
+# tile path), each beside the reference P-NDF of the same region of the asset's plane materialised
+# as a normal map (glintquery materialise; scenes tiny_{near,far}_reference.json).
+TINY_MAP = "brushed"
+TINY_BAKE = {
+    "tiled": ["--crop", "64,64,32", "--type", "tiled", "--rotate", "90"],
+    "stochastic": ["--crop", "64,64,32", "--type", "stochastic", "--rotate-range", "0,360", "--scale-range",
+                   "0.8,1.25", "--density", "0.3", "--seed", "5"],
+}
+TINY_VIEWS = {"near": 8, "far": 64}  # view: examples across the plane (the materialised cells per side)
 
 _cache_lock = threading.Lock()
 
@@ -260,6 +273,7 @@ def main():
                         help="footprints whose NDF images are shown side by side (a subset of --ndf-sigmas)")
     parser.add_argument("--no-glitter", action="store_true", help="leave out the procedural glitter renders")
     parser.add_argument("--no-wang", action="store_true", help="leave out the Wang tile renders")
+    parser.add_argument("--no-tiny", action="store_true", help="leave out the tiny-example renders")
     parser.add_argument("-j", "--jobs", type=int, default=2, help="tool runs in parallel (each on one thread)")
     opts = parser.parse_args()
     views = [v for v in opts.views.split(",") if v]
@@ -270,7 +284,7 @@ def main():
 
     total_start = time.perf_counter()
     cpu_start = os.times()
-    for name in ("mapgen", "ndfgen", "tensorpack", "wangtile", "glintref", "glintquery", "glintinfo"):
+    for name in ("mapgen", "ndfgen", "tensorpack", "wangtile", "tinyexample", "glintref", "glintquery", "glintinfo"):
         if not os.access(os.path.join(opts.bin, name), os.X_OK):
             fail(f"{os.path.join(opts.bin, name)} not found: build first (scripts/build.sh) or pass --bin")
     out = opts.out
@@ -559,11 +573,93 @@ def main():
             del r["exr"]
         return {"period_pixels": period, "cells": WANG_CELLS, "renders": renders}
 
+    def tiny_assets():
+        """Both tiny-example assets of the brushed crop (baked here with the example build's arguments,
+        for their figures) and, per view, the region of each plane the scene shows as a normal map."""
+        map_path = os.path.join(opts.maps, f"{TINY_MAP}.exr")
+        if not os.path.exists(map_path):
+            runner.run([tool("mapgen")] + MAPS[TINY_MAP] + ["-o", map_path, "--quiet"], outputs=[map_path])
+        assets = {}
+        for kind, args in TINY_BAKE.items():
+            path = os.path.join(work, f"tiny_{kind}.gbk")
+            doc, seconds = runner.run([tool("tinyexample"), map_path] + args + ["-o", path, "--json", "-j", "1"],
+                                      inputs=[map_path], outputs=[path], capture_json=True)
+            regions = {}
+            for view, cells in TINY_VIEWS.items():
+                region = os.path.join(work, f"tiny_{kind}_{view}_region.exr")
+                made, _ = runner.run([tool("glintquery"), "materialise", path, "--cells", f"0,0,{cells},{cells}",
+                                      "-o", region, "--json"], inputs=[path], outputs=[region], capture_json=True)
+                regions[view] = {"path": region, "covered_fraction": made["covered_fraction"]}
+            assets[kind] = {"path": path, "regions": regions, "bake": " ".join(args),
+                            "bake_seconds": seconds, "tile_seconds": doc["tile_seconds"],
+                            "file_bytes": doc["file_bytes"], "raw_bytes": doc["raw_bytes"], "tiles": doc["tiles"],
+                            "flakes": doc["flakes"], "covered_fraction": doc["asset"].get("covered_fraction")}
+        return assets
+
+    def render_tiny(asset, kind, view):
+        """One asset at one distance: the runtime's render and the reference's on the materialised
+        region, their relative MSE and the fraction of the region's texels some example covers."""
+        renders = {}
+        for mode in ("asset", "reference"):
+            scene = os.path.join(opts.scenes, f"tiny_{view}.json" if mode == "asset" else f"tiny_{view}_reference.json")
+            if not os.path.exists(scene):
+                fail(f"{scene} not found")
+            stem = f"tiny_{kind}_{view}_{mode}"
+            exr = os.path.join(work, stem + ".exr")
+            png = os.path.join(img_dir, stem + ".png")
+            args = [tool("glintref"), "render", scene, "-o", exr, "--preview", png, "--exposure", EXPOSURE, "--json",
+                    "--quiet"] + threads
+            inputs = [scene]
+            if mode == "asset":
+                args += ["--ndf", "asset", "--asset", asset["path"]]
+                inputs.append(asset["path"])
+            else:
+                args += ["--ndf", "reference", "--normal-map", asset["regions"][view]["path"]]
+                inputs.append(asset["regions"][view]["path"])
+            if opts.image_size:
+                args += ["--image-size", opts.image_size]
+            doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
+            renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
+                             "sigma_mean": doc["footprint_sigma_texels"]["mean"],
+                             "preview": os.path.relpath(png, out), "exr": exr}
+        heat = os.path.join(img_dir, f"tiny_{kind}_{view}_error.png")
+        doc, _ = runner.run([tool("glintref"), "compare", renders["asset"]["exr"], renders["reference"]["exr"],
+                             "--heatmap", heat, "--json"],
+                            inputs=[renders["asset"]["exr"], renders["reference"]["exr"]], outputs=[heat],
+                            capture_json=True)
+        # The NDF images at the region's centre and the view's footprint: the asset's bin averages
+        # against the reference evaluator's on the materialised map.
+        centre = TINY_VIEWS[view] * 16 + 0.5
+        sigma = round(renders["asset"]["sigma_mean"], 2)
+        at = f"{centre},{centre + 30}"
+        ref_exr = os.path.join(work, f"tiny_{kind}_{view}_ndf_reference.exr")
+        runner.run([tool("glintref"), "image", asset["regions"][view]["path"], "--at", at, "--sigma", sigma, "--res",
+                    128, "-o", ref_exr, "--quiet"] + threads, inputs=[asset["regions"][view]["path"]],
+                   outputs=[ref_exr])
+        asset_exr = os.path.join(work, f"tiny_{kind}_{view}_ndf_asset.exr")
+        runner.run([tool("glintquery"), "image", asset["path"], "--at", at, "--sigma", sigma, "-o", asset_exr,
+                    "--quiet"] + threads, inputs=[asset["path"]], outputs=[asset_exr])
+        result = {"type": kind, "view": view, "examples_across": TINY_VIEWS[view],
+                  "ndf_relative_l1": relative_l1(read_exr(asset_exr), read_exr(ref_exr)), "ndf_at": at,
+                  "sigma_mean": renders["asset"]["sigma_mean"], "relative_mse": doc["relative_mse"],
+                  "psnr": doc["psnr"], "heatmap": os.path.relpath(heat, out),
+                  "covered_texels": asset["regions"][view]["covered_fraction"],
+                  "speedup": (renders["reference"]["render_seconds"] / renders["asset"]["render_seconds"]
+                              if renders["asset"]["render_seconds"] > 0 else None)}
+        for mode, r in renders.items():
+            del r["exr"]
+            result[mode] = r
+        return result
+
     tasks = []
     wang_task = None
     if not opts.no_wang:
         wang_paths, wang_by = wang_assets()
         wang_task = pool.submit(render_wang, wang_paths)
+    tiny_tasks, tiny = [], None
+    if not opts.no_tiny:
+        tiny = tiny_assets()
+        tiny_tasks = [pool.submit(render_tiny, tiny[kind], kind, view) for kind in TINY_BAKE for view in TINY_VIEWS]
     glitter_tasks = []
     if not opts.no_glitter:
         asset, glitter_by = glitter_asset()
@@ -597,6 +693,12 @@ def main():
         report["wang"]["baked_by"] = wang_by
         print("make-report: wang tiles: repetition " + " ".join(
             f"{m} {fmt(r['repetition'])}" for m, r in report["wang"]["renders"].items()), file=sys.stderr)
+    if tiny_tasks:
+        report["tiny"] = {"map": TINY_MAP, "assets": {k: {key: v for key, v in a.items() if key not in ("path", "regions")}
+                                                      for k, a in tiny.items()},
+                          "views": [t.result() for t in tiny_tasks]}
+        print("make-report: tiny examples: relative MSE " + " ".join(
+            f"{v['type']}/{v['view']} {fmt(v['relative_mse'])}" for v in report["tiny"]["views"]), file=sys.stderr)
     if glitter_tasks:
         report["glitter"] = {"baked_by": glitter_by, "bake": " ".join(GLITTER_ARGS),
                              "views": [t.result() for t in glitter_tasks]}
@@ -764,6 +866,58 @@ example's period ({wang['period_pixels']} pixels), along x and y: near 1 when th
     return "".join(parts)
 
 
+def tiny_html(tiny):
+    """The tiny-example section: each asset near and far beside the reference on its materialised plane."""
+    e = html.escape
+    parts = [f"""<h2 id='tiny'>Tiny examples: one 32 x 32 crop over the whole plane</h2>
+<p>Two tiny-example assets (Xing et al.) of a 32 x 32 crop of the {e(tiny['map'])} map: tiled (one
+transform for all copies, here a rotation by 90 degrees) and stochastic (each example rotated and
+scaled at random, a given fraction of the plane covered, the rest flat). Each is rendered through the
+runtime on a plane seen from straight above under one directional light, near (8 x 8 examples across)
+and far (64 x 64), beside the reference P-NDF of the same region of the asset's plane materialised as a
+normal map (<code>glintquery materialise</code>: every example as placed and transformed, slopes
+mapped by the inverse transpose as the runtime maps them). Relative MSE and heat maps as above;
+covered texels: the fraction of the materialised region some example covers; NDF image relative L1:
+the asset's NDF image (<code>glintquery image</code>, 128 x 128 bins) against the reference
+evaluator's on the materialised region (<code>glintref image</code>) at the view's footprint, near
+the region's centre. Both assets answer footprints below 4 texels exactly from the flakes of the plane
+they lay (the rotated and rescaled examples as the materialised map holds them), blend them with the
+tiles up to 6 texels and answer larger footprints from the tile images alone: piecewise constant over
+bins 2/128 wide, so a render, which reads one half vector per pixel, shows the bins where the NDF is
+as sharp as the brushed streak (the NDF images agree far better). Near, the stochastic render differs
+from the reference only at the region's edges, where the reference repeats the region while the
+plane goes on.</p>
+<table>
+<tr><th class='l'>asset</th><th class='l'>bake (tinyexample)</th><th>tiles</th><th>tile NDF time (s)</th>
+<th>size (bytes)</th><th>raw tile images (bytes)</th><th>exact flakes</th><th>covered fraction asked</th></tr>
+"""]
+    for kind, a in tiny["assets"].items():
+        parts.append(f"<tr><td class='l'>{e(kind)}</td><td class='l'><code>{e(a['bake'])}</code></td><td>{a['tiles']}</td>"
+                     f"<td>{fmt(a['tile_seconds'])}</td><td>{a['file_bytes']}</td><td>{a['raw_bytes']}</td>"
+                     f"<td>{'yes' if a['flakes'] else 'no'}</td><td>{fmt(a['covered_fraction'])}</td></tr>\n")
+    parts.append("</table>\n<table>\n<tr><th class='l'>asset</th><th class='l'>view</th><th>examples across</th>"
+                 "<th>footprint std (texels)</th><th>covered texels</th><th>relative MSE vs the reference</th>"
+                 "<th>PSNR (dB)</th><th>NDF image relative L1</th><th>render time asset / reference (s)</th>"
+                 "<th>speedup</th></tr>\n")
+    for v in tiny["views"]:
+        parts.append(f"<tr><td class='l'>{e(v['type'])}</td><td class='l'>{e(v['view'])}</td>"
+                     f"<td>{v['examples_across']}</td><td>{fmt(v['sigma_mean'])}</td><td>{fmt(v['covered_texels'])}</td>"
+                     f"<td>{fmt(v['relative_mse'])}</td><td>{fmt(v['psnr'])}</td><td>{fmt(v['ndf_relative_l1'])}</td>"
+                     f"<td>{fmt(v['asset']['render_seconds'])} / {fmt(v['reference']['render_seconds'])}</td>"
+                     f"<td>{fmt(v['speedup'])}</td></tr>\n")
+    parts.append("</table>\n")
+    for v in tiny["views"]:
+        label = f"{v['type']}, {v['view']} (footprint {fmt(v['sigma_mean'])} texels)"
+        parts.append(f"<div class='row'><h3>{e(label)}</h3>\n")
+        for key, title in (("asset", "tiny-example asset (runtime)"),
+                           ("reference", "reference P-NDF of the materialised region")):
+            parts.append(f"<figure><img src='{e(v[key]['preview'])}' alt='{e(title)}'>"
+                         f"<figcaption>{e(title)}</figcaption></figure>\n")
+        parts.append(f"<figure><img src='{e(v['heatmap'])}' alt='error'><figcaption>error, relative MSE "
+                     f"{fmt(v['relative_mse'])}</figcaption></figure>\n</div>\n")
+    return "".join(parts)
+
+
 def glitter_html(glitter):
     """The glitter section: three distances, glitter beside smooth Beckmann, with the figures."""
     e = html.escape
@@ -893,6 +1047,8 @@ Area and environment lights integrate the NDF over s, where bin averages are wha
         parts.append(wang_html(report["wang"]))
     if report.get("glitter"):
         parts.append(glitter_html(report["glitter"]))
+    if report.get("tiny"):
+        parts.append(tiny_html(report["tiny"]))
 
     for entry in report["assets"]:
         t = entry["tensor16"]

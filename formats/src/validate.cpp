@@ -79,6 +79,7 @@ struct Payload {
   bool nonfinite_after_flakes_record = false;  // floats at offsets >= sizeof(FlakesRecord)
   bool outside_unit = false;                   // !(|v| <= 1) for a float at any offset
   bool negative_after_image_header = false;    // v < 0 for a float at offsets >= 32
+  bool above_one_after_image_header = false;   // v > 1 for a float at offsets >= 32
 };
 static_assert(sizeof(FlakesRecord) <= Payload::kHead && sizeof(WangRecord) <= Payload::kHead &&
                   sizeof(TinyExampleRecord) <= Payload::kHead && layout::kImageHeaderSize <= Payload::kHead,
@@ -119,6 +120,7 @@ class PayloadSink final : public detail::SectionSink {
     if (offset >= layout::kImageHeaderSize) {
       if (!finite) ++p_->nonfinite_after_image_header;
       if (v < 0.0f) p_->negative_after_image_header = true;
+      if (v > 1.0f) p_->above_one_after_image_header = true;
     }
   }
   Payload* p_;
@@ -228,6 +230,7 @@ struct TinyExampleSeen {
   bool record_ok = false;
   TinyExampleRecord record;
   std::vector<std::pair<uint64_t, ImageSectionHeader>> levels;  // (key, image header) of readable levels
+  int layouts = 0;                                              // layout sections (type 115)
 };
 
 void noteTinyExamplePayload(size_t index, const SectionInfo& s, const Payload& raw, TinyExampleSeen* seen,
@@ -247,6 +250,36 @@ void noteTinyExamplePayload(size_t index, const SectionInfo& s, const Payload& r
       return;
     }
     seen->levels.emplace_back(s.key, header);
+  } else if (s.type == kSectionTinyExampleLevelHalf) {
+    // binary16 values: the header's dimensions against the size; values are checked by readers.
+    if (raw.size < layout::kImageHeaderSize || layout::load32(raw.head.data()) != kTinyHalfImageMagic) {
+      addError(messages, 6006, describe(index, s) + ": missing the GIMH header of binary16 tile images");
+      return;
+    }
+    ImageSectionHeader h;
+    h.width = layout::load32(raw.head.data() + 4);
+    h.height = layout::load32(raw.head.data() + 8);
+    h.channels = layout::load32(raw.head.data() + 12);
+    h.layers = layout::load32(raw.head.data() + 16);
+    if (uint64_t(h.width) * h.height * h.channels * h.layers * 2 + layout::kImageHeaderSize != raw.size) {
+      addError(messages, 6006, describe(index, s) + ": binary16 header dimensions do not match the section's size");
+      return;
+    }
+    seen->levels.emplace_back(s.key, h);
+  } else if (s.type == kSectionTinyExampleLayout) {
+    ++seen->layouts;
+    ImageSectionHeader h;
+    if (!parseImageHeader(raw.head.data(), raw.size, &h)) {
+      addError(messages, 6006, describe(index, s) + ": the layout is not an image section of its size");
+      return;
+    }
+    if (s.key != 0 || h.layers != 1 || h.width < 1 || h.height < 1 || h.width > kMaxTinyLayoutSide ||
+        h.height > kMaxTinyLayoutSide || h.channels < 1 || h.channels > kMaxTinyLayoutChannels)
+      addError(messages, 6006,
+               describe(index, s) + ": the layout is not one image of 1..1024 x 1..1024 cells, 1..3 channels, key 0");
+    else if (raw.nonfinite_after_image_header != 0 || raw.negative_after_image_header ||
+             raw.above_one_after_image_header)
+      addError(messages, 6006, describe(index, s) + ": layout values not finite or outside [0, 1]");
   }
 }
 
@@ -266,12 +299,15 @@ void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const Tiny
                              [](const SectionInfo& s) { return s.type == kSectionTinyExampleTexels && s.key == 0; });
   if (texels == sections.end() || texels->raw_size != n * n * 8)
     addError(messages, 6006, "the tiny-example texels (type 113) are missing or not example_size^2 (n_x, n_y) pairs");
+  const bool half = (r.flags & kTinyFlagHalf) != 0;
+  const uint32_t level_type = half ? kSectionTinyExampleLevelHalf : kSectionTinyExampleLevel;
   for (uint32_t l = 0; l < r.levels; ++l) {
     auto level = std::find_if(sections.begin(), sections.end(),
-                              [&](const SectionInfo& s) { return s.type == kSectionTinyExampleLevel && s.key == l; });
+                              [&](const SectionInfo& s) { return s.type == level_type && s.key == l; });
     if (level == sections.end() || level->raw_size != tinyLevelSectionSize(r, l)) {
       addError(messages, 6006,
-               "tiny-example level " + std::to_string(l) + " (type 114) is missing or has the wrong size");
+               "tiny-example level " + std::to_string(l) + " (type " + std::to_string(level_type) +
+                   ") is missing or has the wrong size");
       continue;
     }
     const uint64_t m = tinyTilesPerSide(r.example_size, l);
@@ -280,9 +316,20 @@ void checkTinyExampleLayout(const std::vector<SectionInfo>& sections, const Tiny
         addError(messages, 6006, "tiny-example level " + std::to_string(l) + " images are not tiles^2 layers of R x R");
     }
   }
+  const bool has_layout = (r.flags & kTinyFlagLayout) != 0;
+  if (has_layout && seen.layouts != 1)
+    addError(messages, 6006,
+             "the record asks for a layout image, and the asset holds " + std::to_string(seen.layouts) +
+                 " layout sections (type 115), not one");
+  if (!has_layout && seen.layouts != 0)
+    addError(messages, 6006, "a layout section (type 115) in an asset whose record has no layout");
   for (const SectionInfo& s : sections) {
-    if (s.type == kSectionTinyExampleLevel && s.key >= r.levels)
+    if ((s.type == kSectionTinyExampleLevel || s.type == kSectionTinyExampleLevelHalf) && s.key >= r.levels)
       addError(messages, 6006, "tiny-example level " + std::to_string(s.key) + " beyond the record's levels");
+    if (s.type == (half ? kSectionTinyExampleLevel : kSectionTinyExampleLevelHalf))
+      addError(messages, 6006,
+               std::string("a ") + (half ? "float32" : "binary16") + " level section (type " + std::to_string(s.type) +
+                   ") in an asset whose record stores its levels as " + (half ? "binary16" : "float32"));
   }
 }
 
@@ -578,7 +625,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
     } else if (s.type >= kSectionWangInfo && s.type <= kSectionWangTileNdf) {
       checkWangPayload(i, s, raw, &wang_record, &have_wang_record, &report.messages);
     } else if (s.type == kSectionTinyExampleInfo || s.type == kSectionTinyExampleTexels ||
-               s.type == kSectionGlitterInfo || s.type == kSectionGlitterIntegrals) {
+               s.type == kSectionTinyExampleLevelHalf || s.type == kSectionGlitterInfo ||
+               s.type == kSectionGlitterIntegrals) {
       // Records, not images.
     } else if (s.type != kSectionMetadata) {
       checkImagePayload(i, s, raw, &report.messages);

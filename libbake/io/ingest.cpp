@@ -507,4 +507,38 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   return map;
 }
 
+Result<ImageChannels> loadImageChannels(const std::string& path, int max_side, int max_channels) {
+  QuietStderr quiet;
+  IngestOptions options;
+  options.max_size = max_side;
+  Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path, options);
+  if (!opened) return opened.error();
+  OIIO::ImageInput& input = *opened.value();
+  const OIIO::ImageSpec spec = input.spec();
+  if (spec.deep) return makeError(ErrorCode::kInvalidInput, path + ": deep images are not supported");
+  if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1 || spec.width > max_side || spec.height > max_side) {
+    return makeError(ErrorCode::kInvalidInput, path + ": size " + std::to_string(spec.width) + "x" +
+                                                   std::to_string(spec.height) + " is outside 1.." +
+                                                   std::to_string(max_side) + " per side");
+  }
+  if (spec.nchannels < 1 || spec.nchannels > max_channels) {
+    return makeError(ErrorCode::kInvalidInput, path + ": " + std::to_string(spec.nchannels) + " channels, at most " +
+                                                   std::to_string(max_channels) + " expected");
+  }
+  if (BakeStatus st = checkPlausibleSize(path, input, options, spec.nchannels); !st) return st.error();
+  Result<std::vector<float>> read = readPixels(path, input, options, spec.nchannels);
+  if (!read) return read.error();
+  ImageChannels out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.channels = spec.nchannels;
+  out.values = std::move(read.value());
+  std::string hex;
+  if (format::hashFile128Hex(path, &hex) != format::ContainerStatus::kOk) {
+    return makeError(ErrorCode::kIo, path + ": cannot read file to hash it");
+  }
+  out.content_hash = hex.rfind("xxh3-128:", 0) == 0 ? hex : "xxh3-128:" + hex;
+  return out;
+}
+
 }  // namespace glintbake::bake

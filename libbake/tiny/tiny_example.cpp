@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tiny examples: records, tile images and the asset's sections (see bake/tiny/tiny_example.h).
 #include <glintbake/bake/tiny/tiny_example.h>
+#include <glintbake/format/binary16.h>
 #include <glintbake/runtime/tiny_example_ndf.h>
 
 #include <tbb/parallel_for.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 namespace glintbake::bake::tiny {
@@ -15,6 +17,74 @@ namespace glintbake::bake::tiny {
 namespace {
 
 bool finite2(const double v[2]) { return std::isfinite(v[0]) && std::isfinite(v[1]); }
+
+// Overlapping layouts: for every coverage sample point, the smallest threshold of the examples that
+// would cover it (the point is covered at occupancy q when that is below q), sorted.
+std::vector<double> coverageThresholds(const format::TinyExampleRecord& r, const format::TinyLayout* layout) {
+  const int reach = format::tinyOverlapReach(r);
+  const int cells = format::kTinyCoverageCells + 2 * reach, samples = format::kTinyCoverageSamples;
+  std::vector<format::TinyPlacement> candidates(size_t(cells) * cells);
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i)
+      candidates[size_t(j) * cells + i] = format::tinyCellCandidate(r, i - reach, j - reach, layout);
+  const double step = format::kTinyCoverageCells * r.cell_size / samples;
+  std::vector<double> out(size_t(samples) * samples);
+  tbb::parallel_for(0, samples, [&](int b) {
+    double local[2];
+    for (int a = 0; a < samples; ++a) {
+      const double x = (a + 0.5) * step, y = (b + 0.5) * step;
+      const int ci = int(std::floor(x / r.cell_size)), cj = int(std::floor(y / r.cell_size));
+      double best = std::numeric_limits<double>::infinity();
+      for (int j = cj - reach; j <= cj + reach; ++j)
+        for (int i = ci - reach; i <= ci + reach; ++i) {
+          const format::TinyPlacement& c = candidates[size_t(j + reach) * cells + size_t(i + reach)];
+          if (c.threshold < best && format::tinyContains(r, c, x, y, local)) best = c.threshold;
+        }
+      out[size_t(b) * samples + a] = best;
+    }
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The cell side and occupancy of an overlapping layout for the density (or, with a layout image and
+// no density, occupancy 1 and the density it gives): cells of the examples' mean area first, smaller
+// ones while the density is out of reach.
+BakeStatus chooseOverlapLayout(format::TinyExampleRecord* r, const format::TinyLayout* layout, double density,
+                               bool density_given) {
+  format::TinyExampleRecord plain = *r;
+  plain.flags &= ~format::kTinyFlagOverlap;
+  plain.cell_size = 1.0;
+  plain.occupancy = 1.0;
+  const double mean_area = format::tinyCoveredFraction(plain, nullptr);  // E|det M| n^2
+  const double min_cell = format::tinyMinCellSize(*r) / (2.0 * format::kMaxTinyOverlapReach);
+  double cell = std::max(min_cell, std::sqrt(mean_area));
+  for (int attempt = 0;; ++attempt) {
+    r->cell_size = std::ceil(cell * 64.0) / 64.0;
+    r->occupancy = 1.0;
+    const std::vector<double> t = coverageThresholds(*r, layout);
+    const size_t reachable = size_t(std::lower_bound(t.begin(), t.end(), 1.0) - t.begin());
+    if (layout && !density_given) {
+      if (reachable == 0)
+        return makeError(ErrorCode::kInvalidInput, "layout image: presence is 0 in every cell (no example anywhere)");
+      r->density = double(reachable) / double(t.size());
+      return okStatus();
+    }
+    const size_t k = size_t(std::ceil(density * double(t.size()) - 1e-9));
+    if (k >= 1 && k <= reachable) {
+      // Just above the k-th smallest threshold: exactly k sample points covered.
+      r->occupancy = std::min(1.0, std::nextafter(t[k - 1], 2.0));
+      r->density = density;
+      return okStatus();
+    }
+    if (r->cell_size <= min_cell * (1.0 + 1e-9) || attempt >= 16)
+      return makeError(ErrorCode::kBadArgument, "--density " + std::to_string(density) +
+                                                    " exceeds the largest covered fraction of this overlapping "
+                                                    "layout (" +
+                                                    std::to_string(double(reachable) / double(t.size())) + ")");
+    cell = std::max(min_cell, cell / 1.25);
+  }
+}
 
 }  // namespace
 
@@ -44,8 +114,9 @@ Result<format::TinyExampleRecord> makeTinyRecord(int n, int ndf_res, double sigm
   const double mirror[4] = {p.mirror ? -1.0 : 1.0, 0.0, 0.0, 1.0};
   if (p.type == TinyExampleType::kTiled) {
     if (p.rotate_range[0] != p.rotate_range[1] || p.scale_range[0] != p.scale_range[1])
-      return makeError(ErrorCode::kBadArgument, "the tiled type takes one rotation and one scale (--rotate-range and "
-                                                "--scale-range need A == B)");
+      return makeError(ErrorCode::kBadArgument,
+                       "the tiled type takes one rotation and one scale (--rotate-range and "
+                       "--scale-range need A == B)");
     // The tiled matrix is the stochastic rule with a one-point range: R H S (mirror).
     format::TinyExampleRecord probe = r;
     std::copy(mirror, mirror + 4, probe.matrix);
@@ -75,12 +146,31 @@ Result<format::TinyExampleRecord> makeTinyRecord(int n, int ndf_res, double sigm
     std::copy(p.shear, p.shear + 2, r.shear);
     r.occupancy = 1.0;
     r.cell_size = std::ceil(format::tinyMinCellSize(r) * 64.0) / 64.0;
-    const double full = format::tinyCoveredFraction(r);
-    if (p.density > full * (1.0 + 1e-12))
-      return makeError(ErrorCode::kBadArgument, "--density " + std::to_string(p.density) +
-                                                    " exceeds the largest covered fraction of this layout (" +
-                                                    std::to_string(full) + ")");
-    r.occupancy = std::min(1.0, p.density / full);
+    const format::TinyLayout* layout = p.layout.width > 0 ? &p.layout : nullptr;
+    if (layout) {
+      if (const char* why = format::checkTinyLayout(*layout)) return makeError(ErrorCode::kInvalidInput, why);
+      r.version = 2;
+      r.flags = format::kTinyFlagLayout;
+    }
+    if (p.overlap) {
+      r.version = 2;
+      r.flags |= format::kTinyFlagOverlap;
+      if (BakeStatus st = chooseOverlapLayout(&r, layout, p.density, p.density_given); !st) return st.error();
+      if (const char* why = format::checkTinyExampleRecord(r)) return makeError(ErrorCode::kBadArgument, why);
+      return r;
+    }
+    const double full = format::tinyCoveredFraction(r, layout);
+    if (layout && !(full > 0.0))
+      return makeError(ErrorCode::kInvalidInput, "layout image: presence is 0 in every cell (no example anywhere)");
+    if (layout && !p.density_given) {
+      r.density = std::min(1.0, full);
+    } else {
+      if (p.density > full * (1.0 + 1e-12))
+        return makeError(ErrorCode::kBadArgument, "--density " + std::to_string(p.density) +
+                                                      " exceeds the largest covered fraction of this layout (" +
+                                                      std::to_string(full) + ")");
+      r.occupancy = std::min(1.0, p.density / full);
+    }
   }
   if (const char* why = format::checkTinyExampleRecord(r)) return makeError(ErrorCode::kBadArgument, why);
   return r;
@@ -88,8 +178,8 @@ Result<format::TinyExampleRecord> makeTinyRecord(int n, int ndf_res, double sigm
 
 BakeStatus checkTinyExample(const NormalMap& example) {
   const int n = example.width;
-  if (example.width != example.height || n < int(format::kMinTinyExampleSize) ||
-      n > int(format::kMaxTinyExampleSize) || (n & (n - 1)) != 0)
+  if (example.width != example.height || n < int(format::kMinTinyExampleSize) || n > int(format::kMaxTinyExampleSize) ||
+      (n & (n - 1)) != 0)
     return makeError(ErrorCode::kBadArgument, "the example is " + std::to_string(example.width) + " x " +
                                                   std::to_string(example.height) +
                                                   " texels; it must be square, a power of two from 4 to 256");
@@ -139,8 +229,22 @@ std::vector<std::vector<float>> bakeTinyLevels(const std::vector<float>& texels,
   return out;
 }
 
+bool tinyLevelsFitHalf(const std::vector<std::vector<float>>& levels) {
+  for (const auto& level : levels)
+    for (float v : level)
+      if (!(v <= format::kTinyHalfMax)) return false;
+  return true;
+}
+
+format::TinyExampleRecord withHalfLevels(format::TinyExampleRecord record) {
+  record.version = 2;
+  record.flags |= format::kTinyFlagHalf;
+  return record;
+}
+
 BakeStatus writeTinyExampleSections(format::Writer& writer, const format::TinyExampleRecord& record,
-                                    const std::vector<float>& texels, const std::vector<std::vector<float>>& levels) {
+                                    const std::vector<float>& texels, const std::vector<std::vector<float>>& levels,
+                                    const format::TinyLayout* layout) {
   if (const char* why = format::checkTinyExampleRecord(record)) return makeError(ErrorCode::kRuntime, why);
   const size_t n = record.example_size, image = size_t(record.ndf_res) * record.ndf_res;
   if (texels.size() != n * n * 2 || levels.size() != record.levels)
@@ -158,10 +262,37 @@ BakeStatus writeTinyExampleSections(format::Writer& writer, const format::TinyEx
     h.width = h.height = record.ndf_res;
     h.channels = 1;
     h.layers = m * m;
-    bytes.resize(sizeof h + levels[l].size() * 4);
+    const bool half = (record.flags & format::kTinyFlagHalf) != 0;
+    if (half) {
+      h.magic = format::kTinyHalfImageMagic;
+      bytes.resize(sizeof h + levels[l].size() * 2);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      for (size_t i = 0; i < levels[l].size(); ++i) {
+        const uint16_t v = format::floatToHalf(levels[l][i]);
+        std::memcpy(bytes.data() + sizeof h + 2 * i, &v, 2);
+      }
+    } else {
+      bytes.resize(sizeof h + levels[l].size() * 4);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      std::memcpy(bytes.data() + sizeof h, levels[l].data(), levels[l].size() * 4);
+    }
+    if (writer.addSection(half ? format::kSectionTinyExampleLevelHalf : format::kSectionTinyExampleLevel, l,
+                          bytes.data(), bytes.size()) != format::ContainerStatus::kOk)
+      return failed();
+  }
+  if ((record.flags & format::kTinyFlagLayout) != 0) {
+    if (!layout || format::checkTinyLayout(*layout))
+      return makeError(ErrorCode::kRuntime, "the record asks for a layout image and none valid was given");
+    format::ImageSectionHeader h;
+    h.width = layout->width;
+    h.height = layout->height;
+    h.channels = layout->channels;
+    h.layers = 1;
+    const size_t count = size_t(layout->width) * layout->height * layout->channels;
+    bytes.resize(sizeof h + count * 4);
     std::memcpy(bytes.data(), &h, sizeof h);
-    std::memcpy(bytes.data() + sizeof h, levels[l].data(), levels[l].size() * 4);
-    if (writer.addSection(format::kSectionTinyExampleLevel, l, bytes.data(), bytes.size()) !=
+    std::memcpy(bytes.data() + sizeof h, layout->values, count * 4);
+    if (writer.addSection(format::kSectionTinyExampleLayout, 0, bytes.data(), bytes.size()) !=
         format::ContainerStatus::kOk)
       return failed();
   }
@@ -175,7 +306,8 @@ NormalMap materialiseTiled(const NormalMap& example, int copies) {
   big.wrap = Wrap::kRepeat;
   big.normals.resize(size_t(big.width) * size_t(big.height) * 3);
   for (int y = 0; y < big.height; ++y)
-    for (int x = 0; x < big.width; ++x) std::memcpy(big.at(x, y), example.at(x % example.width, y % example.height), 12);
+    for (int x = 0; x < big.width; ++x)
+      std::memcpy(big.at(x, y), example.at(x % example.width, y % example.height), 12);
   return big;
 }
 

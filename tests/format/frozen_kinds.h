@@ -7,6 +7,7 @@
 
 #include <glintbake/format/container.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -200,6 +201,57 @@ inline std::vector<uint8_t> tinyLevel(uint32_t level) {
   return imageSection(4, 4, 1, level == 0 ? 4 : 1, [level](uint32_t x, uint32_t y, uint32_t, uint32_t layer) {
     return tinyValue(level, layer, x, y);
   });
+}
+
+// --- tiny-example, record version 2 (SPEC 10.8): the same example, texels and levels, stochastic
+// with flags layout | overlap: seed 7, density 0.5, cell 2 texels, occupancy 1, rotations 0-180
+// degrees, scale 1, and a 2 x 1 layout of two channels (presence 1 and 0, rotation 0.5 and 0). --
+
+inline std::vector<uint8_t> tinyRecordV2() {
+  Bytes b(168);
+  b.u32(0, 0x594E5447).u32(4, 2).u32(8, 4).u32(12, 2).u32(16, 4).u32(20, 1).u32(24, 3).u32(28, 0);
+  b.f64(32, 0.05);
+  b.f64(40, 1.0).f64(48, 0.0).f64(56, 0.0).f64(64, 1.0);  // matrix
+  b.u64(88, 7).f64(96, 0.5).f64(104, 2.0).f64(112, 1.0);  // seed, density, cell_size, occupancy
+  b.f64(120, 0.0).f64(128, 180.0);                        // rotate_range
+  b.f64(136, 1.0).f64(144, 1.0);                          // scale_range
+  return b.bytes();
+}
+
+// --- tiny-example, record version 2 with flag half (SPEC 10.8): the tiled example above with its
+// levels as binary16 (section 116; every value a multiple of 1/16, exact in binary16). -------------
+
+inline std::vector<uint8_t> tinyRecordHalf() {
+  std::vector<uint8_t> out = tinyRecord();
+  const uint32_t version = 2, flags = 4;
+  std::memcpy(out.data() + 4, &version, 4);
+  std::memcpy(out.data() + 24, &flags, 4);
+  return out;
+}
+
+// binary16 bits of a non-negative value exact in binary16 (a normal number or 0).
+inline uint16_t tinyHalfBits(float v) {
+  if (v == 0.0f) return 0;
+  int e = 0;
+  const float m = std::frexp(v, &e);  // v = m 2^e, m in [0.5, 1)
+  return uint16_t(((e - 1 + 15) << 10) | uint32_t(std::lround((2.0f * m - 1.0f) * 1024.0f)));
+}
+
+inline std::vector<uint8_t> tinyLevelHalf(uint32_t level) {
+  const uint32_t layers = level == 0 ? 4 : 1;
+  Bytes b(32 + 2 * 16 * layers);
+  b.u32(0, 0x484D4947).u32(4, 4).u32(8, 4).u32(12, 1).u32(16, layers);
+  for (uint32_t l = 0; l < layers; ++l)
+    for (uint32_t y = 0; y < 4; ++y)
+      for (uint32_t x = 0; x < 4; ++x) b.u16(32 + 2 * ((l * 4 + y) * 4 + x), tinyHalfBits(tinyValue(level, l, x, y)));
+  return b.bytes();
+}
+
+inline std::vector<uint8_t> tinyLayoutV2() {
+  Bytes b(32 + 2 * 2 * 4);  // image header (SPEC 3.1), then (presence, rotation) of cells 0 and 1
+  b.u32(0, 0x474D4947).u32(4, 2).u32(8, 1).u32(12, 2).u32(16, 1);
+  b.f32(32, 1.0f).f32(36, 0.5f).f32(40, 0.0f).f32(44, 0.0f);
+  return b.bytes();
 }
 
 }  // namespace glintbake::format::frozen

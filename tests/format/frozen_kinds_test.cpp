@@ -6,11 +6,11 @@
 #include <glintbake/format/binary16.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/glitter.h>
-#include <glintbake/format/kinds/partial.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
+#include <glintbake/format/kinds/partial.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
-#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/format/kinds/wang.h>
 #include <glintbake/format/validate.h>
 
 #include "frozen_kinds.h"
@@ -205,6 +205,56 @@ TEST(FrozenKindsV1_0, TinyExample) {
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 0), frozen::tinyLevel(0));
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1), frozen::tinyLevel(1));
   EXPECT_EQ(section(reader, kSectionTinyExampleLevel, 1).size(), tinyLevelSectionSize(r, 1));
+}
+
+// Record version 2: a layout image and overlapping examples; the placement rules pinned on it.
+// Levels as binary16 (flag half, section 116): the record and the sections' bytes.
+TEST(FrozenKindsV1_0, TinyExampleHalf) {
+  Reader reader;
+  openFrozen("v1_0_tiny_example_half.gbk", AssetKind::kTinyExample, &reader);
+  const std::vector<uint8_t> rec = section(reader, kSectionTinyExampleInfo, 0);
+  EXPECT_EQ(rec, frozen::tinyRecordHalf());
+  const TinyExampleRecord r = as<TinyExampleRecord>(rec);
+  EXPECT_EQ(checkTinyExampleRecord(r), nullptr);
+  EXPECT_EQ(r.flags, kTinyFlagHalf);
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevelHalf, 0), frozen::tinyLevelHalf(0));
+  EXPECT_EQ(section(reader, kSectionTinyExampleLevelHalf, 1), frozen::tinyLevelHalf(1));
+  EXPECT_EQ(tinyLevelSectionSize(r, 0), 32u + 2u * 16u * 4u);
+  EXPECT_LT(reader.find(kSectionTinyExampleLevel, 0), 0);
+}
+
+TEST(FrozenKindsV1_0, TinyExampleVersion2) {
+  Reader reader;
+  openFrozen("v1_0_tiny_example_v2.gbk", AssetKind::kTinyExample, &reader);
+  const std::vector<uint8_t> rec = section(reader, kSectionTinyExampleInfo, 0);
+  EXPECT_EQ(rec, frozen::tinyRecordV2());
+  const TinyExampleRecord r = as<TinyExampleRecord>(rec);
+  EXPECT_EQ(checkTinyExampleRecord(r), nullptr);
+  EXPECT_EQ(r.version, 2u);
+  EXPECT_EQ(r.flags, kTinyFlagLayout | kTinyFlagOverlap);
+  const std::vector<uint8_t> layout_bytes = section(reader, kSectionTinyExampleLayout, 0);
+  EXPECT_EQ(layout_bytes, frozen::tinyLayoutV2());
+  std::vector<float> values(4);
+  std::memcpy(values.data(), layout_bytes.data() + 32, 16);
+  const TinyLayout layout{2, 1, 2, values.data()};
+  EXPECT_EQ(checkTinyLayout(layout), nullptr);
+  EXPECT_EQ(tinyOverlapReach(r), 2);
+  // Odd columns of cells have presence 0; even ones always hold an example, rotated by 90 degrees,
+  // its centre inside its cell.
+  for (int64_t j = -3; j <= 3; ++j) {
+    for (int64_t i = -4; i <= 4; ++i) {
+      const TinyPlacement p = tinyCellPlacement(r, i, j, &layout);
+      EXPECT_EQ(p.present, (i & 1) == 0) << i << "," << j;
+      if (!p.present) continue;
+      EXPECT_NEAR(p.matrix[0], 0.0, 1e-15);
+      EXPECT_EQ(p.matrix[1], 1.0);
+      EXPECT_EQ(p.matrix[2], -1.0);
+      EXPECT_GE(p.centre[0], 2.0 * double(i));
+      EXPECT_LT(p.centre[0], 2.0 * double(i + 1));
+    }
+  }
+  // Without its layout the record places nothing (the layout is part of the asset).
+  EXPECT_FALSE(tinyCellPlacement(r, 0, 0).present);
 }
 
 TEST(FrozenKindsV1_0, Partial) {

@@ -3,10 +3,12 @@
 // records exactly (frozen_kinds.h).
 #include <glintbake/runtime/glitter_ndf.h>
 #include <glintbake/runtime/tiny_example_ndf.h>
+
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf.h>
 #include <glintbake/runtime/wang_ndf.h>
+#include <cmath>
 
 #include "frozen_kinds.h"
 
@@ -118,6 +120,38 @@ TEST(FrozenRuntimeV1_0, TinyExample) {
   EXPECT_DOUBLE_EQ(v, 0.125 * 6 + 0.5);
   ASSERT_EQ(tiny.eval(Footprint{1.0, 2.0, 100.0}, SPoint{0.75, -0.75}, &v), RuntimeStatus::kOk);
   EXPECT_EQ(v, 0.0);
+}
+
+// Levels stored as binary16 (flag half): the runtime widens them to the float32 values of the
+// version 1 asset.
+TEST(FrozenRuntimeV1_0, TinyExampleHalf) {
+  TinyExampleNdf tiny;
+  ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example_half.gbk").c_str()), RuntimeStatus::kOk);
+  EXPECT_EQ(tiny.record().flags, 4u);
+  double v = 0.0;
+  ASSERT_EQ(tiny.eval(Footprint{1.0, 2.0, 100.0}, SPoint{-0.25, 0.25}, &v), RuntimeStatus::kOk);
+  EXPECT_DOUBLE_EQ(v, 0.125 * 6 + 0.5);
+}
+
+// Record version 2 (layout image, overlaps): the runtime reads the layout and answers on it.
+TEST(FrozenRuntimeV1_0, TinyExampleVersion2) {
+  TinyExampleNdf tiny;
+  ASSERT_EQ(tiny.open(frozenPath("v1_0_tiny_example_v2.gbk").c_str()), RuntimeStatus::kOk);
+  EXPECT_TRUE(tiny.hasFlakes());  // the plane flakes
+  EXPECT_FALSE(tiny.hasGridFlakes());
+  const format::TinyLayout* layout = tiny.layout();
+  ASSERT_TRUE(layout != nullptr);
+  if (layout == nullptr) return;
+  EXPECT_EQ(layout->width, 2u);
+  EXPECT_EQ(layout->channels, 2u);
+  EXPECT_EQ(layout->values[1], 0.5f);
+  double mass = 0.0;
+  ASSERT_EQ(tiny.mass(Footprint{3.0, -5.0, 6.0}, &mass), RuntimeStatus::kOk);
+  EXPECT_GT(mass, 0.0);
+  EXPECT_TRUE(std::isfinite(mass));
+  int64_t examples = 0, tiles = 0;
+  ASSERT_EQ(tiny.traversalCount(Footprint{3.0, -5.0, 6.0}, &examples, &tiles), RuntimeStatus::kOk);
+  EXPECT_GT(examples, 0);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 //   ./a.out v1_0_wang  the wang-tiles container (frozen_kinds.h), added with the kind
 //   ./a.out v1_0_tiny_example  the tiny-example container (frozen_kinds.h), added with the kind
 //   ./a.out v1_0_partial  the partial container (frozen_kinds.h), added with the kind
+//   ./a.out v1_0_tiny_example_v2  a tiny-example of record version 2 (layout, overlap), added with it
+//   ./a.out v1_0_tiny_example_half  a tiny-example whose levels are binary16 (flag half), added with it
 #include "frozen_content.h"
 #include "frozen_kinds.h"
 
@@ -105,6 +107,29 @@ int writeTinyExample() {
   return 0;
 }
 
+int writeTinyExampleV2() {
+  if (!writeKind("v1_0_tiny_example_v2.gbk", AssetKind::kTinyExample, "tiny-example", "tinyexample",
+                 {{kSectionTinyExampleInfo, 0, frozen::tinyRecordV2(), Codec::kRaw},
+                  {kSectionTinyExampleTexels, 0, frozen::tinyTexels(), Codec::kRaw},
+                  {kSectionTinyExampleLevel, 0, frozen::tinyLevel(0), Codec::kZstd},
+                  {kSectionTinyExampleLevel, 1, frozen::tinyLevel(1), Codec::kZstd},
+                  {kSectionTinyExampleLayout, 0, frozen::tinyLayoutV2(), Codec::kRaw}}))
+    return 1;
+  std::puts("wrote v1_0_tiny_example_v2.gbk");
+  return 0;
+}
+
+int writeTinyExampleHalf() {
+  if (!writeKind("v1_0_tiny_example_half.gbk", AssetKind::kTinyExample, "tiny-example", "tinyexample",
+                 {{kSectionTinyExampleInfo, 0, frozen::tinyRecordHalf(), Codec::kRaw},
+                  {kSectionTinyExampleTexels, 0, frozen::tinyTexels(), Codec::kRaw},
+                  {kSectionTinyExampleLevelHalf, 0, frozen::tinyLevelHalf(0), Codec::kZstd},
+                  {kSectionTinyExampleLevelHalf, 1, frozen::tinyLevelHalf(1), Codec::kZstd}}))
+    return 1;
+  std::puts("wrote v1_0_tiny_example_half.gbk");
+  return 0;
+}
+
 int writePartial() {
   if (!writeKind("v1_0_partial.gbk", AssetKind::kPartial, "partial", "ndfgen",
                  {{kSectionShardSection, 1, frozen::shardSection(), Codec::kRaw},
@@ -148,6 +173,11 @@ int main(int argc, char** argv) {
   if (argc == 2 && std::strcmp(argv[1], "v1_0_wang") == 0) return writeWang();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_tiny_example") == 0) return writeTinyExample();
   if (argc == 2 && std::strcmp(argv[1], "v1_0_partial") == 0) return writePartial();
-  std::fputs("usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang | v1_0_tiny_example | v1_0_partial\n", stderr);
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_tiny_example_v2") == 0) return writeTinyExampleV2();
+  if (argc == 2 && std::strcmp(argv[1], "v1_0_tiny_example_half") == 0) return writeTinyExampleHalf();
+  std::fputs(
+      "usage: generate_frozen v1_0 | v1_0_kinds | v1_0_glitter | v1_0_wang | v1_0_tiny_example | v1_0_partial | "
+      "v1_0_tiny_example_v2 | v1_0_tiny_example_half\n",
+      stderr);
   return 2;
 }

@@ -1,14 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
-// glintquery materialise: the normal map of a rectangle of cells of a wang-tiles asset's implicit
-// grid, as the runtime lays the tiles (WangGridTexels), so that the reference evaluator and the
-// renderer can be run on the very surface the asset answers for.
+// glintquery materialise: the normal map of a rectangle of cells of an unbounded asset's plane, so
+// that the reference evaluator and the renderer can be run on the very surface the asset answers
+// for: a wang-tiles grid as the runtime lays the tiles (WangGridTexels), or a tiny-example plane with
+// its examples placed and transformed as the runtime places them (TinyPlaneTexels; cells of the
+// example's size).
 #include "commands.h"
 
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/runtime/tiny_example_ndf.h>
 #include <glintbake/runtime/wang_ndf.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,9 +56,13 @@ void parseCells(const std::string& text, int64_t cells[4]) {
 
 CLI::App* addMaterialiseCommand(CLI::App& app, MaterialiseOptions& options) {
   CLI::App* cmd = app.add_subcommand(
-      "materialise", "The normal map of a rectangle of a wang-tiles asset's implicit grid (cells I0..I0+NX-1, ...)");
-  cmd->add_option("asset", options.asset, "wang-tiles asset (.gbk)")->required();
-  cmd->add_option("--cells", options.cells, "Grid cells I0,J0,NX,NY (cell (i, j) covers texels [iT, iT + T) x ...)")
+      "materialise",
+      "The normal map of a rectangle of a wang-tiles or tiny-example asset's plane (cells I0..I0+NX-1, ...)");
+  cmd->add_option("asset", options.asset, "wang-tiles or tiny-example asset (.gbk)")->required();
+  cmd->add_option("--cells", options.cells,
+                  "Cells I0,J0,NX,NY: cell (i, j) covers texels [iT, iT + T) x [jT, jT + T) of the plane, T the "
+                  "tile size (wang-tiles) or the example size n (tiny-example; the examples as placed and "
+                  "transformed, read bilinearly, slopes mapped by the inverse transpose, uncovered texels flat)")
       ->required();
   cmd->add_option("-o,--output", options.output, "Output normal map (.exr: signed float n_x, n_y, n_z)")->required();
   return cmd;
@@ -70,24 +78,48 @@ int runMaterialise(cli::Tool& tool, const MaterialiseOptions& options) {
   const format::ContainerStatus cs = reader.open(options.asset);
   if (cs != format::ContainerStatus::kOk)
     throw Error(cli::exitCodeOf(cs), "cannot open " + options.asset + ": " + format::statusString(cs));
+  // The cell side T and the texels of the rectangle, from the asset's kind.
   rt::WangNdf wang;
-  const rt::RuntimeStatus st = wang.load(reader);
-  if (st != rt::RuntimeStatus::kOk)
-    throw Error(cli::exitCodeOf(st),
-                "cannot open " + options.asset + " as a wang-tiles asset: " + rt::statusString(st));
-  const int64_t t = wang.record().tile_size;
+  rt::TinyExampleNdf tiny;
+  std::unique_ptr<rt::TexelSource> texels;
+  int64_t t = 0;
+  const std::string kind = format::assetKindString(reader.kind());
+  if (reader.kind() == format::AssetKind::kWangTiles) {
+    const rt::RuntimeStatus st = wang.load(reader);
+    if (st != rt::RuntimeStatus::kOk)
+      throw Error(cli::exitCodeOf(st),
+                  "cannot open " + options.asset + " as a wang-tiles asset: " + rt::statusString(st));
+    t = wang.record().tile_size;
+  } else if (reader.kind() == format::AssetKind::kTinyExample) {
+    const rt::RuntimeStatus st = tiny.load(reader);
+    if (st != rt::RuntimeStatus::kOk)
+      throw Error(cli::exitCodeOf(st),
+                  "cannot open " + options.asset + " as a tiny-example asset: " + rt::statusString(st));
+    t = tiny.record().example_size;
+  } else {
+    throw Error(cli::kExitUnsupported,
+                options.asset + " is a " + kind + " asset: materialise needs a wang-tiles or tiny-example asset");
+  }
   const int64_t w = cells[2] * t, h = cells[3] * t;
   if (cells[2] > kMaxMaterialisedSide || cells[3] > kMaxMaterialisedSide || w > kMaxMaterialisedSide ||
       h > kMaxMaterialisedSide || w * h > kMaxMaterialisedTexels)
     throw Error(cli::kExitBadArguments, "--cells " + options.cells + " gives a " + std::to_string(w) + " x " +
                                             std::to_string(h) +
                                             " texel map: at most 16384 per side and 2^25 texels in all");
-  const rt::WangGridTexels texels(wang, cells[0], cells[1], int(cells[2]), int(cells[3]));
+  std::unique_ptr<rt::TinyPlaneTexels> plane;
+  if (reader.kind() == format::AssetKind::kWangTiles)
+    texels.reset(new rt::WangGridTexels(wang, cells[0], cells[1], int(cells[2]), int(cells[3])));
+  else
+    plane.reset(new rt::TinyPlaneTexels(tiny, cells[0] * t, cells[1] * t, int(w), int(h)));
   std::vector<float> rgb(size_t(w) * size_t(h) * 3);
+  int64_t covered = 0;
   for (int64_t y = 0; y < h; ++y) {
     for (int64_t x = 0; x < w; ++x) {
       float n[2];
-      texels.normal(int(x), int(y), n);
+      if (plane)
+        covered += plane->texel(int(x), int(y), n) ? 1 : 0;
+      else
+        texels->normal(int(x), int(y), n);
       float* p = rgb.data() + (size_t(y) * size_t(w) + size_t(x)) * 3;
       p[0] = n[0];
       p[1] = n[1];
@@ -102,9 +134,11 @@ int runMaterialise(cli::Tool& tool, const MaterialiseOptions& options) {
     doc["op"] = "materialise";
     doc["asset"] = cli::baseName(options.asset);
     doc["output"] = cli::baseName(options.output);
+    doc["kind"] = kind;
     doc["cells"] = {cells[0], cells[1], cells[2], cells[3]};
     doc["tile_size"] = t;
     doc["size"] = {w, h};
+    if (plane) doc["covered_fraction"] = double(covered) / double(w * h);
     tool.printJson(doc);
   } else {
     tool.info("wrote " + options.output + " (" + std::to_string(w) + "x" + std::to_string(h) + ")");

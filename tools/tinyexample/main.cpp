@@ -2,6 +2,7 @@
 // tinyexample: bakes the multi-scale tile NDFs of a small normal-map example and its placement
 // (tiled or stochastic) into a tiny-example asset (formats/SPEC.md 10.8; Xing et al., "Tiny
 // example-based procedural microstructures").
+#include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/tiny/tiny_example.h>
 #include <glintbake/cli/container_output.h>
 #include <glintbake/cli/exit_codes.h>
@@ -56,7 +57,8 @@ uint64_t parseBytes(const std::string& text) {
     if (!(value > 0) || value * scale >= 1.8e19) throw std::invalid_argument("range");
     return uint64_t(value * scale);
   } catch (const std::exception&) {
-    throw Error(cli::kExitBadArguments, "--max-memory must be a positive number of bytes, optionally with K, M, G or T");
+    throw Error(cli::kExitBadArguments,
+                "--max-memory must be a positive number of bytes, optionally with K, M, G or T");
   }
 }
 
@@ -75,7 +77,25 @@ bake::NormalMap crop(const bake::NormalMap& map, const std::vector<int>& c) {
   return out;
 }
 
-Json recordJson(const format::TinyExampleRecord& r) {
+// The layout image of --layout: every channel read (1..3), every value finite and in [0, 1].
+bake::ImageChannels loadLayout(cli::Tool& t, const std::string& path) {
+  bake::ImageChannels image =
+      cli::unwrap(bake::loadImageChannels(path, int(format::kMaxTinyLayoutSide), int(format::kMaxTinyLayoutChannels)),
+                  "--layout: ");
+  t.addInput(path);
+  const format::TinyLayout layout{uint32_t(image.width), uint32_t(image.height), uint32_t(image.channels),
+                                  image.values.data()};
+  uint64_t bad = 0;
+  if (const char* why = format::checkTinyLayout(layout, &bad)) {
+    const uint64_t pixel = bad / uint64_t(image.channels), channel = bad % uint64_t(image.channels);
+    throw Error(cli::kExitInvalidInput,
+                "--layout: " + path + ": " + why + " (pixel " + std::to_string(pixel % uint64_t(image.width)) + "," +
+                    std::to_string(pixel / uint64_t(image.width)) + ", channel " + std::to_string(channel) + ")");
+  }
+  return image;
+}
+
+Json recordJson(const format::TinyExampleRecord& r, const format::TinyLayout* layout) {
   Json j;
   j["type"] = format::tinyExampleTypeString(format::TinyExampleType(r.type));
   j["example_size"] = r.example_size;
@@ -90,10 +110,13 @@ Json recordJson(const format::TinyExampleRecord& r) {
     j["density"] = r.density;
     j["cell_size"] = r.cell_size;
     j["occupancy"] = r.occupancy;
-    j["covered_fraction"] = format::tinyCoveredFraction(r);
+    j["covered_fraction"] = format::tinyCoveredFraction(r, layout);
     j["rotate_range"] = {r.rotate_range[0], r.rotate_range[1]};
     j["scale_range"] = {r.scale_range[0], r.scale_range[1]};
     j["shear"] = {r.shear[0], r.shear[1]};
+    // Only when set: assets of version 1 keep their metadata.
+    if ((r.flags & format::kTinyFlagLayout) != 0) j["layout"] = true;
+    if ((r.flags & format::kTinyFlagOverlap) != 0) j["overlap"] = true;
   }
   return j;
 }
@@ -106,9 +129,12 @@ int main(int argc, char** argv) {
                   "A 32 x 32 crop tiled over the plane, rotated by 90 degrees.");
   tool.addExample("tinyexample flake.png --type stochastic --rotate-range 0,360 --density 0.3 --seed 5 -o sparse.gbk",
                   "Randomly rotated copies of the example covering 30% of the plane.");
-  std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G";
+  tool.addExample("tinyexample flake.png --type stochastic --rotate-range 0,180 --layout layout.png -o painted.gbk",
+                  "Presence (red) and rotation (green) of the example in each layout cell painted in an image.");
+  std::string input, output, type = "tiled", rotate_range, scale_range, shear, translate, layout, max_memory = "1G",
+                             precision = "float16";
   double rotate = 0.0, density = 1.0, sigma_r = 0.005;
-  bool rotate_given = false, mirror = false;
+  bool rotate_given = false, mirror = false, overlap = false;
   int ndf_res = 128, zstd_level = 3;
   uint64_t seed = 0;
   std::vector<int> crop_box;
@@ -122,17 +148,33 @@ int main(int argc, char** argv) {
   app.add_option("--ndf-res", ndf_res, "Bins per side of every tile NDF (2..1024)")->capture_default_str();
   app.add_option("--sigma-r", sigma_r, "Intrinsic roughness of the texels' lobes (0, 1]")->capture_default_str();
   app.add_option("--seed", seed, "Stochastic: seed of the layout")->capture_default_str();
-  app.add_option("--density", density, "Stochastic: covered fraction of the plane (0, 1]")->capture_default_str();
+  auto* density_opt =
+      app.add_option("--density", density, "Stochastic: covered fraction of the plane (0, 1]")->capture_default_str();
   auto* rot = app.add_option("--rotate", rotate, "Rotation of every example, degrees counter-clockwise");
   app.add_option("--rotate-range", rotate_range, "Stochastic: rotations drawn uniformly from A,B degrees")
       ->excludes(rot);
   app.add_option("--scale-range", scale_range, "Scales drawn uniformly from A,B (tiled: A = B), 0.125..8");
   app.add_option("--shear", shear, "Shear HX,HY of every example (|.| <= 2)");
   app.add_flag("--mirror", mirror, "Mirror every example left to right");
+  app.add_flag("--overlap", overlap,
+               "Stochastic: let examples overlap (cells smaller than the examples, centres anywhere in their "
+               "cell); each point belongs to the example with the nearest centre among those covering it, and "
+               "densities up to what full overlap covers are reachable");
   app.add_option("--translate", translate, "Tiled: position X,Y (texels) of the example's corner");
-  app.add_option("--layout", layout, "A layout image for the stochastic placement (not supported by this version)");
-  app.add_option("--crop", crop_box, "Use the SIZE x SIZE texels at X,Y of the map as the example")->delimiter(',')
+  app.add_option("--layout", layout,
+                 "Stochastic: an image of 1..1024 x 1..1024 layout cells, repeating over the plane, values in "
+                 "[0, 1] (integer files: value / max): channel 0 the probability that the cell holds an example, "
+                 "1 (optional) its rotation within --rotate-range, 2 (optional) its scale within --scale-range; "
+                 "missing channels come from --seed. With --density the presences are scaled to that covered "
+                 "fraction; without, they are used as they are. More than 3 channels, NaNs or values outside "
+                 "[0, 1] are refused (exit 3)");
+  app.add_option("--crop", crop_box, "Use the SIZE x SIZE texels at X,Y of the map as the example")
+      ->delimiter(',')
       ->expected(3);
+  app.add_option("--precision", precision,
+                 "Storage of the tile images: float16 (binary16, half the bytes; float32 is used, with a warning, "
+                 "when a value exceeds 65504) or float32")
+      ->capture_default_str();
   app.add_option("--zstd-level", zstd_level, "zstd compression level of the sections (1..19)")->capture_default_str();
   app.add_option("--max-memory", max_memory,
                  "Refuse the bake when its tile images would need more than this many bytes (suffix K, M, G, T)")
@@ -143,8 +185,8 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     rotate_given = rot->count() > 0;
     if (zstd_level < 1 || zstd_level > 19) throw Error(cli::kExitBadArguments, "--zstd-level must be in [1, 19]");
-    if (!layout.empty())
-      throw Error(cli::kExitUnsupported, "--layout: layout images are not supported by this version (use --seed)");
+    if (precision != "float16" && precision != "float32")
+      throw Error(cli::kExitBadArguments, "--precision must be float16 or float32, not \"" + precision + "\"");
     bake::tiny::TinyPlacementOptions place;
     if (type == "tiled") {
       place.type = format::TinyExampleType::kTiled;
@@ -168,15 +210,25 @@ int main(int argc, char** argv) {
     place.mirror = mirror;
     place.seed = seed;
     place.density = density;
+    place.density_given = density_opt->count() > 0;
     if (tiled && density != 1.0) throw Error(cli::kExitBadArguments, "--density needs --type stochastic");
+    if (tiled && !layout.empty()) throw Error(cli::kExitBadArguments, "--layout needs --type stochastic");
+    if (tiled && overlap) throw Error(cli::kExitBadArguments, "--overlap needs --type stochastic");
+    place.overlap = overlap;
     const uint64_t budget = parseBytes(max_memory);
+    bake::ImageChannels layout_image;
+    if (!layout.empty()) {
+      layout_image = loadLayout(t, layout);
+      place.layout = {uint32_t(layout_image.width), uint32_t(layout_image.height), uint32_t(layout_image.channels),
+                      layout_image.values.data()};
+    }
 
     bake::IngestReport ingest_report;
     const bake::NormalMap map = cli::loadNormalMapForTool(t, input, ingest, &ingest_report);
     const bake::NormalMap example = crop(map, crop_box);
     cli::check(bake::tiny::checkTinyExample(example), input + ": ");
     const int n = example.width;
-    const format::TinyExampleRecord record = cli::unwrap(bake::tiny::makeTinyRecord(n, ndf_res, sigma_r, place));
+    format::TinyExampleRecord record = cli::unwrap(bake::tiny::makeTinyRecord(n, ndf_res, sigma_r, place));
 
     // Tile images in memory: (n^2 - 1) / 3 tiles of R^2 floats, plus the section being written.
     uint64_t tiles = 0;
@@ -196,9 +248,17 @@ int main(int argc, char** argv) {
     const std::vector<float> texels = bake::tiny::tinyTexels(example);
     const std::vector<std::vector<float>> levels = bake::tiny::bakeTinyLevels(texels, n, sigma_r, ndf_res);
     const double tile_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    if (precision == "float16") {
+      if (bake::tiny::tinyLevelsFitHalf(levels)) {
+        record = bake::tiny::withHalfLevels(record);
+      } else {
+        t.warning("a tile density exceeds 65504 (the largest float16): the tile images are stored as float32");
+      }
+    }
 
     cli::ContainerOutput out(t, output, format::AssetKind::kTinyExample, zstd_level);
-    cli::check(bake::tiny::writeTinyExampleSections(out.writer(), record, texels, levels));
+    cli::check(bake::tiny::writeTinyExampleSections(out.writer(), record, texels, levels,
+                                                    place.layout.width > 0 ? &place.layout : nullptr));
     Json params;
     params["type"] = type;
     params["ndf_res"] = ndf_res;
@@ -211,12 +271,19 @@ int main(int argc, char** argv) {
     if (!tiled) {
       params["seed"] = seed;
       params["density"] = density;
+      if (overlap) params["overlap"] = true;
+      if (!layout.empty()) {
+        params["layout"] = cli::baseName(layout);
+        params["layout_size"] = {layout_image.width, layout_image.height, layout_image.channels};
+        params["density_given"] = place.density_given;
+      }
     }
     if (!crop_box.empty()) params["crop"] = crop_box;
+    params["precision"] = precision;
     params["zstd_level"] = zstd_level;
     params["ingest"] = cli::ingestOptionsJson(ingest);
     Json meta = out.makeMetadata(params);
-    meta["asset"] = recordJson(record);
+    meta["asset"] = recordJson(record, place.layout.width > 0 ? &place.layout : nullptr);
     out.finish(meta);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -225,7 +292,7 @@ int main(int argc, char** argv) {
       doc["tool"] = "tinyexample";
       doc["input"] = cli::baseName(input);
       doc["output"] = cli::baseName(output);
-      doc["asset"] = recordJson(record);
+      doc["asset"] = recordJson(record, place.layout.width > 0 ? &place.layout : nullptr);
       doc["levels"] = Json::array();
       for (uint32_t l = 0; l < record.levels; ++l) {
         const uint32_t m = format::tinyTilesPerSide(record.example_size, l);
@@ -237,7 +304,8 @@ int main(int argc, char** argv) {
       doc["tiles"] = tiles;
       doc["raw_bytes"] = raw_bytes;
       doc["file_bytes"] = out.bytesWritten();
-      doc["flakes"] = tiled && glintbake::runtime::TransformedExampleTexels::isGridTransform(record.matrix);
+      doc["flakes"] = true;  // every placement answers small footprints from the plane's flakes
+      doc["precision"] = (record.flags & format::kTinyFlagHalf) != 0 ? "float16" : "float32";
       doc["tile_seconds"] = tile_seconds;
       doc["seconds"] = seconds;
       t.printJson(doc);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace glintbake::format {
 namespace {
@@ -49,6 +50,14 @@ void exampleMatrix(const TinyExampleRecord& r, double degrees, double scale, dou
 
 double det(const double m[4]) { return m[0] * m[3] - m[1] * m[2]; }
 
+// The layout pixel of cell (i, j) (the image repeating over the plane), or null without a layout.
+const float* layoutCell(const TinyLayout* layout, int64_t i, int64_t j) {
+  if (!layout || !layout->values || layout->width == 0 || layout->height == 0) return nullptr;
+  const int64_t w = layout->width, h = layout->height;
+  const int64_t x = ((i % w) + w) % w, y = ((j % h) + h) % h;
+  return layout->values + (size_t(y) * size_t(w) + size_t(x)) * layout->channels;
+}
+
 }  // namespace
 
 const char* tinyExampleTypeString(TinyExampleType type) {
@@ -68,7 +77,7 @@ uint32_t tinyTilesPerSide(uint32_t n, uint32_t level) {
 
 uint64_t tinyLevelSectionSize(const TinyExampleRecord& r, uint32_t level) {
   const uint64_t m = tinyTilesPerSide(r.example_size, level);
-  return 32 + m * m * uint64_t(r.ndf_res) * uint64_t(r.ndf_res) * 4;
+  return 32 + m * m * uint64_t(r.ndf_res) * uint64_t(r.ndf_res) * ((r.flags & kTinyFlagHalf) != 0 ? 2 : 4);
 }
 
 bool tinyInvert(const double m[4], double inv[4]) {
@@ -83,7 +92,7 @@ bool tinyInvert(const double m[4], double inv[4]) {
 
 const char* checkTinyExampleRecord(const TinyExampleRecord& r) {
   if (r.magic != TinyExampleRecord().magic) return "tiny-example record: bad magic";
-  if (r.version != 1) return "tiny-example record: unsupported version";
+  if (r.version != 1 && r.version != 2) return "tiny-example record: unsupported version";
   const uint32_t n = r.example_size;
   if (n < kMinTinyExampleSize || n > kMaxTinyExampleSize || (n & (n - 1)) != 0)
     return "tiny-example record: example_size is not a power of two in [4, 256]";
@@ -92,7 +101,12 @@ const char* checkTinyExampleRecord(const TinyExampleRecord& r) {
   if (r.levels != levels) return "tiny-example record: levels is not log2(example_size)";
   if (r.ndf_res < 2 || r.ndf_res > kMaxTinyNdfRes) return "tiny-example record: ndf_res out of range";
   if (r.type > uint32_t(TinyExampleType::kStochastic)) return "tiny-example record: unknown type";
-  if (r.flags != 0 || r.reserved != 0) return "tiny-example record: reserved fields are not zero";
+  if (r.reserved != 0 || (r.version == 1 && r.flags != 0) ||
+      (r.flags & ~(kTinyFlagLayout | kTinyFlagOverlap | kTinyFlagHalf)) != 0)
+    return "tiny-example record: reserved fields are not zero";
+  if (r.version == 2 && r.flags == 0) return "tiny-example record: version 2 without flags";
+  if ((r.flags & (kTinyFlagLayout | kTinyFlagOverlap)) != 0 && r.type != uint32_t(TinyExampleType::kStochastic))
+    return "tiny-example record: layout images and overlaps need the stochastic type";
   if (!(finite(r.sigma_r) && r.sigma_r > 0.0 && r.sigma_r <= 1.0)) return "tiny-example record: sigma_r out of range";
   for (double v : r.matrix)
     if (!finite(v)) return "tiny-example record: matrix is not finite";
@@ -117,8 +131,11 @@ const char* checkTinyExampleRecord(const TinyExampleRecord& r) {
   if (!(finite(r.density) && r.density > 0.0 && r.density <= 1.0)) return "tiny-example record: density out of range";
   if (!(finite(r.occupancy) && r.occupancy > 0.0 && r.occupancy <= 1.0))
     return "tiny-example record: occupancy out of range";
-  if (!(finite(r.cell_size) && r.cell_size <= 1e6 && r.cell_size >= tinyMinCellSize(r) * (1.0 - 1e-9)))
-    return "tiny-example record: cell_size smaller than an example";
+  const double min_cell =
+      (r.flags & kTinyFlagOverlap) != 0 ? tinyMinCellSize(r) / (2.0 * kMaxTinyOverlapReach) : tinyMinCellSize(r);
+  if (!(finite(r.cell_size) && r.cell_size <= 1e6 && r.cell_size >= min_cell * (1.0 - 1e-9)))
+    return (r.flags & kTinyFlagOverlap) != 0 ? "tiny-example record: cell_size too small for the overlap reach"
+                                             : "tiny-example record: cell_size smaller than an example";
   return nullptr;
 }
 
@@ -137,22 +154,72 @@ double tinyMinCellSize(const TinyExampleRecord& r) {
   return 2.0 * ext * (1.0 + 2.0 * step);
 }
 
-double tinyCoveredFraction(const TinyExampleRecord& r) {
+const char* checkTinyLayout(const TinyLayout& layout, uint64_t* bad_index) {
+  if (layout.width < 1 || layout.height < 1 || layout.width > kMaxTinyLayoutSide || layout.height > kMaxTinyLayoutSide)
+    return "layout image: size out of range (1..1024 cells per side)";
+  if (layout.channels < 1 || layout.channels > kMaxTinyLayoutChannels)
+    return "layout image: not 1 (presence), 2 (+ rotation) or 3 (+ scale) channels";
+  if (!layout.values) return "layout image: no values";
+  const uint64_t count = uint64_t(layout.width) * layout.height * layout.channels;
+  for (uint64_t k = 0; k < count; ++k) {
+    const float v = layout.values[k];
+    if (!(v >= 0.0f && v <= 1.0f)) {
+      if (bad_index) *bad_index = k;
+      return std::isfinite(v) ? "layout image: a value outside [0, 1]" : "layout image: a value that is not finite";
+    }
+  }
+  return nullptr;
+}
+
+double tinyCoveredFraction(const TinyExampleRecord& r, const TinyLayout* layout) {
+  if ((r.flags & kTinyFlagOverlap) != 0) return tinySampledCoverage(r, layout);
   const double a = r.scale_range[0], b = r.scale_range[1];
-  const double mean_s2 = (a * a + a * b + b * b) / 3.0;
+  double mean_s2 = (a * a + a * b + b * b) / 3.0;
+  if (layout && layout->values && layout->width > 0 && layout->height > 0) {
+    // The mean over the image's cells of presence x s^2 (s uniform on the range without channel 2).
+    double sum = 0.0;
+    for (uint32_t y = 0; y < layout->height; ++y) {
+      for (uint32_t x = 0; x < layout->width; ++x) {
+        const float* c = layoutCell(layout, x, y);
+        double s2 = mean_s2;
+        if (layout->channels >= 3) {
+          const double s = a + (b - a) * double(c[2]);
+          s2 = s * s;
+        }
+        sum += double(c[0]) * s2;
+      }
+    }
+    mean_s2 = sum / (double(layout->width) * double(layout->height));
+  }
   const double mean_det = mean_s2 * std::fabs(1.0 - r.shear[0] * r.shear[1]) * std::fabs(det(r.matrix));
   const double n = r.example_size;
   return r.occupancy * mean_det * n * n / (r.cell_size * r.cell_size);
 }
 
-TinyPlacement tinyCellPlacement(const TinyExampleRecord& r, int64_t i, int64_t j) {
+namespace {
+
+// The example of cell (i, j); with `any`, whatever its presence (the candidate).
+TinyPlacement cellExample(const TinyExampleRecord& r, int64_t i, int64_t j, const TinyLayout* layout, bool any) {
   TinyPlacement p;
   p.cell_x = i;
   p.cell_y = j;
-  if (cellUniform(r.seed, i, j, 0) >= r.occupancy) return p;
-  const double deg = r.rotate_range[0] + (r.rotate_range[1] - r.rotate_range[0]) * cellUniform(r.seed, i, j, 1);
-  const double scale = r.scale_range[0] + (r.scale_range[1] - r.scale_range[0]) * cellUniform(r.seed, i, j, 2);
+  const float* cell = (r.flags & kTinyFlagLayout) != 0 ? layoutCell(layout, i, j) : nullptr;
+  if ((r.flags & kTinyFlagLayout) != 0 && !cell) return p;  // a layout asset read without its layout
+  const double presence = cell ? double(cell[0]) : 1.0;
+  const double u0 = cellUniform(r.seed, i, j, 0);
+  p.threshold = presence == 1.0 ? u0 : presence > 0.0 ? u0 / presence : std::numeric_limits<double>::infinity();
+  if (!any && !(p.threshold < r.occupancy)) return p;
+  const double u_rot = cell && layout->channels >= 2 ? double(cell[1]) : cellUniform(r.seed, i, j, 1);
+  const double u_scale = cell && layout->channels >= 3 ? double(cell[2]) : cellUniform(r.seed, i, j, 2);
+  const double deg = r.rotate_range[0] + (r.rotate_range[1] - r.rotate_range[0]) * u_rot;
+  const double scale = r.scale_range[0] + (r.scale_range[1] - r.scale_range[0]) * u_scale;
   exampleMatrix(r, deg, scale, p.matrix);
+  if ((r.flags & kTinyFlagOverlap) != 0) {
+    p.centre[0] = (double(i) + cellUniform(r.seed, i, j, 3)) * r.cell_size;
+    p.centre[1] = (double(j) + cellUniform(r.seed, i, j, 4)) * r.cell_size;
+    p.present = true;
+    return p;
+  }
   const double half = 0.5 * double(r.example_size);
   const double ext_x = (std::fabs(p.matrix[0]) + std::fabs(p.matrix[1])) * half;
   const double ext_y = (std::fabs(p.matrix[2]) + std::fabs(p.matrix[3])) * half;
@@ -163,7 +230,56 @@ TinyPlacement tinyCellPlacement(const TinyExampleRecord& r, int64_t i, int64_t j
   return p;
 }
 
-TinyPlacement tinyOwner(const TinyExampleRecord& r, double x, double y, double local[2]) {
+}  // namespace
+
+TinyPlacement tinyCellPlacement(const TinyExampleRecord& r, int64_t i, int64_t j, const TinyLayout* layout) {
+  TinyPlacement p = cellExample(r, i, j, layout, false);
+  p.present = p.present && p.threshold < r.occupancy;
+  return p;
+}
+
+TinyPlacement tinyCellCandidate(const TinyExampleRecord& r, int64_t i, int64_t j, const TinyLayout* layout) {
+  return cellExample(r, i, j, layout, true);
+}
+
+int tinyOverlapReach(const TinyExampleRecord& r) {
+  if ((r.flags & kTinyFlagOverlap) == 0 || !(r.cell_size > 0.0)) return 0;
+  // A cheap bound on the half extent of every example, sqrt(2) |M| n / 2 (|M| the largest singular
+  // value of M at the largest scale: no rotation makes a row of M longer), computed per query. The
+  // record check keeps the true extent within kMaxTinyOverlapReach cells, so clamping is safe.
+  const double h[4] = {1.0, r.shear[0], r.shear[1], 1.0};
+  double m[4];
+  multiply(h, r.matrix, m);
+  const double f2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2] + m[3] * m[3], d = det(m);
+  const double sigma_max = std::sqrt(0.5 * (f2 + std::sqrt(std::max(0.0, f2 * f2 - 4.0 * d * d))));
+  const double half = 1.4142135623730951 * r.scale_range[1] * sigma_max * 0.5 * double(r.example_size);
+  const double cells = std::ceil(half / r.cell_size);
+  return int(std::clamp(cells, 1.0, double(kMaxTinyOverlapReach)));
+}
+
+bool tinyContains(const TinyExampleRecord& r, const TinyPlacement& p, double x, double y, double local[2]) {
+  double inv[4];
+  if (!p.present || !tinyInvert(p.matrix, inv)) return false;
+  const double n = r.example_size;
+  const double dx = x - p.centre[0], dy = y - p.centre[1];
+  const double lx = inv[0] * dx + inv[1] * dy + 0.5 * n, ly = inv[2] * dx + inv[3] * dy + 0.5 * n;
+  if (!(lx >= 0.0 && lx < n && ly >= 0.0 && ly < n)) return false;
+  local[0] = lx;
+  local[1] = ly;
+  return true;
+}
+
+double tinySampledCoverage(const TinyExampleRecord& r, const TinyLayout* layout) {
+  const double step = kTinyCoverageCells * r.cell_size / kTinyCoverageSamples;
+  int64_t owned = 0;
+  double local[2];
+  for (int b = 0; b < kTinyCoverageSamples; ++b)
+    for (int a = 0; a < kTinyCoverageSamples; ++a)
+      owned += tinyOwner(r, (a + 0.5) * step, (b + 0.5) * step, local, layout).present ? 1 : 0;
+  return double(owned) / (double(kTinyCoverageSamples) * kTinyCoverageSamples);
+}
+
+TinyPlacement tinyOwner(const TinyExampleRecord& r, double x, double y, double local[2], const TinyLayout* layout) {
   const double n = r.example_size;
   double inv[4];
   if (r.type == uint32_t(TinyExampleType::kTiled)) {
@@ -184,7 +300,29 @@ TinyPlacement tinyOwner(const TinyExampleRecord& r, double x, double y, double l
     local[1] = std::clamp(ey - cy * n, 0.0, std::nextafter(n, 0.0));
     return p;
   }
-  TinyPlacement p = tinyCellPlacement(r, int64_t(std::floor(x / r.cell_size)), int64_t(std::floor(y / r.cell_size)));
+  if ((r.flags & kTinyFlagOverlap) != 0) {
+    // Of the examples covering the point, the one with the nearest centre.
+    const int reach = tinyOverlapReach(r);
+    const int64_t ci = int64_t(std::floor(x / r.cell_size)), cj = int64_t(std::floor(y / r.cell_size));
+    TinyPlacement best;
+    double best_d = 0.0, at[2];
+    for (int64_t j = cj - reach; j <= cj + reach; ++j) {
+      for (int64_t i = ci - reach; i <= ci + reach; ++i) {
+        const TinyPlacement e = tinyCellPlacement(r, i, j, layout);
+        if (!tinyContains(r, e, x, y, at)) continue;
+        const double dx = x - e.centre[0], dy = y - e.centre[1], d = dx * dx + dy * dy;
+        if (!best.present || tinyNearer(d, e, best_d, best)) {
+          best = e;
+          best_d = d;
+          local[0] = at[0];
+          local[1] = at[1];
+        }
+      }
+    }
+    return best;
+  }
+  TinyPlacement p =
+      tinyCellPlacement(r, int64_t(std::floor(x / r.cell_size)), int64_t(std::floor(y / r.cell_size)), layout);
   if (!p.present || !tinyInvert(p.matrix, inv)) {
     p.present = false;
     return p;

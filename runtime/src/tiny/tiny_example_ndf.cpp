@@ -3,6 +3,7 @@
 // examples a footprint reaches and the NdfSource queries over the tiles it keeps.
 #include <glintbake/runtime/tiny_example_ndf.h>
 
+#include <glintbake/format/binary16.h>
 #include <glintbake/format/validate.h>
 
 #include "../flakes/flake_model.h"
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <new>
+#include <optional>
 
 namespace glintbake::runtime {
 
@@ -172,6 +174,172 @@ TinyExampleNdf::Frame makeFrame(const double m[4]) {
 
 const double kIdentity[4] = {1.0, 0.0, 0.0, 1.0};
 
+// ---------------------------------------------------------------------------------------------
+// Overlapping layouts: the examples that may take points of one example, and the share of a tile
+// the example owns under the nearest-centre rule (format::tinyNearer).
+
+constexpr int kMaxNeighbours = (4 * format::kMaxTinyOverlapReach + 1) * (4 * format::kMaxTinyOverlapReach + 1);
+
+struct Neighbour {
+  format::TinyPlacement p;
+  double box[4];  // x0, x1, y0, y1 of its square on the plane
+};
+
+struct OwnedExample {
+  format::TinyPlacement self;
+  Neighbour others[kMaxNeighbours];
+  int count = 0;
+};
+
+// Bounding box of the example's square on the plane.
+void exampleBox(const format::TinyExampleRecord& r, const format::TinyPlacement& p, double box[4]) {
+  const double half = 0.5 * double(r.example_size);
+  const double ex = (std::fabs(p.matrix[0]) + std::fabs(p.matrix[1])) * half;
+  const double ey = (std::fabs(p.matrix[2]) + std::fabs(p.matrix[3])) * half;
+  box[0] = p.centre[0] - ex;
+  box[1] = p.centre[0] + ex;
+  box[2] = p.centre[1] - ey;
+  box[3] = p.centre[1] + ey;
+}
+
+bool boxesMeet(const double a[4], const double b[4]) {
+  return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3];
+}
+
+// The examples whose squares meet p's (their cells lie within twice the reach of p's cell). False
+// when there are none: p owns all of its square.
+// The placements of a rectangle of cells, computed once per query when the rectangle fits (the
+// window's cells and those their examples' neighbours lie in), else each time they are asked for.
+struct PlacementCache {
+  static constexpr int kCells = 576;
+  const format::TinyExampleRecord* record = nullptr;
+  const format::TinyLayout* layout = nullptr;
+  int64_t i0 = 0, j0 = 0, width = 0, height = 0;  // width 0: nothing cached
+  format::TinyPlacement cells[kCells];
+
+  void fill(int64_t ci0, int64_t ci1, int64_t cj0, int64_t cj1) {
+    width = height = 0;
+    if ((ci1 - ci0 + 1) * (cj1 - cj0 + 1) > kCells) return;
+    i0 = ci0;
+    j0 = cj0;
+    width = ci1 - ci0 + 1;
+    height = cj1 - cj0 + 1;
+    for (int64_t j = 0; j < height; ++j)
+      for (int64_t i = 0; i < width; ++i)
+        cells[j * width + i] = format::tinyCellPlacement(*record, i0 + i, j0 + j, layout);
+  }
+  format::TinyPlacement at(int64_t i, int64_t j) const {
+    if (i >= i0 && i < i0 + width && j >= j0 && j < j0 + height) return cells[(j - j0) * width + (i - i0)];
+    return format::tinyCellPlacement(*record, i, j, layout);
+  }
+};
+
+bool gatherNeighbours(const format::TinyExampleRecord& r, const PlacementCache& cache, const format::TinyPlacement& p,
+                      int reach, OwnedExample* out) {
+  out->self = p;
+  out->count = 0;
+  double own[4];
+  exampleBox(r, p, own);
+  const int span = 2 * reach;
+  for (int64_t j = p.cell_y - span; j <= p.cell_y + span; ++j) {
+    for (int64_t i = p.cell_x - span; i <= p.cell_x + span; ++i) {
+      if (i == p.cell_x && j == p.cell_y) continue;
+      const format::TinyPlacement q = cache.at(i, j);
+      if (!q.present) continue;
+      Neighbour& nb = out->others[out->count];
+      exampleBox(r, q, nb.box);
+      if (!boxesMeet(own, nb.box)) continue;
+      nb.p = q;
+      ++out->count;
+    }
+  }
+  return out->count > 0;
+}
+
+double dist2(const double c[2], double x, double y) {
+  const double dx = x - c[0], dy = y - c[1];
+  return dx * dx + dy * dy;
+}
+
+// The plane point of example frame point (vx, vy).
+void toPlane(const format::TinyExampleRecord& r, const format::TinyPlacement& p, double vx, double vy, double* x,
+             double* y) {
+  const double h = 0.5 * double(r.example_size);
+  *x = p.centre[0] + p.matrix[0] * (vx - h) + p.matrix[1] * (vy - h);
+  *y = p.centre[1] + p.matrix[2] * (vx - h) + p.matrix[3] * (vy - h);
+}
+
+// Whether the example owns the plane point (x, y) of its own square.
+bool ownsPoint(const format::TinyExampleRecord& r, const OwnedExample& e, double x, double y) {
+  const double de = dist2(e.self.centre, x, y);
+  double local[2];
+  for (int k = 0; k < e.count; ++k) {
+    const Neighbour& nb = e.others[k];
+    if (x < nb.box[0] || x > nb.box[1] || y < nb.box[2] || y > nb.box[3]) continue;
+    if (format::tinyNearer(de, e.self, dist2(nb.p.centre, x, y), nb.p)) continue;
+    if (format::tinyContains(r, nb.p, x, y, local)) return false;
+  }
+  return true;
+}
+
+enum class Ownership { kFull, kNone, kMixed };
+
+// The tile [x0, x0 + t]^2 of the example's frame: owned wholly, taken wholly by one other example,
+// or shared. Half-planes of nearer points and the squares are convex: the corners decide.
+Ownership classifyTile(const format::TinyExampleRecord& r, const OwnedExample& e, double x0, double y0, double t) {
+  double cx[4], cy[4], quad[4] = {1e300, -1e300, 1e300, -1e300};
+  for (int k = 0; k < 4; ++k) {
+    toPlane(r, e.self, x0 + (k & 1) * t, y0 + (k >> 1) * t, &cx[k], &cy[k]);
+    quad[0] = std::min(quad[0], cx[k]);
+    quad[1] = std::max(quad[1], cx[k]);
+    quad[2] = std::min(quad[2], cy[k]);
+    quad[3] = std::max(quad[3], cy[k]);
+  }
+  bool mixed = false;
+  double local[2];
+  for (int k = 0; k < e.count; ++k) {
+    const Neighbour& nb = e.others[k];
+    if (!boxesMeet(quad, nb.box)) continue;
+    int self_wins = 0, inside = 0;
+    for (int c = 0; c < 4; ++c) {
+      self_wins +=
+          format::tinyNearer(dist2(e.self.centre, cx[c], cy[c]), e.self, dist2(nb.p.centre, cx[c], cy[c]), nb.p) ? 1
+                                                                                                                 : 0;
+      inside += format::tinyContains(r, nb.p, cx[c], cy[c], local) ? 1 : 0;
+    }
+    if (self_wins == 4) continue;
+    if (self_wins == 0 && inside == 4) return Ownership::kNone;
+    mixed = true;
+  }
+  return mixed ? Ownership::kMixed : Ownership::kFull;
+}
+
+// The footprint-weighted share of the tile the example owns, from s x s points of the tile.
+double ownedShare(const format::TinyExampleRecord& r, const OwnedExample& e, const Gauss& g, double x0, double y0,
+                  double t, int s) {
+  const double det = g.cxx * g.cyy - g.cxy * g.cxy;
+  const double ixx = g.cyy / det, ixy = -g.cxy / det, iyy = g.cxx / det;
+  double total = 0.0, owned = 0.0;
+  int count = 0, owned_count = 0;
+  for (int b = 0; b < s; ++b) {
+    for (int a = 0; a < s; ++a) {
+      const double vx = x0 + (a + 0.5) * t / s, vy = y0 + (b + 0.5) * t / s;
+      const double dx = vx - g.mx, dy = vy - g.my;
+      const double w = det > 0.0 ? std::exp(-0.5 * (ixx * dx * dx + 2.0 * ixy * dx * dy + iyy * dy * dy)) : 0.0;
+      double x, y;
+      toPlane(r, e.self, vx, vy, &x, &y);
+      const bool mine = ownsPoint(r, e, x, y);
+      total += w;
+      ++count;
+      if (mine) {
+        owned += w;
+        ++owned_count;
+      }
+    }
+  }
+  return total > 1e-300 ? owned / total : double(owned_count) / double(count);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -226,6 +394,48 @@ void TransformedExampleTexels::normal(int x, int y, float out[2]) const {
   const double a0 = m_[0], a1 = -m_[1], a2 = -m_[2], a3 = m_[3];
   out[0] = float(a0 * t[0] + a1 * t[1]);
   out[1] = float(a2 * t[0] + a3 * t[1]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// A rectangle of the plane as a normal map.
+
+TinyPlaneTexels::TinyPlaneTexels(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int width, int height)
+    : asset_(asset), x0_(x0), y0_(y0), width_(std::max(1, width)), height_(std::max(1, height)) {}
+
+bool TinyPlaneTexels::texel(int x, int y, float out[2]) const {
+  out[0] = out[1] = 0.0f;
+  const float* texels = asset_.texels();
+  if (!texels) return false;
+  const format::TinyExampleRecord& r = asset_.record();
+  const int n = int(r.example_size);
+  double local[2];
+  const format::TinyPlacement p =
+      format::tinyOwner(r, double(x0_ + x) + 0.5, double(y0_ + y) + 0.5, local, asset_.layout());
+  if (!p.present) return false;
+  // Bilinear between the texel centres (k + 1/2), the example repeating with its size.
+  const double fx = local[0] - 0.5, fy = local[1] - 0.5;
+  const double ix = std::floor(fx), iy = std::floor(fy);
+  const double tx = fx - ix, ty = fy - iy;
+  const int x_lo = ((int(ix) % n) + n) % n, y_lo = ((int(iy) % n) + n) % n;
+  const int x_hi = (x_lo + 1) % n, y_hi = (y_lo + 1) % n;
+  double e[2];
+  for (int c = 0; c < 2; ++c) {
+    const double a = texels[(size_t(y_lo) * n + x_lo) * 2 + c], b = texels[(size_t(y_lo) * n + x_hi) * 2 + c];
+    const double d = texels[(size_t(y_hi) * n + x_lo) * 2 + c], f = texels[(size_t(y_hi) * n + x_hi) * 2 + c];
+    // Exact at texel centres (tx = ty = 0): no rounding from the weights.
+    const double top = tx == 0.0 ? a : a + tx * (b - a), bottom = tx == 0.0 ? d : d + tx * (f - d);
+    e[c] = ty == 0.0 ? top : top + ty * (bottom - top);
+  }
+  const TinyExampleNdf::Frame frame = makeFrame(p.matrix);
+  double sx = frame.a[0] * e[0] + frame.a[1] * e[1], sy = frame.a[2] * e[0] + frame.a[3] * e[1];
+  const double len = std::sqrt(sx * sx + sy * sy);
+  if (len > kTinyMaxMaterialisedSlope) {
+    sx *= kTinyMaxMaterialisedSlope / len;
+    sy *= kTinyMaxMaterialisedSlope / len;
+  }
+  out[0] = float(sx);
+  out[1] = float(sy);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -284,7 +494,7 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
       s != RuntimeStatus::kOk)
     return s;
   std::memcpy(&rec, bytes.data(), sizeof rec);
-  if (rec.magic == TinyExampleRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
+  if (rec.magic == TinyExampleRecord().magic && rec.version > 2) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkTinyExampleRecord(rec)) return RuntimeStatus::kInvalidAsset;
   const int n = int(rec.example_size), res = int(rec.ndf_res);
   if (RuntimeStatus s = readSized(reader, format::kSectionTinyExampleTexels, 0, uint64_t(n) * n * 8, &bytes);
@@ -298,24 +508,61 @@ RuntimeStatus TinyExampleNdf::load(const format::Reader& reader) {
   tile_mass_.assign(rec.levels, {});
   row_mass_.assign(rec.levels, {});
   const size_t image = size_t(res) * res;
+  const bool half = (rec.flags & format::kTinyFlagHalf) != 0;
   for (uint32_t l = 0; l < rec.levels; ++l) {
     const uint64_t m = format::tinyTilesPerSide(rec.example_size, l);
     if (RuntimeStatus s =
-            readSized(reader, format::kSectionTinyExampleLevel, l, format::tinyLevelSectionSize(rec, l), &bytes);
+            readSized(reader, half ? format::kSectionTinyExampleLevelHalf : format::kSectionTinyExampleLevel, l,
+                      format::tinyLevelSectionSize(rec, l), &bytes);
         s != RuntimeStatus::kOk)
       return s;
     format::ImageSectionHeader h;
-    if (!format::parseImageSection(bytes.data(), bytes.size(), &h) || h.width != rec.ndf_res ||
-        h.height != rec.ndf_res || h.channels != 1 || h.layers != m * m)
+    if (half) {
+      uint32_t head[5];
+      std::memcpy(head, bytes.data(), sizeof head);
+      h.width = head[1];
+      h.height = head[2];
+      h.channels = head[3];
+      h.layers = head[4];
+      if (head[0] != format::kTinyHalfImageMagic) return RuntimeStatus::kInvalidAsset;
+    } else if (!format::parseImageSection(bytes.data(), bytes.size(), &h)) {
+      return RuntimeStatus::kInvalidAsset;
+    }
+    if (h.width != rec.ndf_res || h.height != rec.ndf_res || h.channels != 1 || h.layers != m * m)
       return RuntimeStatus::kInvalidAsset;
     levels_[l].resize(size_t(m * m) * image);
-    std::memcpy(levels_[l].data(), bytes.data() + 32, levels_[l].size() * 4);
+    if (half) {
+      for (size_t i = 0; i < levels_[l].size(); ++i) {
+        uint16_t v;
+        std::memcpy(&v, bytes.data() + 32 + 2 * i, 2);
+        levels_[l][i] = format::halfToFloat(v);
+      }
+    } else {
+      std::memcpy(levels_[l].data(), bytes.data() + 32, levels_[l].size() * 4);
+    }
     for (float v : levels_[l])
       if (!(std::isfinite(v) && v >= 0.0f)) return RuntimeStatus::kInvalidAsset;
     tile_mass_[l].resize(size_t(m * m));
     row_mass_[l].resize(size_t(m * m) * res);
     for (size_t t = 0; t < m * m; ++t)
       tile_mass_[l][t] = rowIntegrals(levels_[l].data() + t * image, res, row_mass_[l].data() + t * res);
+  }
+  layout_ = format::TinyLayout();
+  layout_values_.clear();
+  if ((rec.flags & format::kTinyFlagLayout) != 0) {
+    const int idx = reader.find(format::kSectionTinyExampleLayout, 0);
+    if (idx < 0 || reader.sections()[size_t(idx)].raw_size < 32) return RuntimeStatus::kInvalidAsset;
+    if (RuntimeStatus s = fromFormatStatus(reader.readSection(size_t(idx), &bytes)); s != RuntimeStatus::kOk) return s;
+    format::ImageSectionHeader h;
+    if (!format::parseImageSection(bytes.data(), bytes.size(), &h) || h.layers != 1 || h.width < 1 || h.height < 1 ||
+        h.width > format::kMaxTinyLayoutSide || h.height > format::kMaxTinyLayoutSide || h.channels < 1 ||
+        h.channels > format::kMaxTinyLayoutChannels ||
+        bytes.size() != 32 + uint64_t(h.width) * h.height * h.channels * 4)
+      return RuntimeStatus::kInvalidAsset;
+    layout_values_.resize(size_t(h.width) * h.height * h.channels);
+    std::memcpy(layout_values_.data(), bytes.data() + 32, layout_values_.size() * 4);
+    layout_ = {h.width, h.height, h.channels, layout_values_.data()};
+    if (format::checkTinyLayout(layout_)) return RuntimeStatus::kInvalidAsset;
   }
   std::vector<uint8_t>().swap(bytes);
   // The flat base of stochastic layouts: N(0, sigma_r^2 I), bin-integrated.
@@ -347,10 +594,14 @@ FootprintRange TinyExampleNdf::footprintRange() const {
   FootprintRange r;
   if (!open_) return r;
   r.pyramid_min_sigma = 2.0;
+  // Stochastic: the widest footprint whose window (and, with overlaps, the cells around it) stays
+  // within kTinyMaxCells cells.
+  const double side_cells = std::sqrt(double(kTinyMaxCells)) - 2.0 * format::tinyOverlapReach(record_) - 1.0;
   r.pyramid_max_sigma = record_.type == uint32_t(TinyExampleType::kTiled)
                             ? 1e300
-                            : std::sqrt(double(kTinyMaxCells)) * record_.cell_size / (2.0 * kTinyWindowSigmas);
-  if (hasFlakes()) r.exact_max_sigma = kTinyFlakesUpTo;
+                            : side_cells * record_.cell_size / (2.0 * kTinyWindowSigmas);
+  r.exact_max_sigma = kTinyFlakesExactUpTo;
+  r.handover_max_sigma = kTinyFlakesUpTo;
   return r;
 }
 
@@ -364,7 +615,13 @@ bool TinyExampleNdf::validFootprint(const Footprint& f) const {
   return f.sigma <= footprintRange().pyramid_max_sigma;
 }
 
-bool TinyExampleNdf::useFlakes(const Footprint& f) const { return hasFlakes() && f.sigma < kTinyFlakesUpTo; }
+// The flakes' share of a footprint's answer: 1 up to kTinyFlakesExactUpTo, 0 from kTinyFlakesUpTo on,
+// linear in log(sigma) between (the tiles take the rest).
+static double tinyFlakeShare(double sigma) {
+  if (!(sigma > kTinyFlakesExactUpTo)) return 1.0;
+  if (sigma >= kTinyFlakesUpTo) return 0.0;
+  return std::log(kTinyFlakesUpTo / sigma) / std::log(kTinyFlakesUpTo / kTinyFlakesExactUpTo);
+}
 
 // The footprint in the transformed example's grid (the flakes' coordinates).
 Footprint TinyExampleNdf::flakeFootprint(const Footprint& f) const {
@@ -391,6 +648,14 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
   const size_t image = size_t(r.ndf_res) * r.ndf_res;
   const int res = int(r.ndf_res);
   const double sigma = std::max(fp.sigma, kMinSigma);
+  // Overlapping layouts: the probability of the footprint on covered ground is the sum of the kept
+  // tiles' (owned) weights.
+  const bool overlap = format::tinyOverlapReach(r) > 0;
+  double owned_weight = 0.0;
+  auto emit = [&](const Visit& v) {
+    if (overlap) owned_weight += v.weight;
+    visit(v);
+  };
 
   // Descends from the top tile of one example (example frame offset ox, oy; Gaussian g).
   auto descend = [&](const Frame& frame, const Gauss& g, double ox, double oy, auto&& self, int level, int ix,
@@ -409,8 +674,8 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     }
     const int m = int(n) >> (level + 1);
     const size_t tile = size_t(iy) * size_t(m) + size_t(ix);
-    visit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
-                tile_mass_[size_t(level)][tile], w});
+    emit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
+               tile_mass_[size_t(level)][tile], w});
   };
 
   if (r.type == uint32_t(TinyExampleType::kTiled)) {
@@ -447,18 +712,30 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     return true;
   }
 
-  // Stochastic: the cells of the window, each example in its own frame, then the flat base.
+  // Stochastic: the cells of the window (overlapping layouts: and the cells whose examples reach
+  // into it), each example in its own frame, then the flat base.
   const double cell = r.cell_size;
   const double reach = kTinyWindowSigmas * sigma;
+  const int cells_out = format::tinyOverlapReach(r);
   if (!windowInRange(fp.x, reach, cell) || !windowInRange(fp.y, reach, cell)) return false;
-  const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)), i1 = int64_t(std::floor((fp.x + reach) / cell));
-  const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)), j1 = int64_t(std::floor((fp.y + reach) / cell));
+  const int64_t i0 = int64_t(std::floor((fp.x - reach) / cell)) - cells_out,
+                i1 = int64_t(std::floor((fp.x + reach) / cell)) + cells_out;
+  const int64_t j0 = int64_t(std::floor((fp.y - reach) / cell)) - cells_out,
+                j1 = int64_t(std::floor((fp.y + reach) / cell)) + cells_out;
   if (i1 - i0 >= kTinyMaxCells || j1 - j0 >= kTinyMaxCells || (i1 - i0 + 1) * (j1 - j0 + 1) > kTinyMaxCells)
     return false;
   double covered = 0.0;
+  // Built only for overlapping layouts (it is large: no cost for the others).
+  std::optional<PlacementCache> cache;
+  if (overlap) {
+    cache.emplace();
+    cache->record = &r;
+    cache->layout = layout();
+    cache->fill(i0 - 2 * cells_out, i1 + 2 * cells_out, j0 - 2 * cells_out, j1 + 2 * cells_out);
+  }
   for (int64_t j = j0; j <= j1; ++j) {
     for (int64_t i = i0; i <= i1; ++i) {
-      const format::TinyPlacement p = format::tinyCellPlacement(r, i, j);
+      const format::TinyPlacement p = overlap ? cache->at(i, j) : format::tinyCellPlacement(r, i, j, layout());
       if (!p.present) continue;
       double inv[4];
       if (!format::tinyInvert(p.matrix, inv)) continue;
@@ -472,12 +749,47 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
       if (mx + kTinyWindowSigmas * g.sx < 0.0 || mx - kTinyWindowSigmas * g.sx > n ||
           my + kTinyWindowSigmas * g.sy < 0.0 || my - kTinyWindowSigmas * g.sy > n)
         continue;
-      covered += boxProbability(g, 0.0, n, 0.0, n);
       const Frame frame = makeFrame(p.matrix);
       if (entered) ++*entered;
-      descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+      if (!overlap) {
+        covered += boxProbability(g, 0.0, n, 0.0, n);
+        descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+        continue;
+      }
+      OwnedExample e;
+      if (!gatherNeighbours(r, *cache, p, cells_out, &e)) {
+        descend(frame, g, 0.0, 0.0, descend, top, 0, 0);
+        continue;
+      }
+      // Tiles wholly owned descend as without overlaps; tiles others take wholly are dropped; tiles
+      // on the boundary are split while the rule asks, then kept with the owned share of their weight.
+      auto owned = [&](int level, int ix, int iy, auto&& self) -> void {
+        const double t = double(2 << level);
+        const double x0 = ix * t, y0 = iy * t;
+        const double w = boxProbability(g, x0, x0 + t, y0, y0 + t);
+        if (!(w > kNegligible)) return;
+        const Ownership own = classifyTile(r, e, x0, y0, t);
+        if (own == Ownership::kNone) return;
+        if (own == Ownership::kFull) {
+          descend(frame, g, 0.0, 0.0, descend, level, ix, iy);
+          return;
+        }
+        const double ox = x0 + 0.5 * t - g.mx, oy = y0 + 0.5 * t - g.my;
+        if (level > 0 && w * t * (std::sqrt(ox * ox + oy * oy) + t) > kTinyRefine * g.lambda_min) {
+          for (int c = 0; c < 4; ++c) self(level - 1, 2 * ix + (c & 1), 2 * iy + (c >> 1), self);
+          return;
+        }
+        const double share = ownedShare(r, e, g, x0, y0, t, level > 0 ? 8 : 4);
+        if (!(share > 0.0)) return;
+        const int m = int(n) >> (level + 1);
+        const size_t tile = size_t(iy) * size_t(m) + size_t(ix);
+        emit(Visit{&frame, levels_[size_t(level)].data() + tile * image, row_mass_[size_t(level)].data() + tile * res,
+                   tile_mass_[size_t(level)][tile], w * share});
+      };
+      owned(top, 0, 0, owned);
     }
   }
+  if (overlap) covered = owned_weight;
   const double rest = 1.0 - covered;
   if (rest > kNegligible) {
     static const Frame base_frame = makeFrame(kIdentity);
@@ -500,11 +812,7 @@ RuntimeStatus TinyExampleNdf::traversalCount(const Footprint& fp, int64_t* examp
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->eval(flakeFootprint(fp), s, value);
-  }
+RuntimeStatus TinyExampleNdf::tileEval(const Footprint& fp, const SPoint& s, double* value) const {
   if (!inSquare(s)) {
     *value = 0.0;
     return RuntimeStatus::kOk;
@@ -522,23 +830,10 @@ RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double*
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
-  if (!value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->mass(flakeFootprint(fp), value);
-  }
+RuntimeStatus TinyExampleNdf::tileMass(const Footprint& fp, double* value) const {
   double sum = 0.0;
   if (!traverse(fp, [&](const Visit& v) { sum += v.weight * v.mass; })) return RuntimeStatus::kInvalidArgument;
   *value = sum;
-  return RuntimeStatus::kOk;
-}
-
-RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  double e = 0.0, m = 0.0;
-  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
-  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
-  *value = m > 0.0 ? e / m : 0.0;
   return RuntimeStatus::kOk;
 }
 
@@ -590,11 +885,7 @@ bool TinyExampleNdf::batched(const Footprint& fp, F&& flush) const {
   return true;
 }
 
-RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
-  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->average(flakeFootprint(fp), rect, value);
-  }
+RuntimeStatus TinyExampleNdf::tileAverage(const Footprint& fp, const SRect& rect, double* value) const {
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   const double out_area = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
@@ -612,14 +903,9 @@ RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, do
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_count) const {
+// Adds weight times the tiles' image to out (R * R floats).
+RuntimeStatus TinyExampleNdf::addTileImage(const Footprint& fp, double weight, float* out) const {
   const int res = resolution();
-  const size_t count = size_t(res) * size_t(res);
-  if (!out || count == 0 || out_count < count || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->image(flakeFootprint(fp), out, out_count);
-  }
-  std::fill(out, out + count, 0.0f);
   const double bin = 2.0 / res;
   if (!batched(fp, [&](const Batch& batch) {
         const Frame& f = batch.frame;
@@ -638,7 +924,7 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
                                   batch.images, batch.count, res) /
                   (bin * bin);
             }
-            out[size_t(j) * res + i] += float(v);
+            out[size_t(j) * res + i] += float(weight * v);
           }
         }
       }))
@@ -646,14 +932,10 @@ RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
-  if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
-    return RuntimeStatus::kInvalidArgument;
-  if (useFlakes(fp)) {
-    return flakes_->sample(flakeFootprint(fp), u1, u2, out);
-  }
+// Draws from the tiles' answer; the point only (the caller sets the pdf).
+RuntimeStatus TinyExampleNdf::tileSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
   double total = 0.0;
-  if (RuntimeStatus st = mass(fp, &total); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = tileMass(fp, &total); st != RuntimeStatus::kOk) return st;
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The tile, in proportion to weight x mass, in the traversal's order.
   double target = u1 * total, acc = 0.0;
@@ -701,6 +983,242 @@ RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, 
   const double ex = -1.0 + (i + u2) * bin, ey = 1.0 - (j + rest) * bin;
   out->s.x = frame.a[0] * ex + frame.a[1] * ey;
   out->s.y = frame.a[2] * ex + frame.a[3] * ey;
+  out->pdf = 0.0;
+  return RuntimeStatus::kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small footprints: the flakes of the plane as the asset lays it (TinyPlaneTexels).
+
+namespace {
+
+// Texels per side of the largest window the plane flakes read: flakes within
+// 6 sqrt(sigma_h^2 + sigma^2) of the centre for sigma < kTinyFlakesUpTo, and one texel on each side
+// for the central differences.
+constexpr int kPlaneWindow = 2 * int(6.0 * kTinyFlakesUpTo + 2.0) + 4;
+
+struct PlaneWindow {
+  int64_t x0 = 0, y0 = 0;  // plane texel of entry (0, 0)
+  int w = 0, h = 0;
+  float t[kPlaneWindow * kPlaneWindow * 2];
+  const float* at(int64_t x, int64_t y) const { return t + (size_t(y - y0) * size_t(w) + size_t(x - x0)) * 2; }
+};
+
+}  // namespace
+
+// Calls lobe(weight, Lobe) for every flake of the plane within the footprint's window: flake k at
+// plane texel centre u_k = (X + 1/2, Y + 1/2) has the materialised texel's normal n_k and the central
+// differences J_k of its neighbours (formats/SPEC.md 10.5 at rate 1), weight N(u_k; u, (sigma_h^2 +
+// sigma^2) I) and lobe N(n_k + J_k c (u - u_k), sigma_r^2 I + sigma^2 c J_k J_k^T), c = sigma_h^2 /
+// (sigma_h^2 + sigma^2). False when the window does not fit (not reached for sigma < kTinyFlakesUpTo).
+template <typename F>
+bool TinyExampleNdf::planeFlakes(const Footprint& fp, F&& lobe) const {
+  const double sp2 = fp.sigma * fp.sigma, h2 = kSigmaH * kSigmaH, v = h2 + sp2;
+  const double reach = 6.0 * std::sqrt(v);
+  const int64_t fx0 = int64_t(std::ceil(fp.x - reach - 0.5)), fx1 = int64_t(std::floor(fp.x + reach - 0.5));
+  const int64_t fy0 = int64_t(std::ceil(fp.y - reach - 0.5)), fy1 = int64_t(std::floor(fp.y + reach - 0.5));
+  if (fx1 < fx0 || fy1 < fy0) return true;
+  PlaneWindow win;
+  win.x0 = fx0 - 1;
+  win.y0 = fy0 - 1;
+  win.w = int(fx1 - fx0 + 3);
+  win.h = int(fy1 - fy0 + 3);
+  if (win.w > kPlaneWindow || win.h > kPlaneWindow) return false;
+  const TinyPlaneTexels plane(*this, win.x0, win.y0, win.w, win.h);
+  for (int y = 0; y < win.h; ++y)
+    for (int x = 0; x < win.w; ++x) plane.texel(x, y, win.t + (size_t(y) * win.w + x) * 2);
+  const double c = h2 / v, spread = sp2 * c, r2 = record_.sigma_r * record_.sigma_r;
+  const double norm = 1.0 / (2.0 * 3.14159265358979323846 * v);
+  for (int64_t y = fy0; y <= fy1; ++y) {
+    const double dy = fp.y - (double(y) + 0.5);
+    for (int64_t x = fx0; x <= fx1; ++x) {
+      const double dx = fp.x - (double(x) + 0.5);
+      const double w = norm * std::exp(-0.5 * (dx * dx + dy * dy) / v);
+      const float* nk = win.at(x, y);
+      const float *l = win.at(x - 1, y), *r = win.at(x + 1, y), *u = win.at(x, y - 1), *d = win.at(x, y + 1);
+      // As the flake model stores them: float normals and Jacobians.
+      const double j0 = double(float((double(r[0]) - double(l[0])) * 0.5)),
+                   j1 = double(float((double(d[0]) - double(u[0])) * 0.5));
+      const double j2 = double(float((double(r[1]) - double(l[1])) * 0.5)),
+                   j3 = double(float((double(d[1]) - double(u[1])) * 0.5));
+      const flakes::Lobe g{double(nk[0]) + c * (j0 * dx + j1 * dy), double(nk[1]) + c * (j2 * dx + j3 * dy),
+                           r2 + spread * (j0 * j0 + j1 * j1), spread * (j0 * j2 + j1 * j3),
+                           r2 + spread * (j2 * j2 + j3 * j3)};
+      lobe(w, g);
+    }
+  }
+  return true;
+}
+
+namespace {
+
+double lobeDensity(const flakes::Lobe& g, double sx, double sy) {
+  const double det = g.cxx * g.cyy - g.cxy * g.cxy;
+  const double dx = sx - g.mx, dy = sy - g.my;
+  const double q = (g.cyy * dx * dx - 2.0 * g.cxy * dx * dy + g.cxx * dy * dy) / det;
+  return std::exp(-0.5 * q) / (2.0 * 3.14159265358979323846 * std::sqrt(det));
+}
+
+}  // namespace
+
+// The flakes' answers: the grid-preserving tiled transforms through FlakeNdf over the transformed
+// example, every other asset through the plane flakes above (the same model and texels).
+RuntimeStatus TinyExampleNdf::flakeEval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (hasGridFlakes()) return flakes_->eval(flakeFootprint(fp), s, value);
+  double sum = 0.0;
+  if (inSquare(s) && !planeFlakes(fp, [&](double w, const flakes::Lobe& g) { sum += w * lobeDensity(g, s.x, s.y); }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::flakeMass(const Footprint& fp, double* value) const {
+  if (hasGridFlakes()) return flakes_->mass(flakeFootprint(fp), value);
+  double sum = 0.0;
+  if (!planeFlakes(fp, [&](double w, const flakes::Lobe&) { sum += w; })) return RuntimeStatus::kInvalidArgument;
+  *value = sum;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::flakeAverage(const Footprint& fp, const SRect& rect, double* value) const {
+  if (hasGridFlakes()) return flakes_->average(flakeFootprint(fp), rect, value);
+  const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
+  const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
+  double sum = 0.0;
+  if (x1 > x0 && y1 > y0 && !planeFlakes(fp, [&](double w, const flakes::Lobe& g) {
+        sum += w * flakes::lobeRectProbability(g, x0, x1, y0, y1);
+      }))
+    return RuntimeStatus::kInvalidArgument;
+  *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::addFlakeImage(const Footprint& fp, double weight, float* out) const {
+  const int res = resolution();
+  if (hasGridFlakes()) return flakes_->addImage(flakeFootprint(fp), weight, out, size_t(res) * res);
+  const double bin = 2.0 / res;
+  if (!planeFlakes(fp,
+                   [&](double w, const flakes::Lobe& g) { flakes::splatLobe(g, weight * w / (bin * bin), res, out); }))
+    return RuntimeStatus::kInvalidArgument;
+  return RuntimeStatus::kOk;
+}
+
+// Draws from the flakes' answer; the point only (the caller sets the pdf).
+RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (hasGridFlakes()) return flakes_->sample(flakeFootprint(fp), u1, u2, out);
+  double total = 0.0;
+  if (RuntimeStatus st = flakeMass(fp, &total); st != RuntimeStatus::kOk) return st;
+  if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+  // The flake in proportion to its weight, in the window's order, then a point of its lobe (Box-Muller
+  // on the rescaled u1 and u2).
+  const double target = u1 * total;
+  double acc = 0.0, rest = 0.5;
+  bool found = false;
+  flakes::Lobe chosen{0.0, 0.0, 1.0, 0.0, 1.0};
+  planeFlakes(fp, [&](double w, const flakes::Lobe& g) {
+    if (found || !(w > 0.0)) return;
+    chosen = g;
+    if (target < acc + w) {
+      found = true;
+      rest = (target - acc) / w;
+      return;
+    }
+    acc += w;
+  });
+  rest = std::clamp(rest, 0.0, 0.99999999999999989);
+  const double radius = std::sqrt(-2.0 * std::log1p(-rest)), phi = 2.0 * 3.14159265358979323846 * u2;
+  const double z0 = radius * std::cos(phi), z1 = radius * std::sin(phi);
+  const double l00 = std::sqrt(chosen.cxx), l10 = chosen.cxy / l00;
+  const double l11 = std::sqrt(std::max(chosen.cyy - l10 * l10, 0.0));
+  out->s.x = chosen.mx + l00 * z0;
+  out->s.y = chosen.my + l10 * z0 + l11 * z1;
+  out->pdf = 0.0;
+  return RuntimeStatus::kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The queries: the flakes below kTinyFlakesExactUpTo, the tiles from kTinyFlakesUpTo, blended
+// linearly in log(sigma) between.
+
+RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeEval(fp, s, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileEval(fp, s, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
+  if (!value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeMass(fp, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileMass(fp, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
+  double e = 0.0, m = 0.0;
+  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
+  *value = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
+  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
+  const double a = tinyFlakeShare(fp.sigma);
+  double f = 0.0, t = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeAverage(fp, rect, &f); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileAverage(fp, rect, &t); st != RuntimeStatus::kOk) return st;
+  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::image(const Footprint& fp, float* out, size_t out_count) const {
+  const int res = resolution();
+  const size_t count = size_t(res) * size_t(res);
+  if (!out || count == 0 || out_count < count || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
+  if (hasGridFlakes() && tinyFlakeShare(fp.sigma) >= 1.0) return flakes_->image(flakeFootprint(fp), out, out_count);
+  std::fill(out, out + count, 0.0f);
+  const double a = tinyFlakeShare(fp.sigma);
+  if (a > 0.0)
+    if (RuntimeStatus st = addFlakeImage(fp, a, out); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = addTileImage(fp, 1.0 - a, out); st != RuntimeStatus::kOk) return st;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+    return RuntimeStatus::kInvalidArgument;
+  // The path in proportion to its share of the mass, u1 rescaled for the chosen one.
+  const double a = tinyFlakeShare(fp.sigma);
+  double mf = 0.0, mt = 0.0;
+  if (a > 0.0)
+    if (RuntimeStatus st = flakeMass(fp, &mf); st != RuntimeStatus::kOk) return st;
+  if (a < 1.0)
+    if (RuntimeStatus st = tileMass(fp, &mt); st != RuntimeStatus::kOk) return st;
+  const double pf = a * mf, pt = (1.0 - a) * mt;
+  if (!(pf + pt > 0.0)) return RuntimeStatus::kInvalidArgument;
+  const double split = pf / (pf + pt);
+  RuntimeStatus st;
+  if (u1 < split || !(pt > 0.0)) {
+    st = flakeSample(fp, std::clamp(u1 / split, 0.0, 0.99999999999999989), u2, out);
+  } else {
+    st = tileSample(fp, std::clamp((u1 - split) / (1.0 - split), 0.0, 0.99999999999999989), u2, out);
+  }
+  if (st != RuntimeStatus::kOk) return st;
   if (!inSquare(out->s)) {
     out->pdf = 0.0;
     return RuntimeStatus::kOk;

@@ -6,6 +6,7 @@
 #include <glintbake/bake/tiny/tiny_example.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/format/validate.h>
 #include <glintbake/reference/flakes.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/layered_brdf.h>
@@ -13,9 +14,11 @@
 #include <glintbake/runtime/tiny_example_ndf.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -47,12 +50,16 @@ bake::NormalMap example(int n, bake::MapKind kind = bake::MapKind::kBeckmann, ui
 
 // Bakes an asset of the example with the placement and opens it.
 std::unique_ptr<TinyExampleNdf> bakeAsset(const bake::NormalMap& map, int res, const TinyPlacementOptions& place,
-                                          const std::string& name) {
+                                          const std::string& name, bool half = false) {
   auto rec = bake::tiny::makeTinyRecord(map.width, res, kSigmaR, place);
   EXPECT_TRUE(rec.ok()) << (rec.ok() ? "" : rec.error().message);
   if (!rec.ok()) return nullptr;
   const std::vector<float> texels = bake::tiny::tinyTexels(map);
   const auto levels = bake::tiny::bakeTinyLevels(texels, map.width, kSigmaR, res);
+  if (half) {
+    EXPECT_TRUE(bake::tiny::tinyLevelsFitHalf(levels));
+    rec = bake::tiny::withHalfLevels(rec.value());
+  }
   const std::string path = glintbake::testing::processTempDir() + name + ".gbk";
   format::Writer w;
   EXPECT_EQ(w.open(path, format::AssetKind::kTinyExample), format::ContainerStatus::kOk);
@@ -188,7 +195,8 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
   // sigma 64, where the reference takes minutes).
   // GLINTBAKE_TINY_WIDE=1 adds the footprints of many examples (minutes of reference time).
   std::vector<double> sigmas = {0.5, 1.0, 2.0, 4.0, 5.5, 6.0, 8.0, 11.0};
-  std::vector<double> bounds = {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 0.01, 5e-3, 5e-3};
+  // 5.5 lies in the hand-over band (flakes and tiles blended).
+  std::vector<double> bounds = {1e-4, 1e-4, 1e-4, 1e-4, 0.01, 0.01, 5e-3, 5e-3};
   if (const char* wide = std::getenv("GLINTBAKE_TINY_WIDE"); wide && wide[0] == '1') {
     sigmas.insert(sigmas.end(), {16.0, 32.0, 64.0});
     bounds.insert(bounds.end(), {5e-3, 5e-3, 5e-3});
@@ -208,6 +216,175 @@ TEST(TinyExample, TiledIdentityAgainstTheMaterialisedMap) {
   }
 }
 
+// The plane texels [x0, x0 + side)^2 as the asset lays them (what glintquery materialise writes), as a
+// normal map continuing with its edge texels.
+bake::NormalMap materialised(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int side) {
+  const runtime::TinyPlaneTexels plane(asset, x0, y0, side, side);
+  bake::NormalMap m;
+  m.width = m.height = side;
+  m.wrap = bake::Wrap::kClamp;
+  m.normals.resize(size_t(side) * side * 3);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      float t[2];
+      plane.texel(x, y, t);
+      float* o = m.at(x, y);
+      o[0] = t[0];
+      o[1] = t[1];
+      o[2] = std::sqrt(std::max(0.0f, 1.0f - t[0] * t[0] - t[1] * t[1]));
+    }
+  return m;
+}
+
+// Below the finest tile every placement answers from the flakes of the plane it lays: a 30-degree
+// rotation, a scale and a stochastic layout (rotations, scales, 30% covered) against the reference
+// evaluator on the materialised region; between kTinyFlakesExactUpTo and kTinyFlakesUpTo the blend.
+TEST(TinyExample, SmallFootprintsAgainstTheMaterialisedPlane) {
+  const int n = 16, res = 32;
+  const bake::NormalMap map = example(n);
+  TinyPlacementOptions rot;
+  rot.rotate_range[0] = rot.rotate_range[1] = 30.0;
+  TinyPlacementOptions scaled;
+  scaled.scale_range[0] = scaled.scale_range[1] = 1.5;
+  scaled.shear[0] = 0.3;
+  TinyPlacementOptions sto;
+  sto.type = format::TinyExampleType::kStochastic;
+  sto.rotate_range[1] = 360.0;
+  sto.scale_range[0] = 0.8;
+  sto.scale_range[1] = 1.25;
+  sto.density = 0.3;
+  sto.seed = 5;
+  TinyPlacementOptions ovl = sto;
+  ovl.density = 0.8;
+  ovl.overlap = true;
+  const struct {
+    const char* name;
+    TinyPlacementOptions place;
+  } cases[] = {{"rotated 30", rot}, {"scaled 1.5, sheared", scaled}, {"stochastic", sto}, {"overlapping", ovl}};
+  for (const auto& c : cases) {
+    const auto asset = bakeAsset(map, res, c.place, std::string("small_") + c.name[0] + c.name[1]);
+    ASSERT_TRUE(asset);
+    EXPECT_TRUE(asset->hasFlakes());
+    EXPECT_FALSE(asset->hasGridFlakes());
+    const int64_t x0 = 1000, y0 = -700;
+    const int side = 96;
+    const reference::FlakeSet ref_set = reference::buildFlakes(materialised(*asset, x0, y0, side), 1);
+    for (const double sigma : {0.25, 0.5, 1.0, 2.0, 3.9, 4.5, 5.5, 6.5}) {
+      for (const double at : {37.3, 52.9}) {
+        if (sigma > runtime::kTinyFlakesExactUpTo && at > 40.0) continue;  // the blend: one point
+        const Footprint fp{double(x0) + at, double(y0) + 0.8 * at + 9.1, sigma};
+        const std::vector<double> got = imageOf(*asset, fp);
+        const std::vector<double> ref =
+            reference::binAveragedImage(ref_set, reference::Footprint{at, 0.8 * at + 9.1, sigma}, kSigmaR, res);
+        const double l1 = relativeL1(got, ref);
+        std::printf("%s: sigma %4.1f at %.1f: relative L1 %.2e\n", c.name, sigma, at, l1);
+        std::fflush(stdout);
+        if (sigma < runtime::kTinyFlakesExactUpTo) {
+          EXPECT_LT(l1, 1e-4) << c.name << " sigma " << sigma;
+        }
+      }
+    }
+  }
+}
+
+// The hand-over from the flakes to the tiles is continuous: the NDF image changes little across
+// either end of the band and between neighbouring footprints inside it. The tiles' own error at 6
+// texels against the reference (what a hard switch there jumps by) is printed beside.
+TEST(TinyExample, HandOverIsContinuous) {
+  const int res = 64;
+  const bake::NormalMap map = example(32, bake::MapKind::kBrushed, 13);
+  TinyPlacementOptions tiled;
+  tiled.rotate_range[0] = tiled.rotate_range[1] = 90.0;
+  TinyPlacementOptions sto;
+  sto.type = format::TinyExampleType::kStochastic;
+  sto.rotate_range[1] = 360.0;
+  sto.scale_range[0] = 0.8;
+  sto.scale_range[1] = 1.25;
+  sto.density = 0.3;
+  sto.seed = 5;
+  const struct {
+    const char* name;
+    TinyPlacementOptions place;
+  } cases[] = {{"tiled, rotated 90", tiled}, {"stochastic", sto}};
+  for (const auto& c : cases) {
+    const auto asset = bakeAsset(map, res, c.place, std::string("handover_") + c.name[0]);
+    ASSERT_TRUE(asset);
+    const double x = 200.0, y = 120.0;
+    const double lo = runtime::kTinyFlakesExactUpTo, hi = runtime::kTinyFlakesUpTo;
+    for (const double edge : {lo, hi}) {
+      const double l1 =
+          relativeL1(imageOf(*asset, {x, y, edge * (1.0 - 1e-6)}), imageOf(*asset, {x, y, edge * (1.0 + 1e-6)}));
+      std::printf("%s: change across sigma %.1f: relative L1 %.2e\n", c.name, edge, l1);
+      EXPECT_LT(l1, 1e-3) << c.name << " at " << edge;
+    }
+    double inside = 0.0, outside = 0.0;
+    std::vector<double> prev = imageOf(*asset, {x, y, 3.5});
+    for (int k = 1; k <= 28; ++k) {
+      const std::vector<double> cur = imageOf(*asset, {x, y, 3.5 * std::pow(2.0, k / 28.0)});
+      const double sigma = 3.5 * std::pow(2.0, k / 28.0);
+      (sigma > lo && sigma < hi ? inside : outside) =
+          std::max(sigma > lo && sigma < hi ? inside : outside, relativeL1(cur, prev));
+      prev = cur;
+    }
+    std::printf(
+        "%s: largest change between footprints 2^(1/28) apart, sigma 3.5-7: %.2e inside the band, %.2e outside\n",
+        c.name, inside, outside);
+    const reference::FlakeSet ref_set = reference::buildFlakes(materialised(*asset, 150, 70, 100), 1);
+    const std::vector<double> ref =
+        reference::binAveragedImage(ref_set, reference::Footprint{50.0, 50.0, hi}, kSigmaR, res);
+    std::printf("%s: tiles at sigma %.1f against the reference: relative L1 %.2e; flakes at %.1f: %.2e\n", c.name, hi,
+                relativeL1(imageOf(*asset, {x, y, hi}), ref), lo,
+                relativeL1(imageOf(*asset, {x, y, lo}),
+                           reference::binAveragedImage(ref_set, reference::Footprint{50.0, 50.0, lo}, kSigmaR, res)));
+  }
+}
+
+// float16 tile images: the asset validates, reads back within binary16 rounding, and its NDF images
+// keep the error against the reference of the float32 asset (median over tile footprints).
+TEST(TinyExample, HalfPrecisionTilesKeepTheFidelity) {
+  const int res = 64;
+  const bake::NormalMap map = example(16);
+  // The identity transform: its tiles are the plane's NDF (a rotated example's tiles are compared with
+  // a resampled plane, which the tile path misses by more than binary16 does).
+  const auto full = bakeAsset(map, res, TinyPlacementOptions(), "half_f32");
+  const auto half = bakeAsset(map, res, TinyPlacementOptions(), "half_f16", true);
+  ASSERT_TRUE(full && half);
+  EXPECT_NE(half->record().flags & format::kTinyFlagHalf, 0u);
+  const format::ValidationReport report = format::validateFile(glintbake::testing::processTempDir() + "half_f16.gbk");
+  for (const auto& m : report.messages)  // the test's container has no tool metadata: kind checks only
+    if (m.id >= 6000) {
+      EXPECT_NE(m.severity, format::Severity::kError) << m.message;
+    }
+  for (int l = 0; l < int(full->record().levels); ++l) {
+    const float *a = full->tileImage(l, 0), *b = half->tileImage(l, 0);
+    for (int i = 0; i < res * res; ++i) EXPECT_NEAR(b[i], a[i], 1e-3 * a[i] + 1e-7);
+  }
+  const reference::FlakeSet ref_set = reference::buildFlakes(materialised(*full, 0, 0, 160), 1);
+  std::vector<double> err_full, err_half, between;
+  for (const double sigma : {6.5, 8.0, 11.0}) {
+    for (const double at : {70.3, 84.9, 77.1}) {
+      const Footprint fp{at, 0.7 * at + 21.0, sigma};
+      const std::vector<double> ref =
+          reference::binAveragedImage(ref_set, reference::Footprint{fp.x, fp.y, sigma}, kSigmaR, res);
+      const std::vector<double> f = imageOf(*full, fp), h = imageOf(*half, fp);
+      err_full.push_back(relativeL1(f, ref));
+      err_half.push_back(relativeL1(h, ref));
+      between.push_back(relativeL1(h, f));
+    }
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  std::printf(
+      "median relative L1 against the reference: float32 %.4f, float16 %.4f; float16 against float32: "
+      "median %.2e, largest %.2e\n",
+      median(err_full), median(err_half), median(between), *std::max_element(between.begin(), between.end()));
+  EXPECT_LT(median(err_half), 0.12);
+  EXPECT_LT(median(err_half), median(err_full) + 1e-3);
+  EXPECT_LT(*std::max_element(between.begin(), between.end()), 1e-3);
+}
+
 // A 90-degree rotation rotates the NDF, a mirror mirrors it, a scale by 2 halves the slopes' spread.
 TEST(TinyExample, TransformsActOnTheSlopes) {
   const int n = 16, res = 64;
@@ -225,7 +402,7 @@ TEST(TinyExample, TransformsActOnTheSlopes) {
   ASSERT_TRUE(id && rot && mir && big);
   EXPECT_TRUE(rot->hasFlakes());
   EXPECT_TRUE(mir->hasFlakes());
-  EXPECT_FALSE(big->hasFlakes());
+  EXPECT_FALSE(big->hasGridFlakes());
   for (const double sigma : {2.0, 8.0, 24.0}) {
     // The same example-frame footprint: u = M v for each transform (corner at the origin).
     const double vx = 5.3, vy = 9.7;
@@ -312,6 +489,188 @@ TEST(TinyExample, StochasticCoverageIsAPartition) {
   }
 }
 
+// Overlapping layout: the owner of a point is the nearest centre among the examples containing it
+// (found here by brute force over a wide neighbourhood), so coverage is still a partition; the
+// covered fraction tracks densities the disjoint cells cannot reach, and the runtime's share of
+// flat ground for a wide footprint is 1 - that fraction.
+TEST(TinyExample, OverlappingCoverageIsANearestCentrePartition) {
+  for (const double density : {0.3, 0.7, 0.95}) {
+    TinyPlacementOptions p;
+    p.type = format::TinyExampleType::kStochastic;
+    p.rotate_range[1] = 360.0;
+    p.scale_range[0] = 0.8;
+    p.scale_range[1] = 1.25;
+    p.seed = 4;
+    p.density = density;
+    p.overlap = true;
+    const auto rec = bake::tiny::makeTinyRecord(16, 16, kSigmaR, p);
+    ASSERT_TRUE(rec.ok()) << rec.error().message;
+    const format::TinyExampleRecord& r = rec.value();
+    ASSERT_EQ(format::checkTinyExampleRecord(r), nullptr);
+    EXPECT_NEAR(format::tinyCoveredFraction(r), density, 1e-3);
+    const int reach = format::tinyOverlapReach(r);
+    ASSERT_GE(reach, 1);
+    std::mt19937_64 rng(8);
+    std::uniform_real_distribution<double> u(-150.0 * r.cell_size, 150.0 * r.cell_size);
+    const int samples = 40000;
+    int covered = 0, overlapped = 0;
+    for (int k = 0; k < samples; ++k) {
+      const double x = u(rng), y = u(rng);
+      double local[2], at[2];
+      const format::TinyPlacement owner = format::tinyOwner(r, x, y, local);
+      const int64_t ci = int64_t(std::floor(x / r.cell_size)), cj = int64_t(std::floor(y / r.cell_size));
+      int holders = 0;
+      double best = 1e300;
+      for (int64_t j = cj - 4; j <= cj + 4; ++j) {
+        for (int64_t i = ci - 4; i <= ci + 4; ++i) {
+          const format::TinyPlacement e = format::tinyCellPlacement(r, i, j);
+          if (!format::tinyContains(r, e, x, y, at)) continue;
+          ++holders;
+          const double dx = x - e.centre[0], dy = y - e.centre[1];
+          best = std::min(best, dx * dx + dy * dy);
+        }
+      }
+      ASSERT_EQ(holders > 0, owner.present);
+      if (owner.present) {
+        const double dx = x - owner.centre[0], dy = y - owner.centre[1];
+        ASSERT_EQ(dx * dx + dy * dy, best);
+      }
+      covered += owner.present;
+      overlapped += holders > 1;
+    }
+    const double fraction = double(covered) / samples;
+    std::printf("overlapping: density %.2f, covered fraction %.4f, points in overlaps %.3f\n", density, fraction,
+                double(overlapped) / samples);
+    EXPECT_NEAR(fraction, density, 0.015);
+    EXPECT_GT(overlapped, 0);
+    const auto asset = bakeAsset(example(16), 16, p, "overlap" + std::to_string(int(density * 100)));
+    ASSERT_TRUE(asset);
+    double mass = 0.0;
+    ASSERT_EQ(asset->mass({123.0, 45.0, 40.0}, &mass), RuntimeStatus::kOk);
+    EXPECT_NEAR(mass, 1.0, 0.02);
+  }
+}
+
+// A layout image is part of the asset: the validator and the runtime refuse a record asking for one
+// without it, a layout the record does not ask for, and layout values outside [0, 1].
+TEST(TinyExample, LayoutSectionIsValidated) {
+  const bake::NormalMap map = example(8);
+  const std::vector<float> texels = bake::tiny::tinyTexels(map);
+  const auto levels = bake::tiny::bakeTinyLevels(texels, 8, kSigmaR, 8);
+  std::vector<float> values = {1.0f, 0.25f, 0.0f, 0.75f, 0.5f, 1.0f};  // 3 x 1 cells, 2 channels
+  TinyPlacementOptions p;
+  p.type = format::TinyExampleType::kStochastic;
+  p.rotate_range[1] = 90.0;
+  p.layout = {3, 1, 2, values.data()};
+  const auto rec = bake::tiny::makeTinyRecord(8, 8, kSigmaR, p);
+  ASSERT_TRUE(rec.ok()) << rec.error().message;
+  EXPECT_EQ(rec.value().version, 2u);
+  EXPECT_EQ(rec.value().flags, format::kTinyFlagLayout);
+  EXPECT_EQ(rec.value().occupancy, 1.0);
+  // Presence 1, 0, 0.5: half the covered fraction of a full layout.
+  format::TinyExampleRecord full = rec.value();
+  full.flags = 0;
+  full.version = 1;
+  EXPECT_NEAR(format::tinyCoveredFraction(rec.value(), &p.layout), 0.5 * format::tinyCoveredFraction(full), 1e-12);
+  // Writes the sections by hand, so that a record and its layout section can disagree.
+  auto write = [&](const std::string& name, const format::TinyExampleRecord& r, const std::vector<float>* layout) {
+    const std::string path = glintbake::testing::processTempDir() + name + ".gbk";
+    format::Writer w;
+    EXPECT_EQ(w.open(path, format::AssetKind::kTinyExample), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionTinyExampleInfo, 0, &r, sizeof r), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.addSection(format::kSectionTinyExampleTexels, 0, texels.data(), texels.size() * 4),
+              format::ContainerStatus::kOk);
+    auto image = [&](uint32_t width, uint32_t height, uint32_t channels, uint32_t layers, const float* v) {
+      format::ImageSectionHeader h;
+      h.width = width;
+      h.height = height;
+      h.channels = channels;
+      h.layers = layers;
+      std::vector<uint8_t> bytes(sizeof h + size_t(width) * height * channels * layers * 4);
+      std::memcpy(bytes.data(), &h, sizeof h);
+      std::memcpy(bytes.data() + sizeof h, v, bytes.size() - sizeof h);
+      return bytes;
+    };
+    for (uint32_t l = 0; l < r.levels; ++l) {
+      const uint32_t m = format::tinyTilesPerSide(r.example_size, l);
+      const auto bytes = image(8, 8, 1, m * m, levels[l].data());
+      EXPECT_EQ(w.addSection(format::kSectionTinyExampleLevel, l, bytes.data(), bytes.size()),
+                format::ContainerStatus::kOk);
+    }
+    if (layout) {
+      const auto bytes = image(3, 1, 2, 1, layout->data());
+      EXPECT_EQ(w.addSection(format::kSectionTinyExampleLayout, 0, bytes.data(), bytes.size()),
+                format::ContainerStatus::kOk);
+    }
+    EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
+    EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
+    return path;
+  };
+  auto has6006 = [](const std::string& path) {
+    for (const auto& m : format::validateFile(path).messages)
+      if (m.id == 6006) return true;
+    return false;
+  };
+  const std::string good = write("layout_good", rec.value(), &values);
+  EXPECT_FALSE(has6006(good));
+  TinyExampleNdf ok;
+  ASSERT_EQ(ok.open(good.c_str()), RuntimeStatus::kOk);
+  const format::TinyLayout* stored = ok.layout();
+  ASSERT_TRUE(stored != nullptr);
+  if (stored == nullptr) return;
+  EXPECT_EQ(stored->values[3], 0.75f);
+  // Cells of presence 0 never hold an example.
+  for (int64_t j = -2; j <= 2; ++j) {
+    for (int64_t i = -6; i <= 6; ++i) {
+      if (((i % 3) + 3) % 3 == 1) {
+        EXPECT_FALSE(format::tinyCellPlacement(rec.value(), i, j, stored).present);
+      }
+    }
+  }
+  // The record asks for a layout the asset lacks.
+  const std::string missing = write("layout_missing", rec.value(), nullptr);
+  EXPECT_TRUE(has6006(missing));
+  TinyExampleNdf refused;
+  EXPECT_EQ(refused.open(missing.c_str()), RuntimeStatus::kInvalidAsset);
+  // A layout section beside a version 1 record.
+  format::TinyExampleRecord v1 = rec.value();
+  v1.flags = 0;
+  v1.version = 1;
+  EXPECT_TRUE(has6006(write("layout_extra", v1, &values)));
+  // A value outside [0, 1] in the stored layout.
+  std::vector<float> bad = values;
+  bad[4] = 1.5f;
+  const std::string outside = write("layout_outside", rec.value(), &bad);
+  EXPECT_TRUE(has6006(outside));
+  EXPECT_EQ(refused.open(outside.c_str()), RuntimeStatus::kInvalidAsset);
+  const format::TinyLayout bad_layout{3, 1, 2, bad.data()};
+  EXPECT_NE(format::checkTinyLayout(bad_layout), nullptr);
+  TinyPlacementOptions q = p;
+  q.layout = bad_layout;
+  EXPECT_FALSE(bake::tiny::makeTinyRecord(8, 8, kSigmaR, q).ok());
+  std::vector<float> nan = values;
+  nan[0] = std::nanf("");
+  uint64_t at = 99;
+  EXPECT_NE(format::checkTinyLayout({3, 1, 2, nan.data()}, &at), nullptr);
+  EXPECT_EQ(at, 0u);
+  EXPECT_NE(format::checkTinyLayout({3, 1, 4, values.data()}), nullptr);
+  EXPECT_NE(format::checkTinyLayout({2000, 1, 1, values.data()}), nullptr);
+  // Version 2 without flags, a layout flag on a tiled record, unknown flags.
+  format::TinyExampleRecord r2 = rec.value();
+  r2.flags = 0;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2.flags = 8;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2.flags = format::kTinyFlagHalf;  // binary16 levels: either type
+  EXPECT_EQ(format::checkTinyExampleRecord(r2), nullptr);
+  r2 = rec.value();
+  r2.type = uint32_t(format::TinyExampleType::kTiled);
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+  r2 = rec.value();
+  r2.version = 3;
+  EXPECT_NE(format::checkTinyExampleRecord(r2), nullptr);
+}
+
 struct SPt {
   double sx, sy;
 };
@@ -364,9 +723,24 @@ TEST(TinyExample, SamplingMatchesEval) {
   checkSampling(*stochastic, {50.0, 70.0, 20.0});
   const auto tiled = bakeAsset(map, 16, TinyPlacementOptions(), "chi_tiled");
   checkSampling(*tiled, {3.0, 7.0, 12.0});
+  // Inside the hand-over band: the flakes or the tiles in proportion to their share of the mass.
+  checkSampling(*tiled, {3.0, 7.0, 5.0});
 }
 
 // average() over a bin equals image()'s bin; queries refuse bad arguments.
+// Sampling an overlapping layout: tiles weighted by the share their example owns.
+TEST(TinyExample, SamplingMatchesEvalWithOverlaps) {
+  TinyPlacementOptions p;
+  p.type = format::TinyExampleType::kStochastic;
+  p.rotate_range[1] = 360.0;
+  p.seed = 2;
+  p.density = 0.8;
+  p.overlap = true;
+  const auto asset = bakeAsset(example(16), 16, p, "overlap_sampling");
+  ASSERT_TRUE(asset);
+  checkSampling(*asset, {37.0, -21.0, 2.0});
+}
+
 TEST(TinyExample, ImageIsTheBinAverageAndArgumentsAreChecked) {
   const bake::NormalMap map = example(8);
   TinyPlacementOptions p;

@@ -15,9 +15,11 @@
 namespace glintbake::format {
 
 // Section types of the tiny-example kind (SPEC.md 10.8), in its block 112-127.
-constexpr uint32_t kSectionTinyExampleInfo = 112;    // the asset record (key = 0)
-constexpr uint32_t kSectionTinyExampleTexels = 113;  // the example's (n_x, n_y) texels (key = 0)
-constexpr uint32_t kSectionTinyExampleLevel = 114;   // the tile NDF images of one level (key = level)
+constexpr uint32_t kSectionTinyExampleInfo = 112;       // the asset record (key = 0)
+constexpr uint32_t kSectionTinyExampleTexels = 113;     // the example's (n_x, n_y) texels (key = 0)
+constexpr uint32_t kSectionTinyExampleLevel = 114;      // the tile NDF images of one level (key = level)
+constexpr uint32_t kSectionTinyExampleLayout = 115;     // a stochastic layout image (key = 0; version 2)
+constexpr uint32_t kSectionTinyExampleLevelHalf = 116;  // one level's tile images as binary16 (key = level; version 2)
 
 // One asset kind: its header value, its stable name (metadata `asset_kind`, glintinfo), the range
 // of section types it owns (first..last inclusive; first = last = 0 when it owns none) and the
@@ -87,6 +89,8 @@ constexpr SectionTypeInfo kSectionTypeRegistry[] = {
     {kSectionTinyExampleInfo, "tiny-example-info"},
     {kSectionTinyExampleTexels, "tiny-example-texels"},
     {kSectionTinyExampleLevel, "tiny-example-level"},
+    {kSectionTinyExampleLayout, "tiny-example-layout"},
+    {kSectionTinyExampleLevelHalf, "tiny-example-level-half"},
     {kSectionGlitterInfo, "glitter-info"},
     {kSectionGlitterIntegrals, "glitter-integrals"},
     {kSectionShardMetadata, "shard-metadata"},

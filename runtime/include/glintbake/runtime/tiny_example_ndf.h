@@ -19,10 +19,19 @@
 // kept tile T adds w_T D_T(M' s) |det M|, w_T the footprint's probability over the tile (exact:
 // erf products, or the correlated-Gaussian rectangle integral for anisotropic frames), D_T the
 // stored bin-averaged image read as piecewise constant. Stochastic surfaces add the flat base
-// lobe N(0, sigma_r^2) with the probability no example holds. Tiled surfaces whose transform maps
-// the texel grid onto itself (rotations by multiples of 90 degrees and mirrors) answer footprints
-// with sigma below kTinyFlakesUpTo from the exact flakes of the transformed example
-// (TransformedExampleTexels through FlakeNdf); above n sigma the periodic sum is the top tile.
+// lobe N(0, sigma_r^2) with the probability no example holds. Above n sigma the periodic sum is the
+// top tile.
+//
+// Small footprints. Below kTinyFlakesExactUpTo every asset answers from the flakes of the plane it
+// lays (formats/SPEC.md 10.5 at rate 1): a flake at each plane texel centre with the texel that
+// TinyPlaneTexels (and glintquery materialise) gives it and the central differences of its
+// neighbours, so the answer equals the reference evaluator on the materialised plane to float
+// rounding, for every transform, layout and overlap. Tiled assets whose transform maps the texel
+// grid onto itself (multiples of 90 degrees, mirrors) get the same flakes faster from a FlakeNdf
+// over the transformed example (TransformedExampleTexels); the others sum the window's flakes per
+// query (up to 73 x 73 of them; the texels are read into a 50 kB buffer on the stack). From
+// kTinyFlakesExactUpTo to kTinyFlakesUpTo the flakes' answer and the tiles' are blended linearly in
+// log(sigma); sample() picks one of the two in proportion to its share of the mass.
 //
 // Contract (NdfSource): eval() is the sum above inside [-1, 1]^2 and 0 outside; average() its
 // exact mean over a rectangle (the transformed rectangle clipped against the stored bins);
@@ -46,8 +55,11 @@
 
 namespace glintbake::runtime {
 
-constexpr double kTinyRefine = 0.005;    // split a tile while w t (d + t) > kTinyRefine lambda_min
-constexpr double kTinyFlakesUpTo = 6.0;  // texels: smaller footprints use the flakes (when available)
+constexpr double kTinyRefine = 0.005;  // split a tile while w t (d + t) > kTinyRefine lambda_min
+// Footprints (sigma, texels) below kTinyFlakesExactUpTo are answered by the flakes alone, from
+// kTinyFlakesUpTo on by the tiles alone, and between by both, blended linearly in log(sigma).
+constexpr double kTinyFlakesExactUpTo = 4.0;
+constexpr double kTinyFlakesUpTo = 6.0;
 constexpr double kTinyWindowSigmas = 6.0;
 constexpr int64_t kTinyMaxCells = 1 << 18;  // stochastic: most layout cells one query visits
 
@@ -83,6 +95,36 @@ class TransformedExampleTexels final : public TexelSource {
   double off_[2];
 };
 
+class TinyExampleNdf;
+
+// Largest |(n_x, n_y)| a materialised texel keeps: a slope the transform pushes out of the unit disk
+// (scales below 1 steepen slopes) is shortened to this length, keeping its direction.
+constexpr double kTinyMaxMaterialisedSlope = 0.999;
+
+// The texels [x0, x0 + width) x [y0, y0 + height) of an asset's plane (texels, y down) as a normal
+// map: the surface the asset answers for, for the reference evaluator and the renderer. Texel
+// (x, y) is the plane point p = (x0 + x + 1/2, y0 + y + 1/2): the example owning p (format::tinyOwner)
+// is read at p's position in its frame, bilinearly between texel centres with the example repeating
+// (so a transform that maps the texel grid onto itself reproduces the texels exactly), and its
+// (n_x, n_y) is mapped by A = F M^-T F as the runtime maps slopes (at most
+// kTinyMaxMaterialisedSlope long); points no example owns are flat (0, 0). Continues with its edge
+// texels beyond the rectangle. The asset must be open and outlive the source.
+class TinyPlaneTexels final : public TexelSource {
+ public:
+  TinyPlaneTexels(const TinyExampleNdf& asset, int64_t x0, int64_t y0, int width, int height);
+  int width() const override { return width_; }
+  int height() const override { return height_; }
+  bool repeats() const override { return false; }
+  void normal(int x, int y, float out[2]) const override { texel(x, y, out); }
+  // normal(), and whether an example owns the texel (false: flat).
+  bool texel(int x, int y, float out[2]) const;
+
+ private:
+  const TinyExampleNdf& asset_;
+  int64_t x0_, y0_;
+  int width_, height_;
+};
+
 class TinyExampleNdf final : public NdfSource {
  public:
   TinyExampleNdf();
@@ -97,9 +139,18 @@ class TinyExampleNdf final : public NdfSource {
   bool isOpen() const { return open_; }
 
   const format::TinyExampleRecord& record() const { return record_; }
+  // The example's n * n (n_x, n_y) texels (row-major), or null when closed.
+  const float* texels() const { return open_ ? texels_.data() : nullptr; }
+  // The stochastic layout image (format::TinyLayout), or null when the asset has none.
+  const format::TinyLayout* layout() const { return open_ && layout_.values ? &layout_ : nullptr; }
   // The stored tile image of (level, tile index row-major) (R * R floats), or null.
   const float* tileImage(int level, int tile) const;
-  bool hasFlakes() const { return flakes_ && flakes_->isBuilt(); }
+  // Every open asset answers small footprints from flakes (exactly: the flake model of the plane
+  // as TinyPlaneTexels lays it).
+  bool hasFlakes() const { return open_; }
+  // Whether they come from a FlakeNdf over the transformed example (tiled assets whose transform
+  // maps the texel grid onto itself: faster, the same answer) rather than the plane texels.
+  bool hasGridFlakes() const { return open_ && flakes_ && flakes_->isBuilt(); }
 
   format::AssetKind kind() const override { return format::AssetKind::kTinyExample; }
   int resolution() const override { return open_ ? int(record_.ndf_res) : 0; }
@@ -125,8 +176,19 @@ class TinyExampleNdf final : public NdfSource {
 
  private:
   bool validFootprint(const Footprint& f) const;
-  bool useFlakes(const Footprint& f) const;
   Footprint flakeFootprint(const Footprint& f) const;
+  template <typename F>
+  bool planeFlakes(const Footprint& f, F&& lobe) const;
+  RuntimeStatus flakeEval(const Footprint& f, const SPoint& s, double* value) const;
+  RuntimeStatus flakeMass(const Footprint& f, double* value) const;
+  RuntimeStatus flakeAverage(const Footprint& f, const SRect& rect, double* value) const;
+  RuntimeStatus addFlakeImage(const Footprint& f, double weight, float* out) const;
+  RuntimeStatus flakeSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
+  RuntimeStatus tileEval(const Footprint& f, const SPoint& s, double* value) const;
+  RuntimeStatus tileMass(const Footprint& f, double* value) const;
+  RuntimeStatus tileAverage(const Footprint& f, const SRect& rect, double* value) const;
+  RuntimeStatus addTileImage(const Footprint& f, double weight, float* out) const;
+  RuntimeStatus tileSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
   template <typename F>
   bool traverse(const Footprint& f, F&& visit, int64_t* entered = nullptr) const;
   // traverse(), handing the tiles over in batches of one frame.
@@ -139,7 +201,9 @@ class TinyExampleNdf final : public NdfSource {
   std::vector<std::vector<float>> levels_;  // per level: tiles^2 images of R^2
   std::vector<std::vector<double>> tile_mass_;
   std::vector<std::vector<double>> row_mass_;  // per level: tiles^2 x R row integrals
-  std::vector<float> base_;                    // the flat lobe (stochastic surfaces)
+  std::vector<float> layout_values_;           // section 115 (version 2 with a layout)
+  format::TinyLayout layout_;
+  std::vector<float> base_;  // the flat lobe (stochastic surfaces)
   std::vector<double> base_rows_;
   double base_mass_ = 0.0;
   std::unique_ptr<FlakeNdf> flakes_;

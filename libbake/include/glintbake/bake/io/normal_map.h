@@ -104,4 +104,22 @@ Result<NormalMap> normalMapFromPixels(int width, int height, int channels, const
 // Multithreaded (TBB); results and counts do not depend on the thread count.
 BakeStatus normaliseNormals(NormalMap* map, const IngestOptions& options, IngestReport* report);
 
+// The raw channel values of an image file, for inputs that are not normal maps (a tiny-example
+// layout image): width x height x channels floats, row-major, row 0 at the top; integer files read
+// as value / max (in [0, 1]), float files as stored.
+struct ImageChannels {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<float> values;
+  std::string content_hash;  // "xxh3-128:..." of the file bytes
+};
+
+// Reads every channel of an image file with the safety checks of loadNormalMap (sizes checked, the
+// file able to hold its declared image, before anything is allocated). Errors, on one line naming
+// the file: kIo (missing, unreadable), kInvalidInput (not a decodable image, corrupt or truncated, a
+// width or height of 0 or above max_side, more than max_channels channels). Values are not checked.
+// Thread-safe for distinct calls (as loadNormalMap, the stderr redirection is process-wide).
+Result<ImageChannels> loadImageChannels(const std::string& path, int max_side, int max_channels);
+
 }  // namespace glintbake::bake
