@@ -564,6 +564,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
     } else if (status == ContainerStatus::kDecompressFailed) {
       addError(&report.messages, 4003, describe(i, s) + ": zstd data does not decode to exactly raw_size bytes");
+    } else if (status == ContainerStatus::kTooLarge) {
+      addError(&report.messages, 4010, describe(i, s) + ": zstd frame window exceeds the reader limit of 128 MiB");
     } else if (status != ContainerStatus::kOk) {
       addError(&report.messages, 1002, describe(i, s) + ": cannot be read (" + statusString(status) + ")");
     }
