@@ -377,6 +377,10 @@ bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* hea
   return data != nullptr && parseImageHeader(data, size, header);
 }
 
+bool parseImageSectionHead(const uint8_t* head, size_t head_size, uint64_t section_size, ImageSectionHeader* header) {
+  return head != nullptr && head_size >= layout::kImageHeaderSize && parseImageHeader(head, section_size, header);
+}
+
 namespace {
 
 bool parseImageHeader(const uint8_t* data, uint64_t size, ImageSectionHeader* header) {

@@ -62,5 +62,8 @@ void validateMetadata(const std::string& json_utf8, AssetKind kind, std::vector<
 // Parses the ImageSectionHeader at the start of a section's raw bytes; false if the bytes are too
 // short, the magic differs, or width*height*channels*layers*4 + 32 != size. Safe on untrusted input.
 bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* header);
+// Same verdict from the section's first bytes alone (`head`, head_size >= 32 of them, else false)
+// and its raw size: for callers that stream the section instead of holding it.
+bool parseImageSectionHead(const uint8_t* head, size_t head_size, uint64_t section_size, ImageSectionHeader* header);
 
 }  // namespace glintbake::format
