@@ -98,7 +98,7 @@ class SectionPair {
  private:
   [[noreturn]] static void fail(const std::string& path, size_t i, format::ContainerStatus status) {
     throw cli::Error(cli::exitCodeOf(status),
-                     path + ": section " + std::to_string(i) + ": " + format::statusString(status));
+                     path + ": section " + std::to_string(i) + ": " + sectionReadError(status));
   }
   [[noreturn]] void failB(format::ContainerStatus status) {
     finishA();
