@@ -114,7 +114,7 @@ class SectionDecoder {
   SectionInfo info_;
   ContainerStatus status_ = ContainerStatus::kInvalidArgument;  // until start() succeeds
   uint64_t produced_ = 0;
-  void* dctx_ = nullptr;        // ZSTD_DCtx, opaque here to keep zstd.h out of this header
+  void* dctx_ = nullptr;  // ZSTD_DCtx, opaque here to keep zstd.h out of this header
   const uint8_t* in_data_ = nullptr;
   size_t in_size_ = 0, in_pos_ = 0;
   uint64_t stored_read_ = 0;    // stored bytes passed to in_ so far

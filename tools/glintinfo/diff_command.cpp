@@ -41,9 +41,8 @@ class ImageComparison {
         if (std::isnan(va) != std::isnan(vb)) max_abs_ = std::numeric_limits<double>::infinity();
         continue;
       }
-      const double d = (std::isinf(va) || std::isinf(vb))
-                           ? (va == vb ? 0.0 : std::numeric_limits<double>::infinity())
-                           : double(va) - double(vb);
+      const double d = (std::isinf(va) || std::isinf(vb)) ? (va == vb ? 0.0 : std::numeric_limits<double>::infinity())
+                                                          : double(va) - double(vb);
       max_abs_ = std::max(max_abs_, std::abs(d));
       diff2_ += d * d;
       if (std::isfinite(va)) norm2_ += double(va) * double(va);

@@ -147,8 +147,9 @@ TEST(SectionStream, FramesOfWindowsOverTheLimitAreRefusedByEveryReader) {
       Writer writer;
       ASSERT_EQ(writer.open(path, AssetKind::kTest), ContainerStatus::kOk);
       ASSERT_EQ(writer.addMetadata(test::testMetadata()), ContainerStatus::kOk);
-      ASSERT_EQ(writer.addStoredSection(kSectionFirstPrivate, 1, Codec::kZstd, data.size(), framed.data(), framed.size()),
-                ContainerStatus::kOk);
+      ASSERT_EQ(
+          writer.addStoredSection(kSectionFirstPrivate, 1, Codec::kZstd, data.size(), framed.data(), framed.size()),
+          ContainerStatus::kOk);
       ASSERT_EQ(writer.finish(), ContainerStatus::kOk);
     }
     const ContainerStatus expected = window_log <= 27 ? ContainerStatus::kOk : ContainerStatus::kTooLarge;
