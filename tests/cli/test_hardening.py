@@ -163,9 +163,9 @@ class HostileContainers(clitest.ToolTestCase):
         changed[chunk] = (stype, key, zstd_with_window(frame, 27), CODEC_ZSTD, raw_size)
         path = self.write("w27.gbk", build_container(changed, kind=KIND_NDF_PYRAMID))
         self.run_ok("glintinfo", "validate", path)
-        args = ("point", "--at", "16,16", "--sigma", "8", "--s", "0.1,0", "--json")
-        self.assertEqual(self.run_ok("glintquery", args[0], path, *args[1:])[0],
-                         self.run_ok("glintquery", args[0], asset, *args[1:])[0])
+        query = ("--at", "16,16", "--sigma", "8", "--s", "0.1,0", "--json")
+        self.assertEqual(json.loads(self.run_ok("glintquery", "point", path, *query)[0])["value"],
+                         json.loads(self.run_ok("glintquery", "point", asset, *query)[0])["value"])
 
     def test_oversized_metadata_is_refused_before_decoding(self):
         # 512 MiB of metadata in a 20 KB file (honest RLE blocks): over the 16 MiB limit.
