@@ -3,8 +3,8 @@
 # Sanitizer builds (Debug, so the DCHECKs run too):
 #   build-tsan/  runtime-only under TSan; runs the runtime's concurrency tests (threads hammering
 #                eval, average, sample, pdf and mass on one shared asset).
-#   build-asan/  the whole project under ASan+UBSan (libraries, tools, Python module and tests; no
-#                benchmarks), at -O1 with line tables only (-g1): about twice as fast to run as -O0,
+#   build-asan/  the whole project under ASan+UBSan (libraries, tools and tests; no benchmarks, and
+#                no Python module: see CMakeLists.txt), at -O1 with line tables only (-g1): about twice as fast to run as -O0,
 #                and the debug information that makes the build slow is not needed for symbolised
 #                reports. Runs the whole CTest suite but the tests listed below, so the tools
 #                themselves meet every malformed input of the CLI tests; every finding fails its test.
