@@ -277,32 +277,9 @@ ContainerStatus parseContainer(const ByteSource& source, const ReaderOptions& op
 
 namespace {
 
-// The most bytes a zstd frame's blocks can produce, from its block headers alone (RFC 8878 3.1.1.2):
-// raw and RLE blocks their stated size, a compressed block at most 128 KiB. The frame header's
-// content size is a claim; this bound is what a hostile frame can really make a decoder write.
-// UINT64_MAX when the block headers are malformed.
-uint64_t zstdBlockBound(const uint8_t* frame, size_t size) {
-  const size_t header = ZSTD_frameHeaderSize(frame, size);
-  if (ZSTD_isError(header) || header > size) return UINT64_MAX;
-  constexpr uint64_t kMaxBlock = uint64_t(128) << 10;
-  uint64_t bound = 0;
-  for (size_t at = header;;) {
-    if (size - at < 3) return UINT64_MAX;
-    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
-    at += 3;
-    const uint32_t type = (block >> 1) & 3, block_size = block >> 3;
-    const uint64_t consumed = type == 1 ? 1 : block_size;  // RLE: one byte repeated
-    if (type == 3 || block_size > kMaxBlock || consumed > size - at) return UINT64_MAX;
-    at += size_t(consumed);
-    bound += type == 2 ? kMaxBlock : block_size;
-    if (block & 1) return bound;
-  }
-}
-
-// The stored bytes of a zstd section, checksum-verified and proven to decode to exactly raw_size:
-// one frame, exactly the stored bytes, recording raw_size as its content size, whose blocks can
-// produce that many bytes. Memory sources are used in place; file sources go through `buffer`
-// (bounded by the file's size). Nothing of raw_size is allocated here.
+// The stored bytes of a zstd section, checksum-verified and proven (ZstdFrameScan) to decode to
+// exactly raw_size within the window limit. Memory sources are used in place; file sources go
+// through `buffer` (bounded by the file's size). Nothing of raw_size is allocated here.
 ContainerStatus loadZstdFrame(const ByteSource& source, const SectionInfo& info, std::vector<uint8_t>* buffer,
                               const uint8_t** stored_out) {
   const uint8_t* stored = source.data() ? source.data() + info.offset : nullptr;
@@ -316,15 +293,10 @@ ContainerStatus loadZstdFrame(const ByteSource& source, const SectionInfo& info,
   }
   const size_t stored_size = size_t(info.stored_size);
   if (hash64(stored, stored_size) != info.checksum) return ContainerStatus::kChecksumMismatch;
-  const size_t frame_size = ZSTD_findFrameCompressedSize(stored, stored_size);
-  if (ZSTD_isError(frame_size) || frame_size != stored_size) return ContainerStatus::kDecompressFailed;
-  const unsigned long long content = ZSTD_getFrameContentSize(stored, stored_size);
-  if (content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR || content != info.raw_size) {
-    return ContainerStatus::kDecompressFailed;
-  }
-  // The frame header may lie; the block headers bound what the frame can really produce.
-  const uint64_t bound = zstdBlockBound(stored, stored_size);
-  if (bound == UINT64_MAX || bound < info.raw_size) return ContainerStatus::kDecompressFailed;
+  ZstdFrameScan scan(info.stored_size);
+  scan.feed(stored, stored_size);
+  const ContainerStatus status = scan.verdict(info.raw_size);
+  if (status != ContainerStatus::kOk) return status;
   *stored_out = stored;
   return ContainerStatus::kOk;
 }
@@ -381,137 +353,67 @@ ContainerStatus readSectionAlloc(const ByteSource& source, const SectionInfo& in
   return status;
 }
 
-namespace {
-
-constexpr int kStreamWindowLog = 27;  // ZSTD_WINDOWLOG_LIMIT_DEFAULT: the largest window streamed
-
-// Raw sections: hashed a chunk at a time (nothing reaches the sink on a mismatch), then read again.
-ContainerStatus streamRaw(const ByteSource& source, const SectionInfo& info, SectionSink* sink) {
-  if (info.stored_size != info.raw_size || info.raw_size > source.size()) return ContainerStatus::kCorruptIndex;
-  if (const uint8_t* data = source.data()) {
-    if (info.offset > source.size() || info.raw_size > source.size() - info.offset) return ContainerStatus::kTruncated;
-    const uint8_t* bytes = data + info.offset;
-    if (hash64(bytes, size_t(info.raw_size)) != info.checksum) return ContainerStatus::kChecksumMismatch;
-    for (uint64_t at = 0; at < info.raw_size; at += kSectionStreamChunk)
-      sink->consume(bytes + at, size_t(std::min<uint64_t>(kSectionStreamChunk, info.raw_size - at)));
-    return ContainerStatus::kOk;
+void ZstdFrameScan::feed(const uint8_t* data, size_t size) {
+  const uint64_t at = fed_;
+  fed_ += size;
+  size_t used = 0;
+  if (state_ == State::kHeader) {
+    used = std::min(size, kMaxFrameHeader - head_size_);
+    std::memcpy(head_ + head_size_, data, used);
+    head_size_ += used;
+    if (head_size_ < kMaxFrameHeader && fed_ < stored_size_) return;
+    parseHeader();
+    walk(head_, 0, head_size_);  // the first blocks may start inside the header's piece
   }
-  std::vector<uint8_t> chunk(size_t(std::min<uint64_t>(kSectionStreamChunk, info.raw_size)));
-  XXH3Streamer hasher;
-  if (!hasher.ok()) return ContainerStatus::kIoError;
-  for (uint64_t at = 0; at < info.raw_size;) {
-    const size_t n = size_t(std::min<uint64_t>(chunk.size(), info.raw_size - at));
-    if (!source.readAt(info.offset + at, chunk.data(), n)) return ContainerStatus::kTruncated;
-    hasher.update(chunk.data(), n);
-    at += n;
-  }
-  if (hasher.digest() != info.checksum) return ContainerStatus::kChecksumMismatch;
-  for (uint64_t at = 0; at < info.raw_size;) {
-    const size_t n = size_t(std::min<uint64_t>(chunk.size(), info.raw_size - at));
-    if (!source.readAt(info.offset + at, chunk.data(), n)) return ContainerStatus::kTruncated;
-    sink->consume(chunk.data(), n);
-    at += n;
-  }
-  return ContainerStatus::kOk;
+  walk(data + used, at + used, size - used);
 }
 
-// A checked frame (loadZstdFrame) decoded by zstd's streaming decoder into one reused chunk.
-ContainerStatus streamZstdFrame(const uint8_t* stored, size_t stored_size, uint64_t raw_size, SectionSink* sink) {
-  ZSTD_DCtx* dctx = ZSTD_createDCtx();
-  if (!dctx) return ContainerStatus::kDecompressFailed;
-  ZSTD_DCtx_setParameter(dctx, ZSTD_d_windowLogMax, kStreamWindowLog);
-  std::vector<uint8_t> chunk(size_t(std::min<uint64_t>(kSectionStreamChunk, std::max<uint64_t>(raw_size, 1))));
-  ZSTD_inBuffer in{stored, stored_size, 0};
-  uint64_t total = 0;
-  ContainerStatus status = ContainerStatus::kDecompressFailed;
-  for (;;) {
-    ZSTD_outBuffer out{chunk.data(), chunk.size(), 0};
-    const size_t left = ZSTD_decompressStream(dctx, &out, &in);
-    if (ZSTD_isError(left) || out.pos > raw_size - total) break;
-    total += out.pos;
-    if (out.pos > 0) sink->consume(chunk.data(), out.pos);
-    if (left == 0) {
-      if (in.pos == in.size && total == raw_size) status = ContainerStatus::kOk;
-      break;
-    }
-    if (in.pos == in.size && out.pos < out.size) break;  // the frame needs bytes it does not have
-  }
-  ZSTD_freeDCtx(dctx);
-  return status;
-}
-
-// A checked frame whose blocks are all raw or RLE (checked here, false otherwise): expanded block
-// by block, so its window size does not matter. Same verdicts as zstd's own decoder on such frames.
-bool rawAndRleOnly(const uint8_t* frame, size_t size, size_t header) {
-  for (size_t at = header; size - at >= 3;) {
-    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
-    const uint32_t type = (block >> 1) & 3;
-    if (type != 0 && type != 1) return false;
-    const size_t consumed = type == 1 ? 1 : size_t(block >> 3);
-    if (consumed > size - at - 3) return false;
-    at += 3 + consumed;
-    if (block & 1) return true;
-  }
-  return false;
-}
-
-ContainerStatus expandRawAndRle(const uint8_t* frame, size_t size, const ZSTD_frameHeader& fh, uint64_t raw_size,
-                                SectionSink* sink) {
-  std::vector<uint8_t> run;
-  XXH64_state_t* xxh = XXH64_createState();
-  if (!xxh) return ContainerStatus::kDecompressFailed;
-  XXH64_reset(xxh, 0);
-  uint64_t total = 0;
-  size_t at = fh.headerSize;
-  bool last = false;
-  while (!last) {  // rawAndRleOnly proved every header and block lies inside the frame
-    const uint32_t block = uint32_t(frame[at]) | uint32_t(frame[at + 1]) << 8 | uint32_t(frame[at + 2]) << 16;
-    at += 3;
-    last = block & 1;
-    const bool rle = ((block >> 1) & 3) == 1;
-    const size_t n = size_t(block >> 3);
-    if (n > raw_size - total) break;
-    const uint8_t* bytes = frame + at;
-    if (rle) {
-      run.assign(n, frame[at]);
-      bytes = run.data();
-    }
-    XXH64_update(xxh, bytes, n);
-    sink->consume(bytes, n);
-    total += n;
-    at += rle ? 1 : n;
-  }
-  const uint64_t digest = XXH64_digest(xxh);
-  XXH64_freeState(xxh);
-  if (!last || total != raw_size) return ContainerStatus::kDecompressFailed;
-  const size_t end = at + (fh.checksumFlag ? 4 : 0);
-  if (end != size) return ContainerStatus::kDecompressFailed;
-  if (fh.checksumFlag && layout::load32(frame + at) != uint32_t(digest)) return ContainerStatus::kDecompressFailed;
-  return ContainerStatus::kOk;
-}
-
-}  // namespace
-
-ContainerStatus streamSection(const ByteSource& source, const SectionInfo& info, SectionSink* sink) {
-  if (!knownCodec(info.codec)) return ContainerStatus::kDecompressFailed;
-  if (info.codec == uint32_t(Codec::kRaw)) return streamRaw(source, info, sink);
-  std::vector<uint8_t> buffer;
-  const uint8_t* stored = nullptr;
-  ContainerStatus status = loadZstdFrame(source, info, &buffer, &stored);
-  if (status != ContainerStatus::kOk) return status;
-  const size_t stored_size = size_t(info.stored_size);
+void ZstdFrameScan::parseHeader() {
   ZSTD_frameHeader fh;
-  const bool plain = ZSTD_getFrameHeader(&fh, stored, stored_size) == 0 && fh.frameType == ZSTD_frame && fh.dictID == 0;
-  if (plain && fh.windowSize <= (uint64_t(1) << kStreamWindowLog))
-    return streamZstdFrame(stored, stored_size, info.raw_size, sink);
-  if (plain && rawAndRleOnly(stored, stored_size, fh.headerSize))
-    return expandRawAndRle(stored, stored_size, fh, info.raw_size, sink);
-  // Anything else (a window above 2^27 with compressed blocks): decoded whole, as readSectionAlloc.
-  std::vector<uint8_t> whole(size_t(info.raw_size));
-  status = decodeZstd(stored, stored_size, whole.data(), whole.size());
-  if (status != ContainerStatus::kOk) return status;
-  for (size_t at = 0; at < whole.size(); at += kSectionStreamChunk)
-    sink->consume(whole.data() + at, std::min(kSectionStreamChunk, whole.size() - at));
+  if (ZSTD_getFrameHeader(&fh, head_, head_size_) != 0 || fh.frameType != ZSTD_frame) {
+    state_ = State::kBad;
+    return;
+  }
+  content_size_ = fh.frameContentSize;  // ZSTD_CONTENTSIZE_UNKNOWN when the header has none
+  window_size_ = fh.windowSize;
+  checksum_flag_ = fh.checksumFlag != 0;
+  next_block_ = fh.headerSize;
+  state_ = State::kBlocks;
+}
+
+// Block headers (RFC 8878 3.1.1.2): 3 bytes, bit 0 last block, bits 1-2 type (0 raw, 1 RLE,
+// 2 compressed, 3 reserved), bits 3-23 size; an RLE block stores one byte.
+void ZstdFrameScan::walk(const uint8_t* piece, uint64_t piece_at, size_t size) {
+  constexpr uint64_t kMaxBlock = uint64_t(128) << 10;
+  const uint64_t end = piece_at + size;
+  while (state_ == State::kBlocks) {
+    uint64_t want = next_block_ + block_have_;  // the next header byte needed
+    if (want >= end) return;
+    if (want < piece_at) {  // cannot happen: pieces arrive in order, each header byte once
+      state_ = State::kBad;
+      return;
+    }
+    while (block_have_ < 3 && want < end) block_[block_have_++] = piece[size_t(want++ - piece_at)];
+    if (block_have_ < 3) return;
+    block_have_ = 0;
+    const uint32_t block = uint32_t(block_[0]) | uint32_t(block_[1]) << 8 | uint32_t(block_[2]) << 16;
+    const uint32_t type = (block >> 1) & 3, block_size = block >> 3;
+    if (type == 3 || block_size > kMaxBlock) {
+      state_ = State::kBad;
+      return;
+    }
+    next_block_ += 3 + (type == 1 ? 1 : block_size);
+    bound_ += type == 2 ? kMaxBlock : block_size;
+    if (block & 1) state_ = State::kDone;
+  }
+}
+
+ContainerStatus ZstdFrameScan::verdict(uint64_t raw_size) const {
+  if (state_ != State::kDone || fed_ != stored_size_) return ContainerStatus::kDecompressFailed;
+  // Exactly one frame, exactly the stored bytes (its optional 4-byte checksum last).
+  if (next_block_ + (checksum_flag_ ? 4 : 0) != stored_size_) return ContainerStatus::kDecompressFailed;
+  if (content_size_ != raw_size || bound_ < raw_size) return ContainerStatus::kDecompressFailed;
+  if (window_size_ > kMaxZstdWindowSize) return ContainerStatus::kTooLarge;
   return ContainerStatus::kOk;
 }
 

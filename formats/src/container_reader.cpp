@@ -103,6 +103,27 @@ ContainerStatus Reader::readSectionInto(size_t i, void* dst, size_t dst_size) co
   return detail::readSectionFrom(*impl_->source, impl_->parsed.sections[i], dst, dst_size);
 }
 
+struct SectionStream::Impl {
+  detail::SectionDecoder decoder;
+};
+
+SectionStream::SectionStream() : impl_(std::make_unique<Impl>()) {}
+SectionStream::~SectionStream() = default;
+
+uint64_t SectionStream::size() const { return impl_->decoder.size(); }
+
+uint64_t SectionStream::remaining() const { return impl_->decoder.remaining(); }
+
+ContainerStatus SectionStream::read(void* dst, size_t size) { return impl_->decoder.read(dst, size); }
+
+ContainerStatus Reader::openSectionStream(size_t i, SectionStream* stream) const {
+  if (stream == nullptr) return ContainerStatus::kInvalidArgument;
+  stream->impl_ = std::make_unique<SectionStream::Impl>();
+  if (!impl_->source) return ContainerStatus::kInvalidArgument;
+  if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;
+  return stream->impl_->decoder.start(*impl_->source, impl_->parsed.sections[i]);
+}
+
 ContainerStatus Reader::readStored(size_t i, std::vector<uint8_t>* out) const {
   if (!impl_->source || out == nullptr) return ContainerStatus::kInvalidArgument;
   if (i >= impl_->parsed.sections.size()) return ContainerStatus::kNotFound;

@@ -419,6 +419,10 @@ bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* hea
   return data != nullptr && parseImageHeader(data, size, header);
 }
 
+bool parseImageSectionHead(const uint8_t* head, size_t head_size, uint64_t section_size, ImageSectionHeader* header) {
+  return head != nullptr && head_size >= layout::kImageHeaderSize && parseImageHeader(head, section_size, header);
+}
+
 namespace {
 
 bool parseImageHeader(const uint8_t* data, uint64_t size, ImageSectionHeader* header) {
@@ -606,6 +610,8 @@ ValidationReport validateSource(const detail::ByteSource& source, const Validate
       addError(&report.messages, 4002, describe(i, s) + ": checksum mismatch");
     } else if (status == ContainerStatus::kDecompressFailed) {
       addError(&report.messages, 4003, describe(i, s) + ": zstd data does not decode to exactly raw_size bytes");
+    } else if (status == ContainerStatus::kTooLarge) {
+      addError(&report.messages, 4010, describe(i, s) + ": zstd frame window exceeds the reader limit of 128 MiB");
     } else if (status != ContainerStatus::kOk) {
       addError(&report.messages, 1002, describe(i, s) + ": cannot be read (" + statusString(status) + ")");
     }

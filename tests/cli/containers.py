@@ -120,6 +120,32 @@ def zstd_block_frame(content_size, pieces, window_log=None):
     return frame
 
 
+def zstd_with_window(frame, window_log, rle_tail=0):
+    """The blocks of a zstd frame (any of this writer's, which set no checksum) under a header
+    declaring a window of 2^window_log bytes (not single segment), plus rle_tail zero bytes in RLE
+    blocks after them, the content size grown to match: compressed blocks whose window the frame
+    header alone decides."""
+    fhd = frame[4]
+    single = (fhd >> 5) & 1
+    assert not (fhd >> 2) & 1, "no frame checksum"
+    fcs_size = (single, 2, 4, 8)[fhd >> 6]
+    fcs_at = 5 + (0 if single else 1) + (0, 1, 2, 4)[fhd & 3]
+    content = int.from_bytes(frame[fcs_at:fcs_at + fcs_size], "little") + (256 if fcs_size == 2 else 0)
+    blocks = bytearray(frame[fcs_at + fcs_size:])
+    if rle_tail:
+        at = 0
+        while True:  # find the last block and clear its flag
+            header = int.from_bytes(blocks[at:at + 3], "little")
+            size = 1 if (header >> 1) & 3 == 1 else header >> 3
+            if header & 1:
+                blocks[at] &= 0xFE
+                break
+            at += 3 + size
+        blocks += zstd_block_frame(rle_tail, [("rle", b"\0", rle_tail)], window_log=window_log)[14:]
+    header = struct.pack("<IBBQ", 0xFD2FB528, 0xC0, (window_log - 10) << 3, content + rle_tail)
+    return header + bytes(blocks)
+
+
 def read_sections(data):
     """The sections of a container's bytes as build_container takes them: (type, key, stored bytes,
     codec, raw_size), in index order, so a test can rebuild a real file with one section changed."""

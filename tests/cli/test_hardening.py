@@ -14,7 +14,7 @@ import zlib
 import clitest
 from clitest import INVALID, IO, OK
 from containers import (CODEC_ZSTD, SECTION_IMAGE, SECTION_METADATA, build_container, image_payload, metadata,
-                        read_sections, zstd_block_frame, zstd_rle_frame)
+                        read_sections, zstd_block_frame, zstd_rle_frame, zstd_with_window)
 from test_ndfgen import write_pfm
 
 KIND_NDF_PYRAMID, SECTION_NDF_CHUNK = 1, 17
@@ -85,33 +85,87 @@ class HostileContainers(clitest.ToolTestCase):
                           outputs=[self.path("x.exr")], limits=MEMORY_LIMIT)
         self.assert_fails(INVALID, "glintinfo", "diff", bomb, bomb, limits=MEMORY_LIMIT)
 
-    def test_a_gibibyte_section_is_validated_in_bounded_memory(self):
+    def test_a_gibibyte_section_is_validated_and_compared_in_bounded_memory(self):
         # Honest 1 GiB image sections in a few KB: a GIMG header in a raw block, RLE blocks of zero
-        # floats, and a last raw block of two floats. Validated as they stream past (under the
-        # 768 MiB address limit), with the same verdicts as a section read whole.
+        # floats, and a last raw block of two floats, in a 1 MiB window. Validated and compared as
+        # they stream past (under the 768 MiB address limit; diff once held both sections whole),
+        # with the same verdicts as sections read whole.
         side = 16384
         header = struct.pack("<6IQ", 0x474D4947, side, side, 1, 1, 0, 0)
         raw_size = len(header) + side * side * 4
-        for window_log in (None, 20):  # single segment (window = 1 GiB) and a 1 MiB window
-            for tail, verdict in ((struct.pack("<2f", 0.5, 1.0), OK), (struct.pack("<2f", float("nan"), float("inf")), INVALID)):
-                frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 32 - 8), ("raw", tail)],
-                                         window_log=window_log)
-                path = self.write("big.gbk", build_container([
-                    (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
-                self.assertLess(os.path.getsize(path), 50_000)
-                code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
-                self.assertEqual(code, verdict, (window_log, out, err))
-                ids = [m["id"] for m in json.loads(out)["messages"]]
-                self.assertEqual(ids, [] if verdict == OK else [4006], out)
-                if verdict == INVALID:
-                    self.assertIn("2 non-finite values", out)
-        # A frame that stops short of its content size is still error-4003.
+        paths = {}
+        for tail, verdict in ((struct.pack("<2f", 0.5, 1.0), OK), (struct.pack("<2f", float("nan"), float("inf")), INVALID)):
+            frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 32 - 8), ("raw", tail)],
+                                     window_log=20)
+            path = paths[verdict] = self.write(f"big{verdict}.gbk", build_container([
+                (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
+            self.assertLess(os.path.getsize(path), 50_000)
+            code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
+            self.assertEqual(code, verdict, (out, err))
+            ids = [m["id"] for m in json.loads(out)["messages"]]
+            self.assertEqual(ids, [] if verdict == OK else [4006], out)
+            if verdict == INVALID:
+                self.assertIn("2 non-finite values", out)
+        code, out, err = clitest.run("glintinfo", "diff", paths[OK], paths[OK], "--json", limits=MEMORY_LIMIT)
+        self.assertEqual(code, OK, err)
+        rows = json.loads(out)["sections"]
+        self.assertEqual([(r["comparison"], r["status"]) for r in rows], [("metadata", "same"), ("image", "same")])
+        self.assertEqual((rows[1]["max_abs_diff"], rows[1]["rel_l2"]), (0, 0))
+        # A NaN against a number is an infinite difference (as when the sections are held whole).
+        code, out, err = clitest.run("glintinfo", "diff", paths[OK], paths[INVALID], "--json", limits=MEMORY_LIMIT)
+        self.assertEqual(code, clitest.DIFFERENCES, err)
+        self.assertEqual(json.loads(out)["sections"][1]["max_abs_diff"], "inf")
+        # The single-segment form of the same frame declares a 1 GiB window: refused, before
+        # decoding (error-4010), by validate and diff alike.
+        frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 32)])
+        wide = self.write("wide.gbk", build_container([
+            (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
+        code, out, err = clitest.run("glintinfo", "validate", wide, "--json", limits=MEMORY_LIMIT)
+        self.assertEqual(code, INVALID, err)
+        self.assertEqual([m["id"] for m in json.loads(out)["messages"]], [4010], out)
+        err = self.assert_fails(INVALID, "glintinfo", "diff", paths[OK], wide, limits=MEMORY_LIMIT)
+        self.assertIn("wide.gbk: section 1: zstd frame window exceeds the reader limit of 128 MiB", err)
+        # A frame that stops short of its content size is still error-4003, for validate and diff.
         frame = zstd_block_frame(raw_size, [("raw", header), ("rle", b"\0", raw_size - 64)], window_log=20)
         path = self.write("short.gbk", build_container([
             (SECTION_METADATA, 0, metadata()), (SECTION_IMAGE, 1, frame, CODEC_ZSTD, raw_size)]))
         code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
         self.assertEqual(code, INVALID, err)
         self.assertIn(4003, [m["id"] for m in json.loads(out)["messages"]])
+        err = self.assert_fails(INVALID, "glintinfo", "diff", paths[OK], path, limits=MEMORY_LIMIT)
+        self.assertIn("short.gbk: section 1: section does not decode", err)
+
+    def test_frames_of_windows_over_the_limit_are_refused_by_every_reader(self):
+        # A real asset's ndf-chunk frame (compressed blocks) under a header declaring a 256 MiB
+        # window, and, for a bomb, a 1 GiB window with 1 GiB of RLE blocks after the real ones
+        # (a streaming decoder would need the whole GiB): every reader refuses both before
+        # decoding, glintquery (the runtime) as glintinfo does.
+        asset = self.path("m.gbk")
+        self.run_ok("ndfgen", self.mapgen("beckmann", "m.png", "--size", "32", "--seed", "3"), "-o", asset, *NDF)
+        with open(asset, "rb") as f:
+            sections = read_sections(f.read())
+        chunk = next(i for i, s in enumerate(sections) if s[0] == SECTION_NDF_CHUNK and s[3] == CODEC_ZSTD)
+        stype, key, frame, _, raw_size = sections[chunk]
+        for name, window_log, tail in (("w28.gbk", 28, 0), ("w30.gbk", 30, 1 << 30)):
+            changed = list(sections)
+            changed[chunk] = (stype, key, zstd_with_window(frame, window_log, tail), CODEC_ZSTD, raw_size + tail)
+            path = self.write(name, build_container(changed, kind=KIND_NDF_PYRAMID))
+            code, out, err = clitest.run("glintinfo", "validate", path, "--json", limits=MEMORY_LIMIT)
+            self.assertEqual(code, INVALID, err)
+            ids = [m["id"] for m in json.loads(out)["messages"]]
+            self.assertEqual(ids[0], 4010, out)
+            err = self.assert_fails(INVALID, "glintinfo", "diff", asset, path, limits=MEMORY_LIMIT)
+            self.assertIn("zstd frame window exceeds the reader limit", err)
+            self.assert_fails(INVALID, "glintquery", "point", path, "--at", "16,16", "--sigma", "8", "--s", "0,0",
+                              limits=MEMORY_LIMIT)
+        # The same blocks under a window of 2^27 bytes, the limit, read as the original.
+        changed = list(sections)
+        changed[chunk] = (stype, key, zstd_with_window(frame, 27), CODEC_ZSTD, raw_size)
+        path = self.write("w27.gbk", build_container(changed, kind=KIND_NDF_PYRAMID))
+        self.run_ok("glintinfo", "validate", path)
+        query = ("--at", "16,16", "--sigma", "8", "--s", "0.1,0", "--json")
+        self.assertEqual(json.loads(self.run_ok("glintquery", "point", path, *query)[0])["value"],
+                         json.loads(self.run_ok("glintquery", "point", asset, *query)[0])["value"])
 
     def test_oversized_metadata_is_refused_before_decoding(self):
         # 512 MiB of metadata in a 20 KB file (honest RLE blocks): over the 16 MiB limit.

@@ -34,12 +34,17 @@ std::unique_ptr<format::Reader> openContainer(const std::string& argument) {
   throw cli::Error(cli::exitCodeOf(status), path + ": " + reason);
 }
 
+std::string sectionReadError(format::ContainerStatus status) {
+  if (status == format::ContainerStatus::kTooLarge) return "zstd frame window exceeds the reader limit of 128 MiB";
+  return format::statusString(status);
+}
+
 std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i) {
   std::vector<uint8_t> bytes;
   const format::ContainerStatus status = reader.readSection(i, &bytes);
   if (status != format::ContainerStatus::kOk) {
     throw cli::Error(cli::exitCodeOf(status),
-                     path + ": section " + std::to_string(i) + ": " + format::statusString(status));
+                     path + ": section " + std::to_string(i) + ": " + sectionReadError(status));
   }
   return bytes;
 }

@@ -19,6 +19,10 @@ namespace glintbake::glintinfo {
 // "a.gbk: header checksum mismatch (stored ..., computed ...)".
 std::unique_ptr<format::Reader> openContainer(const std::string& path);
 
+// Why section i cannot be read, for messages: the status's name, or for kTooLarge (which reading a
+// section of an open reader only returns for the zstd window) the limit.
+std::string sectionReadError(format::ContainerStatus status);
+
 // Reads section i; throws cli::Error (exit 3 for damaged data) naming the file and section.
 std::vector<uint8_t> readSectionOrThrow(const format::Reader& reader, const std::string& path, size_t i);
 

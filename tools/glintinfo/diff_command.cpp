@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "container_access.h"
 
+#include <glintbake/cli/exit_codes.h>
 #include <glintbake/format/validate.h>
 
 #include <algorithm>
@@ -13,43 +14,105 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace glintbake::glintinfo {
 namespace {
+
+constexpr size_t kPiece = size_t(1) << 20;  // bytes of each section held at a time
 
 struct ImageMetrics {
   double max_abs = 0.0;  // max |a - b| over all values (inf if a NaN pairs with a number)
   double rel_l2 = 0.0;   // ||a - b||_2 / ||a||_2 (0 when both are zero, inf when only a is)
 };
 
-// Values start after the 32-byte image header; both images have identical dimensions.
-ImageMetrics compareImages(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
-  constexpr size_t kHeader = sizeof(format::ImageSectionHeader);
-  const size_t count = (a.size() - kHeader) / 4;
-  ImageMetrics m;
-  double diff2 = 0.0, norm2 = 0.0;
-  for (size_t i = 0; i < count; ++i) {
-    float va, vb;
-    std::memcpy(&va, a.data() + kHeader + 4 * i, 4);
-    std::memcpy(&vb, b.data() + kHeader + 4 * i, 4);
-    if (std::isnan(va) || std::isnan(vb)) {
-      if (std::isnan(va) != std::isnan(vb)) m.max_abs = std::numeric_limits<double>::infinity();
-      continue;
+// Accumulates the metrics over the values of two images of identical dimensions, fed in order in
+// pieces of whole floats.
+class ImageComparison {
+ public:
+  void add(const uint8_t* a, const uint8_t* b, size_t bytes) {
+    for (size_t i = 0; i + 4 <= bytes; i += 4) {
+      float va, vb;
+      std::memcpy(&va, a + i, 4);
+      std::memcpy(&vb, b + i, 4);
+      if (std::isnan(va) || std::isnan(vb)) {
+        if (std::isnan(va) != std::isnan(vb)) max_abs_ = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      const double d = (std::isinf(va) || std::isinf(vb)) ? (va == vb ? 0.0 : std::numeric_limits<double>::infinity())
+                                                          : double(va) - double(vb);
+      max_abs_ = std::max(max_abs_, std::abs(d));
+      diff2_ += d * d;
+      if (std::isfinite(va)) norm2_ += double(va) * double(va);
     }
-    const double d = (std::isinf(va) || std::isinf(vb)) ? (va == vb ? 0.0 : std::numeric_limits<double>::infinity())
-                                                        : double(va) - double(vb);
-    m.max_abs = std::max(m.max_abs, std::abs(d));
-    diff2 += d * d;
-    if (std::isfinite(va)) norm2 += double(va) * double(va);
   }
-  if (diff2 == 0.0) {
-    m.rel_l2 = m.max_abs > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
-  } else {
-    m.rel_l2 = norm2 > 0.0 ? std::sqrt(diff2 / norm2) : std::numeric_limits<double>::infinity();
+  ImageMetrics metrics() const {
+    ImageMetrics m;
+    m.max_abs = max_abs_;
+    if (diff2_ == 0.0) {
+      m.rel_l2 = max_abs_ > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+    } else {
+      m.rel_l2 = norm2_ > 0.0 ? std::sqrt(diff2_ / norm2_) : std::numeric_limits<double>::infinity();
+    }
+    return m;
   }
-  return m;
-}
+
+ private:
+  double max_abs_ = 0.0, diff2_ = 0.0, norm2_ = 0.0;
+};
+
+// Section ia of A and ib of B, decoded in step a piece at a time (never whole). Failures are
+// reported as reading A whole and then B whole would report them: a failure of B's only once A
+// has been read to its end without one. Every comparison reads both to their ends, so damage
+// anywhere in either fails the diff whatever the verdict.
+class SectionPair {
+ public:
+  SectionPair(const format::Reader& a, const std::string& path_a, size_t ia, const format::Reader& b,
+              const std::string& path_b, size_t ib)
+      : path_a_(path_a), path_b_(path_b), ia_(ia), ib_(ib), scratch_(kPiece) {
+    if (const format::ContainerStatus status = a.openSectionStream(ia, &a_); status != format::ContainerStatus::kOk)
+      fail(path_a_, ia_, status);
+    if (const format::ContainerStatus status = b.openSectionStream(ib, &b_); status != format::ContainerStatus::kOk)
+      failB(status);
+  }
+  uint64_t sizeA() const { return a_.size(); }
+  uint64_t sizeB() const { return b_.size(); }
+  uint64_t remainingA() const { return a_.remaining(); }
+  uint64_t remainingB() const { return b_.remaining(); }
+  void readA(uint8_t* dst, size_t n) {
+    if (const format::ContainerStatus status = a_.read(dst, n); status != format::ContainerStatus::kOk)
+      fail(path_a_, ia_, status);
+  }
+  void readB(uint8_t* dst, size_t n) {
+    if (const format::ContainerStatus status = b_.read(dst, n); status != format::ContainerStatus::kOk) failB(status);
+  }
+  // Reads what is left of both.
+  void finish() {
+    finishA();
+    while (b_.remaining() > 0) readB(scratch_.data(), size_t(std::min<uint64_t>(kPiece, b_.remaining())));
+  }
+
+ private:
+  [[noreturn]] static void fail(const std::string& path, size_t i, format::ContainerStatus status) {
+    throw cli::Error(cli::exitCodeOf(status),
+                     path + ": section " + std::to_string(i) + ": " + sectionReadError(status));
+  }
+  [[noreturn]] void failB(format::ContainerStatus status) {
+    finishA();
+    fail(path_b_, ib_, status);
+  }
+  void finishA() {
+    while (a_.remaining() > 0) readA(scratch_.data(), size_t(std::min<uint64_t>(kPiece, a_.remaining())));
+  }
+
+  const std::string& path_a_;
+  const std::string& path_b_;
+  size_t ia_, ib_;
+  format::SectionStream a_, b_;
+  std::vector<uint8_t> scratch_;
+};
 
 // Metadata as JSON with the generator version removed. Metadata that is not JSON within the
 // nesting limit is invalid input, never "the same" as another such file.
@@ -128,17 +191,31 @@ int runDiff(cli::Tool& tool, const DiffOptions& options) {
       rows.push_back(row);
       continue;
     }
-    const auto da = readSectionOrThrow(*a, options.file_a, size_t(ia));
-    const auto db = readSectionOrThrow(*b, options.file_b, size_t(ib));
+    // Both sections stream past in step, a piece at a time: their first bytes decide between an
+    // image and a byte comparison.
+    SectionPair pair(*a, options.file_a, size_t(ia), *b, options.file_b, size_t(ib));
+    std::vector<uint8_t> piece_a(kPiece), piece_b(kPiece);
+    const size_t head_a = size_t(std::min<uint64_t>(pair.sizeA(), sizeof(format::ImageSectionHeader)));
+    const size_t head_b = size_t(std::min<uint64_t>(pair.sizeB(), sizeof(format::ImageSectionHeader)));
+    pair.readA(piece_a.data(), head_a);
+    pair.readB(piece_b.data(), head_b);
     format::ImageSectionHeader ha, hb;
-    if (format::parseImageSection(da.data(), da.size(), &ha) && format::parseImageSection(db.data(), db.size(), &hb)) {
+    if (format::parseImageSectionHead(piece_a.data(), head_a, pair.sizeA(), &ha) &&
+        format::parseImageSectionHead(piece_b.data(), head_b, pair.sizeB(), &hb)) {
       row["comparison"] = "image";
       if (ha.width != hb.width || ha.height != hb.height || ha.channels != hb.channels || ha.layers != hb.layers) {
         equal = false;
         row["detail"] = "dimensions differ";
         lines.push_back(label + ": image dimensions differ");
       } else {
-        const ImageMetrics m = compareImages(da, db);
+        ImageComparison comparison;  // same dimensions, so the same size
+        while (pair.remainingA() > 0) {
+          const size_t n = size_t(std::min<uint64_t>(kPiece, pair.remainingA()));
+          pair.readA(piece_a.data(), n);
+          pair.readB(piece_b.data(), n);
+          comparison.add(piece_a.data(), piece_b.data(), n);
+        }
+        const ImageMetrics m = comparison.metrics();
         equal = m.max_abs <= options.abs_tol || m.rel_l2 <= options.rel_tol;
         row["max_abs_diff"] = jsonNumber(m.max_abs);
         row["rel_l2"] = jsonNumber(m.rel_l2);
@@ -151,15 +228,35 @@ int runDiff(cli::Tool& tool, const DiffOptions& options) {
       }
     } else {
       row["comparison"] = "bytes";
-      equal = da == db;
+      // The first difference within the common length; the common length when there is none.
+      const uint64_t common = std::min(pair.sizeA(), pair.sizeB());
+      uint64_t compared = 0;
+      bool differ = false;
+      auto compare = [&](size_t n) {
+        for (size_t k = 0; k < n && !differ; ++k) {
+          if (piece_a[k] != piece_b[k]) {
+            differ = true;
+            compared += k;
+          }
+        }
+        if (!differ) compared += n;
+      };
+      compare(std::min(head_a, head_b));
+      while (!differ && compared < common) {
+        const size_t n = size_t(std::min<uint64_t>(kPiece, common - compared));
+        pair.readA(piece_a.data(), n);
+        pair.readB(piece_b.data(), n);
+        compare(n);
+      }
+      equal = !differ && pair.sizeA() == pair.sizeB();
       if (!equal) {
-        size_t first = 0;
-        while (first < std::min(da.size(), db.size()) && da[first] == db[first]) ++first;
-        row["detail"] = "first difference at byte " + std::to_string(first);
-        lines.push_back(label + ": bytes differ (sizes " + std::to_string(da.size()) + " and " +
-                        std::to_string(db.size()) + ", first difference at byte " + std::to_string(first) + ")");
+        const std::string first = std::to_string(compared);
+        row["detail"] = "first difference at byte " + first;
+        lines.push_back(label + ": bytes differ (sizes " + std::to_string(pair.sizeA()) + " and " +
+                        std::to_string(pair.sizeB()) + ", first difference at byte " + first + ")");
       }
     }
+    pair.finish();
     row["status"] = equal ? "same" : "different";
     same = same && equal;
     rows.push_back(row);

@@ -27,6 +27,7 @@ constexpr size_t kSectionAlignment = 64;                           // every sect
 constexpr uint64_t kDefaultMaxRawSectionSize = uint64_t(1) << 32;  // 4 GiB: readers' default cap
 constexpr uint32_t kMaxSectionCount = 1u << 24;                    // readers refuse more
 constexpr uint64_t kMaxMetadataSize = uint64_t(16) << 20;          // 16 MiB: metadata text limit
+constexpr uint64_t kMaxZstdWindowSize = uint64_t(1) << 27;         // 128 MiB: largest zstd window read
 constexpr int kMaxJsonDepth = 64;                                  // nesting limit of every JSON input
 
 enum class ContainerStatus : int32_t {
@@ -38,7 +39,7 @@ enum class ContainerStatus : int32_t {
   kCorruptIndex = 5,        // index entries out of range, overlapping, misaligned, or checksum mismatch
   kChecksumMismatch = 6,    // a section's stored bytes or the whole file fail their checksum
   kDecompressFailed = 7,    // zstd refused the section or it did not decode to its raw size
-  kTooLarge = 8,            // a size exceeds a reader limit (raw size cap, section count cap)
+  kTooLarge = 8,            // a size exceeds a reader limit (raw size cap, section count cap, zstd window)
   kNotFound = 9,            // no section with that type/key
   kInvalidArgument = 10,    // caller error (bad codec, writer already finished, ...)
   kTruncated = 11,          // the file is shorter than its header or index says
@@ -208,6 +209,28 @@ struct ReaderOptions {
   bool verify_file_checksum = false;  // hash the whole file on open (validate does; queries need not)
 };
 
+// One section's decoded bytes, front to back (Reader::openSectionStream).
+class SectionStream {
+ public:
+  SectionStream();
+  ~SectionStream();
+  SectionStream(const SectionStream&) = delete;
+  SectionStream& operator=(const SectionStream&) = delete;
+
+  // The open section's raw_size and the bytes not yet read (0 when no section is open).
+  uint64_t size() const;
+  uint64_t remaining() const;
+  // Copies the next min(size, remaining()) decoded bytes into dst. kDecompressFailed when the
+  // frame turns out not to decode to exactly raw_size bytes (the call's bytes are then
+  // unspecified, and later calls fail the same way); kInvalidArgument when nothing is open.
+  ContainerStatus read(void* dst, size_t size);
+
+ private:
+  friend class Reader;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // Reads a container with random access: open() reads and checks header and index only; each
 // section is read, checksum-verified and decoded on request. Safe on untrusted input: every offset
 // and size is checked against the file size and the limits above. const methods are thread-safe
@@ -235,12 +258,23 @@ class Reader {
   // Reads section i into out (resized to raw_size): checks bounds, checksum and decoded size. For
   // zstd, the frame's recorded content size must equal raw_size and its blocks must be able to
   // produce that many bytes (from its block headers) BEFORE out is resized, so a small file declaring
-  // a huge section costs at most its stored bytes (kDecompressFailed).
+  // a huge section costs at most its stored bytes (kDecompressFailed). A frame whose window exceeds
+  // kMaxZstdWindowSize is refused (kTooLarge), as openSectionStream must, so that every reader
+  // accepts the same files.
   ContainerStatus readSection(size_t i, std::vector<uint8_t>* out) const;
   // Same, into a caller buffer of exactly raw_size bytes (kInvalidArgument otherwise). Raw sections
   // are read straight into dst; zstd sections of a file reader go through a temporary buffer of
   // stored_size bytes (none for openMemory), plus zstd's decoding context.
   ContainerStatus readSectionInto(size_t i, void* dst, size_t dst_size) const;
+  // Opens section i for reading front to back in bounded memory through `stream` (which any
+  // earlier section it held is dropped from): the checks of readSection (checksum, codec, frame,
+  // window) are made first, reading the stored bytes in 1 MiB pieces; the bytes are then decoded
+  // as stream->read() asks for them. Memory: about 2 MiB plus, for zstd, its window (at most
+  // kMaxZstdWindowSize; about 8 MiB at the writer's levels), whatever raw_size. Same statuses as
+  // readSection; a zstd frame whose damage only decoding finds fails a later read(). The reader
+  // must stay open and outlive the stream. Safe on untrusted input; streams of one reader may be
+  // used from different threads, each stream from one.
+  ContainerStatus openSectionStream(size_t i, SectionStream* stream) const;
   // Reads the stored (possibly compressed) bytes of section i without decoding.
   ContainerStatus readStored(size_t i, std::vector<uint8_t>* out) const;
   // The metadata JSON text (the single kSectionMetadata section). kTooLarge, before anything is

@@ -48,11 +48,10 @@ struct ValidateOptions {
 // crashes; every problem becomes a message. Thread-safe (no shared state).
 ValidationReport validate(const void* data, size_t size, const ValidateOptions& options = {});
 
-// Same, reading the file with positioned reads. Sections are checked as they decode, in 1 MiB
-// pieces: memory is bounded by the metadata (16 MiB), one zstd section's stored bytes and zstd's
-// window (at most 128 MiB; a larger-window frame is expanded block by block when it holds only
-// raw and RLE blocks, decoded whole otherwise), not by the sections' decoded sizes. A file that
-// cannot be opened yields error-1001 and status kIoError.
+// Same, reading the file with positioned reads. Sections are read and checked as they decode, in
+// 1 MiB pieces: memory is bounded by the metadata (16 MiB) and zstd's window (at most
+// kMaxZstdWindowSize; frames of larger windows are refused, error-4010), not by the sections'
+// stored or decoded sizes. A file that cannot be opened yields error-1001 and status kIoError.
 ValidationReport validateFile(const std::string& path, const ValidateOptions& options = {});
 
 // Checks a metadata JSON text against schemas/container-metadata.schema.json (written out as hand
@@ -63,5 +62,8 @@ void validateMetadata(const std::string& json_utf8, AssetKind kind, std::vector<
 // Parses the ImageSectionHeader at the start of a section's raw bytes; false if the bytes are too
 // short, the magic differs, or width*height*channels*layers*4 + 32 != size. Safe on untrusted input.
 bool parseImageSection(const uint8_t* data, size_t size, ImageSectionHeader* header);
+// Same verdict from the section's first bytes alone (`head`, head_size >= 32 of them, else false)
+// and its raw size: for callers that stream the section instead of holding it.
+bool parseImageSectionHead(const uint8_t* head, size_t head_size, uint64_t section_size, ImageSectionHeader* header);
 
 }  // namespace glintbake::format
