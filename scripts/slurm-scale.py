@@ -240,6 +240,7 @@ def main():
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, interrupted)
+    signal.signal(signal.SIGINT, interrupted)  # also when started in the background (SIGINT ignored)
     root = tempfile.mkdtemp(prefix="glintbake-scale-")
     cluster = Cluster(os.path.join(root, "cluster"), cpus=a.cpus)
     os.makedirs(cluster.root)
@@ -307,8 +308,11 @@ def main():
             os.remove(out)
         doc["load_after"] = loadavg()
 
-        # T(N) = F + W / N on the mean shard CPU time; the local bake is N = 1.
+        # T(N) = F + W / N on the mean shard CPU time; the local bake joins as N = 1 only when a
+        # single shard count was measured.
         points = [(r["shards"], sum(t["cpu_s"] for t in r["tasks"]) / r["shards"]) for r in doc["runs"]]
+        if len({n for n, _ in points}) < 2:
+            points.append((1, doc["local"]["cpu_s"]))
         F, W = fit(points)
         scale = (a.project_size / a.size) ** 2
         doc["fit"] = {"F_s": round(F, 2), "W_s": round(W, 1), "local_predicted_s": round(F + W, 1),
@@ -326,12 +330,23 @@ def main():
         return 130
     finally:
         if submitted and cluster.procs:
+            # Cancel what is left and let the killed tasks go before the daemons and the folder.
             subprocess.run([find("scancel") or "scancel", *submitted], env=cluster.env, capture_output=True)
+            end = time.time() + 30
+            while time.time() < end:
+                q = subprocess.run([find("squeue"), "-h"], env=cluster.env, capture_output=True, text=True)
+                if q.returncode != 0 or not q.stdout.strip():
+                    break
+                time.sleep(0.5)
         cluster.stop()
         if a.keep:
             print(f"slurm-scale: kept {root}", file=sys.stderr)
         else:
-            shutil.rmtree(root, ignore_errors=True)
+            for _ in range(3):  # a task's last write may land while the tree is removed
+                shutil.rmtree(root, ignore_errors=True)
+                if not os.path.exists(root):
+                    break
+                time.sleep(1)
 
 
 def report(doc):
