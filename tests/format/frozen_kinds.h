@@ -181,7 +181,9 @@ inline std::vector<uint8_t> tinyRecord() {
   return b.bytes();
 }
 
-inline float tinyTexel(uint32_t x, uint32_t y, uint32_t c) { return 0.0625f * float(x) - 0.125f * float(y) + 0.25f * float(c); }
+inline float tinyTexel(uint32_t x, uint32_t y, uint32_t c) {
+  return 0.0625f * float(x) - 0.125f * float(y) + 0.25f * float(c);
+}
 
 inline std::vector<uint8_t> tinyTexels() {
   Bytes b(4 * 4 * 8);

@@ -48,7 +48,13 @@ typedef struct gb_ndf_asset gb_ndf_asset;
 
 /* Container asset kinds of NDF assets (formats/SPEC.md section 4; the values of the kind registry,
  * glintbake/format/kinds.h). */
-enum { GB_KIND_NDF_PYRAMID = 1, GB_KIND_TENSOR_NDF = 2, GB_KIND_WANG_TILES = 5, GB_KIND_TINY_EXAMPLE = 6, GB_KIND_GLITTER = 7 };
+enum {
+  GB_KIND_NDF_PYRAMID = 1,
+  GB_KIND_TENSOR_NDF = 2,
+  GB_KIND_WANG_TILES = 5,
+  GB_KIND_TINY_EXAMPLE = 6,
+  GB_KIND_GLITTER = 7
+};
 
 /* GB_WRONG_KIND for containers of other asset kinds. */
 GLINTBAKE_C_API int32_t gb_ndf_asset_open(const char* path, gb_ndf_asset** out);
@@ -84,34 +90,36 @@ GLINTBAKE_C_API const char* gb_kind_name(int32_t kind);
  * *length (may be NULL) to the full length without the NUL, so a first call with capacity 0 sizes
  * the buffer. GB_INVALID_ARGUMENT when the text did not fit (buffer then holds the truncated
  * prefix). */
-GLINTBAKE_C_API int32_t gb_ndf_asset_metadata(const gb_ndf_asset* asset, char* buffer, size_t capacity,
-                                              size_t* length);
+GLINTBAKE_C_API int32_t gb_ndf_asset_metadata(const gb_ndf_asset* asset, char* buffer, size_t capacity, size_t* length);
 
 /* Source map size in texels and wrap mode (0 repeat, 1 clamp, 2
- * unbounded: Wang tiles and tiny examples cover the plane without a period, pass positions as they are); any pointer may be NULL. */
+ * unbounded: Wang tiles and tiny examples cover the plane without a period, pass positions as they are); any pointer
+ * may be NULL. */
 GLINTBAKE_C_API int32_t gb_ndf_asset_map(const gb_ndf_asset* asset, int32_t* width, int32_t* height, int32_t* wrap);
 
 /* The footprint std (texels) each path answers (ndf_source.h, FootprintRange): exact from the
  * flakes for sigma <= exact_max (0: no flakes), blended into the pyramid up to handover_max, the
  * pyramid's levels from pyramid_min to pyramid_max. Any pointer may be NULL. */
 GLINTBAKE_C_API int32_t gb_ndf_asset_footprint_range(const gb_ndf_asset* asset, double* exact_max, double* handover_max,
-                                     double* pyramid_min, double* pyramid_max);
+                                                     double* pyramid_min, double* pyramid_max);
 
 /* The footprints the clustered lobes answer alone (both 0: no clustered path); the flakes hand over
  * to them from exact_max, and they to the pyramid up to handover_max. Any pointer may be NULL. */
-GLINTBAKE_C_API int32_t gb_ndf_asset_clustered_range(const gb_ndf_asset* asset, double* clustered_min, double* clustered_max);
+GLINTBAKE_C_API int32_t gb_ndf_asset_clustered_range(const gb_ndf_asset* asset, double* clustered_min,
+                                                     double* clustered_max);
 
-GLINTBAKE_C_API int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
-                          double* value);
-GLINTBAKE_C_API int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0, double sy0,
-                             double sx1, double sy1, double* value);
-GLINTBAKE_C_API int32_t gb_ndf_asset_sample(const gb_ndf_asset* asset, double x, double y, double sigma, double u1, double u2,
-                            double* sx, double* sy, double* pdf);
-GLINTBAKE_C_API int32_t gb_ndf_asset_pdf(const gb_ndf_asset* asset, double x, double y, double sigma, double sx, double sy,
-                         double* pdf);
+GLINTBAKE_C_API int32_t gb_ndf_asset_eval(const gb_ndf_asset* asset, double x, double y, double sigma, double sx,
+                                          double sy, double* value);
+GLINTBAKE_C_API int32_t gb_ndf_asset_average(const gb_ndf_asset* asset, double x, double y, double sigma, double sx0,
+                                             double sy0, double sx1, double sy1, double* value);
+GLINTBAKE_C_API int32_t gb_ndf_asset_sample(const gb_ndf_asset* asset, double x, double y, double sigma, double u1,
+                                            double u2, double* sx, double* sy, double* pdf);
+GLINTBAKE_C_API int32_t gb_ndf_asset_pdf(const gb_ndf_asset* asset, double x, double y, double sigma, double sx,
+                                         double sy, double* pdf);
 /* Integral of the footprint's NDF over the s-plane (what sampling normalises by). */
 GLINTBAKE_C_API int32_t gb_ndf_asset_mass(const gb_ndf_asset* asset, double x, double y, double sigma, double* mass);
-GLINTBAKE_C_API int32_t gb_ndf_asset_image(const gb_ndf_asset* asset, double x, double y, double sigma, float* out, size_t count);
+GLINTBAKE_C_API int32_t gb_ndf_asset_image(const gb_ndf_asset* asset, double x, double y, double sigma, float* out,
+                                           size_t count);
 
 #ifdef __cplusplus
 }
