@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-dev  # libFuzzer targets (scripts/fuzz.sh): the fuzzer runtime is not a dependency of clang
   slurm-wlm slurmctld slurmd slurm-client munge  # the one-node Slurm cluster of tests/slurm
+  time  # /usr/bin/time -v: per-task wall and peak memory in scripts/slurm-scale.py
 )
 if [[ "${1:-}" == "--browser" ]]; then
   packages+=(chromium)
