@@ -83,6 +83,27 @@ struct WeightedImage {
   double weight;
 };
 
+// The chord of a convex polygon at height y: [*xl, *xr]; false when the line misses it.
+bool chordAt(const Poly& p, double y, double* xl, double* xr) {
+  double lo = 1e300, hi = -1e300;
+  for (int i = 0; i < p.n; ++i) {
+    const int j = (i + 1) % p.n;
+    const double ya = p.y[i], yb = p.y[j];
+    if ((ya < y && yb < y) || (ya > y && yb > y)) continue;
+    if (ya == yb) {
+      lo = std::min({lo, p.x[i], p.x[j]});
+      hi = std::max({hi, p.x[i], p.x[j]});
+      continue;
+    }
+    const double x = p.x[i] + (y - ya) / (yb - ya) * (p.x[j] - p.x[i]);
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  *xl = lo;
+  *xr = hi;
+  return lo <= hi;
+}
+
 double polygonIntegral(const Poly& p, const WeightedImage* images, int count, int res) {
   double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
   for (int i = 0; i < p.n; ++i) {
@@ -102,8 +123,22 @@ double polygonIntegral(const Poly& p, const WeightedImage* images, int count, in
     clipAxis(p, 1, top, true, &tmp);
     clipAxis(tmp, 1, bottom, false, &band);
     if (band.n < 3) continue;
+    // Bins between the chords at the band's top and bottom lie wholly inside the polygon (it is
+    // convex): no clipping there.
+    double tl = 0.0, tr = -1.0, bl = 0.0, br = -1.0;
+    double inner_l = 1e300, inner_r = -1e300;
+    if (chordAt(p, top, &tl, &tr) && chordAt(p, bottom, &bl, &br)) {
+      inner_l = std::max(tl, bl);
+      inner_r = std::min(tr, br);
+    }
     for (int i = i0; i <= i1; ++i) {
       const double left = -1.0 + i * bin, right = -1.0 + (i + 1) * bin;
+      if (left >= inner_l && right <= inner_r) {
+        double v = 0.0;
+        for (int k = 0; k < count; ++k) v += images[k].weight * double(images[k].image[size_t(j) * res + i]);
+        total += v * ((right - left) * (top - bottom));
+        continue;
+      }
       clipAxis(band, 0, left, false, &tmp);
       clipAxis(tmp, 0, right, true, &cell);
       if (cell.n < 3) continue;
@@ -208,30 +243,51 @@ bool boxesMeet(const double a[4], const double b[4]) {
 
 // The examples whose squares meet p's (their cells lie within twice the reach of p's cell). False
 // when there are none: p owns all of its square.
-// The placements of a rectangle of cells, computed once per query when the rectangle fits (the
-// window's cells and those their examples' neighbours lie in), else each time they are asked for.
+// The placements of a band of rows of cells, each computed once per query: the rows [j - span,
+// j + span] around the window row j being walked (the rows its examples' neighbours lie in), over
+// the window's columns widened by span. Rows slide down as the walk does; a cell outside the band
+// is computed each time it is asked for.
 struct PlacementCache {
   static constexpr int kCells = 576;
   const format::TinyExampleRecord* record = nullptr;
   const format::TinyLayout* layout = nullptr;
-  int64_t i0 = 0, j0 = 0, width = 0, height = 0;  // width 0: nothing cached
+  int64_t i0 = 0, width = 0;     // columns [i0, i0 + width); width 0: nothing cached
+  int64_t rows = 0;              // rows held: 2 span + 1
+  int64_t first = 0, last = -1;  // rows [first, last] are loaded; row j lives at slot j mod rows
   format::TinyPlacement cells[kCells];
 
-  void fill(int64_t ci0, int64_t ci1, int64_t cj0, int64_t cj1) {
-    width = height = 0;
-    if ((ci1 - ci0 + 1) * (cj1 - cj0 + 1) > kCells) return;
-    i0 = ci0;
-    j0 = cj0;
+  // Columns [ci0, ci1], rows span either side of the walked row.
+  void begin(int64_t ci0, int64_t ci1, int span) {
+    rows = 2 * int64_t(span) + 1;
     width = ci1 - ci0 + 1;
-    height = cj1 - cj0 + 1;
-    for (int64_t j = 0; j < height; ++j)
-      for (int64_t i = 0; i < width; ++i)
-        cells[j * width + i] = format::tinyCellPlacement(*record, i0 + i, j0 + j, layout);
+    i0 = ci0;
+    first = 0;
+    last = -1;
+    if (width * rows > kCells) width = 0;
+  }
+  // Makes rows [j - span, j + span] resident (j only ever grows during a walk).
+  void walkTo(int64_t j) {
+    if (width == 0) return;
+    const int64_t span = rows / 2, lo = j - span, hi = j + span;
+    if (last < first || lo > last || lo < first) {
+      first = lo;
+      last = lo - 1;
+    } else {
+      first = lo;
+    }
+    for (int64_t row = last + 1; row <= hi; ++row) {
+      format::TinyPlacement* slot = cells + slotOf(row) * width;
+      for (int64_t i = 0; i < width; ++i) slot[i] = format::tinyCellPlacement(*record, i0 + i, row, layout);
+    }
+    last = hi;
   }
   format::TinyPlacement at(int64_t i, int64_t j) const {
-    if (i >= i0 && i < i0 + width && j >= j0 && j < j0 + height) return cells[(j - j0) * width + (i - i0)];
+    if (width > 0 && i >= i0 && i < i0 + width && j >= first && j <= last) return cells[slotOf(j) * width + (i - i0)];
     return format::tinyCellPlacement(*record, i, j, layout);
   }
+
+ private:
+  int64_t slotOf(int64_t row) const { return ((row % rows) + rows) % rows; }
 };
 
 bool gatherNeighbours(const format::TinyExampleRecord& r, const PlacementCache& cache, const format::TinyPlacement& p,
@@ -611,8 +667,7 @@ MapSize TinyExampleNdf::mapSize() const {
 
 bool TinyExampleNdf::validFootprint(const Footprint& f) const {
   if (!(open_ && std::isfinite(f.x) && std::isfinite(f.y) && std::isfinite(f.sigma) && f.sigma >= 0.0)) return false;
-  if (std::fabs(f.x) > 1e12 || std::fabs(f.y) > 1e12) return false;
-  return f.sigma <= footprintRange().pyramid_max_sigma;
+  return std::fabs(f.x) <= 1e12 && std::fabs(f.y) <= 1e12;
 }
 
 // The flakes' share of a footprint's answer: 1 up to kTinyFlakesExactUpTo, 0 from kTinyFlakesUpTo on,
@@ -647,7 +702,8 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
   const int top = int(r.levels) - 1;
   const size_t image = size_t(r.ndf_res) * r.ndf_res;
   const int res = int(r.ndf_res);
-  const double sigma = std::max(fp.sigma, kMinSigma);
+  // Wider footprints of stochastic layouts are clamped (footprintRange).
+  const double sigma = std::clamp(fp.sigma, kMinSigma, footprintRange().pyramid_max_sigma);
   // Overlapping layouts: the probability of the footprint on covered ground is the sum of the kept
   // tiles' (owned) weights.
   const bool overlap = format::tinyOverlapReach(r) > 0;
@@ -701,7 +757,8 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     if (!windowInRange(mx, rx, n) || !windowInRange(my, ry, n)) return false;
     const int64_t cx0 = int64_t(std::floor((mx - rx) / n)), cx1 = int64_t(std::floor((mx + rx) / n));
     const int64_t cy0 = int64_t(std::floor((my - ry) / n)), cy1 = int64_t(std::floor((my + ry) / n));
-    if (cx1 - cx0 >= kTinyMaxCells || cy1 - cy0 >= kTinyMaxCells || (cx1 - cx0 + 1) * (cy1 - cy0 + 1) > kTinyMaxCells)
+    if (cx1 - cx0 >= kTinyMaxCopies || cy1 - cy0 >= kTinyMaxCopies ||
+        (cx1 - cx0 + 1) * (cy1 - cy0 + 1) > kTinyMaxCopies)
       return false;
     for (int64_t cy = cy0; cy <= cy1; ++cy) {
       for (int64_t cx = cx0; cx <= cx1; ++cx) {
@@ -731,9 +788,10 @@ bool TinyExampleNdf::traverse(const Footprint& fp, F&& visit, int64_t* entered) 
     cache.emplace();
     cache->record = &r;
     cache->layout = layout();
-    cache->fill(i0 - 2 * cells_out, i1 + 2 * cells_out, j0 - 2 * cells_out, j1 + 2 * cells_out);
+    cache->begin(i0 - 2 * cells_out, i1 + 2 * cells_out, 2 * cells_out);
   }
   for (int64_t j = j0; j <= j1; ++j) {
+    if (overlap) cache->walkTo(j);
     for (int64_t i = i0; i <= i1; ++i) {
       const format::TinyPlacement p = overlap ? cache->at(i, j) : format::tinyCellPlacement(r, i, j, layout());
       if (!p.present) continue;
@@ -933,9 +991,8 @@ RuntimeStatus TinyExampleNdf::addTileImage(const Footprint& fp, double weight, f
 }
 
 // Draws from the tiles' answer; the point only (the caller sets the pdf).
-RuntimeStatus TinyExampleNdf::tileSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
-  double total = 0.0;
-  if (RuntimeStatus st = tileMass(fp, &total); st != RuntimeStatus::kOk) return st;
+RuntimeStatus TinyExampleNdf::tileSample(const Footprint& fp, double total, double u1, double u2,
+                                         NdfSample* out) const {
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The tile, in proportion to weight x mass, in the traversal's order.
   double target = u1 * total, acc = 0.0;
@@ -1104,10 +1161,9 @@ RuntimeStatus TinyExampleNdf::addFlakeImage(const Footprint& fp, double weight, 
 }
 
 // Draws from the flakes' answer; the point only (the caller sets the pdf).
-RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double total, double u1, double u2,
+                                          NdfSample* out) const {
   if (hasGridFlakes()) return flakes_->sample(flakeFootprint(fp), u1, u2, out);
-  double total = 0.0;
-  if (RuntimeStatus st = flakeMass(fp, &total); st != RuntimeStatus::kOk) return st;
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   // The flake in proportion to its weight, in the window's order, then a point of its lobe (Box-Muller
   // on the rescaled u1 and u2).
@@ -1214,16 +1270,21 @@ RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, 
   const double split = pf / (pf + pt);
   RuntimeStatus st;
   if (u1 < split || !(pt > 0.0)) {
-    st = flakeSample(fp, std::clamp(u1 / split, 0.0, 0.99999999999999989), u2, out);
+    st = flakeSample(fp, mf, std::clamp(u1 / split, 0.0, 0.99999999999999989), u2, out);
   } else {
-    st = tileSample(fp, std::clamp((u1 - split) / (1.0 - split), 0.0, 0.99999999999999989), u2, out);
+    st = tileSample(fp, mt, std::clamp((u1 - split) / (1.0 - split), 0.0, 0.99999999999999989), u2, out);
   }
   if (st != RuntimeStatus::kOk) return st;
   if (!inSquare(out->s)) {
     out->pdf = 0.0;
     return RuntimeStatus::kOk;
   }
-  return pdf(fp, out->s, &out->pdf);
+  // pdf() with the masses above (the same sums: the same bits).
+  double e = 0.0;
+  if (RuntimeStatus est = eval(fp, out->s, &e); est != RuntimeStatus::kOk) return est;
+  const double m = a >= 1.0 ? mf : a * mf + (1.0 - a) * mt;
+  out->pdf = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
 }
 
 }  // namespace glintbake::runtime

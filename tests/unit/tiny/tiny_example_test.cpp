@@ -759,6 +759,21 @@ TEST(TinyExample, ImageIsTheBinAverageAndArgumentsAreChecked) {
       ASSERT_EQ(asset->average(fp, {cx - bin / 2, cy - bin / 2, cx + bin / 2, cy + bin / 2}, &a), RuntimeStatus::kOk);
       EXPECT_NEAR(img[size_t(j) * 16 + i], a, 1e-5 * (1.0 + a));
     }
+  // A wide rectangle (bins wholly inside it are summed without clipping) against the sum of its
+  // 16 x 16 pieces, each narrower than a bin (every bin they meet is clipped).
+  const runtime::SRect wide{-0.9, -0.7, 0.8, 0.95};
+  double whole = 0.0, pieces = 0.0;
+  ASSERT_EQ(asset->average(fp, wide, &whole), RuntimeStatus::kOk);
+  const double pw = (wide.x1 - wide.x0) / 16, ph = (wide.y1 - wide.y0) / 16;
+  for (int j = 0; j < 16; ++j)
+    for (int i = 0; i < 16; ++i) {
+      double a = 0.0;
+      const runtime::SRect piece{wide.x0 + i * pw, wide.y0 + j * ph, wide.x0 + (i + 1) * pw, wide.y0 + (j + 1) * ph};
+      ASSERT_EQ(asset->average(fp, piece, &a), RuntimeStatus::kOk);
+      pieces += a / 256.0;
+    }
+  EXPECT_NEAR(whole, pieces, 1e-9 * whole);
+  EXPECT_GT(whole, 0.0);
   double v = 0.0;
   EXPECT_EQ(asset->eval({std::nan(""), 0.0, 1.0}, {0.0, 0.0}, &v), RuntimeStatus::kInvalidArgument);
   EXPECT_EQ(asset->eval({0.0, 0.0, -1.0}, {0.0, 0.0}, &v), RuntimeStatus::kInvalidArgument);
@@ -776,6 +791,55 @@ TEST(TinyExample, ImageIsTheBinAverageAndArgumentsAreChecked) {
 
 // The layered helper: f = f_base (1 - F_coat) + f_coat, each layer its own NDF, and its sampler's
 // pdf is pdf().
+// A stochastic layout's widest footprints: the window stays within kTinyMaxCells cells, footprints
+// beyond pyramid_max_sigma are answered as that one (a clamp, as the pyramids' top level), and
+// the answer there is close to the layout's mean (two far-apart centres agree).
+TEST(TinyExample, WideStochasticFootprintsAreClampedAndBounded) {
+  for (const bool overlap : {false, true}) {
+    const bake::NormalMap map = example(8);
+    TinyPlacementOptions p;
+    p.type = format::TinyExampleType::kStochastic;
+    p.rotate_range[1] = 360.0;
+    p.seed = 9;
+    p.density = overlap ? 0.9 : 0.4;
+    p.overlap = overlap;
+    const auto asset = bakeAsset(map, 16, p, overlap ? "wide_overlap" : "wide");
+    ASSERT_TRUE(asset);
+    const double top = asset->footprintRange().pyramid_max_sigma;
+    ASSERT_GT(top, 2.0);
+    ASSERT_LT(top, 1e6);
+    for (const double x : {0.0, 1234.5, -9.0e5}) {
+      int64_t examples = 0, tiles = 0;
+      ASSERT_EQ(asset->traversalCount({x, 17.0, top}, &examples, &tiles), RuntimeStatus::kOk);
+      EXPECT_LE(examples, runtime::kTinyMaxCells);
+      EXPECT_GT(examples, 100);
+      int64_t wide_examples = 0, wide_tiles = 0;
+      ASSERT_EQ(asset->traversalCount({x, 17.0, 1e9}, &wide_examples, &wide_tiles), RuntimeStatus::kOk);
+      EXPECT_EQ(wide_examples, examples);
+      double at_top = 0.0, wide = 0.0, m_top = 0.0, m_wide = 0.0;
+      ASSERT_EQ(asset->eval({x, 17.0, top}, {0.1, -0.05}, &at_top), RuntimeStatus::kOk);
+      ASSERT_EQ(asset->eval({x, 17.0, 40.0 * top}, {0.1, -0.05}, &wide), RuntimeStatus::kOk);
+      EXPECT_EQ(at_top, wide);
+      ASSERT_EQ(asset->mass({x, 17.0, top}, &m_top), RuntimeStatus::kOk);
+      ASSERT_EQ(asset->mass({x, 17.0, 1e30}, &m_wide), RuntimeStatus::kOk);
+      EXPECT_EQ(m_top, m_wide);
+      runtime::NdfSample a, b;
+      ASSERT_EQ(asset->sample({x, 17.0, top}, 0.4, 0.6, &a), RuntimeStatus::kOk);
+      ASSERT_EQ(asset->sample({x, 17.0, 1e7}, 0.4, 0.6, &b), RuntimeStatus::kOk);
+      EXPECT_EQ(a.s.x, b.s.x);
+      EXPECT_EQ(a.pdf, b.pdf);
+    }
+    // Converged: far-apart windows of the widest footprint give nearly the same image.
+    const std::vector<double> a = imageOf(*asset, {0.0, 0.0, top}), b = imageOf(*asset, {5.0e4, -3.0e4, top});
+    double diff = 0.0, sum = 0.0;
+    for (size_t k = 0; k < a.size(); ++k) {
+      diff += std::fabs(a[k] - b[k]);
+      sum += a[k];
+    }
+    EXPECT_LT(diff / sum, 0.15) << "overlap " << overlap;
+  }
+}
+
 TEST(TinyExample, LayeredBrdf) {
   const auto asset = bakeAsset(example(8), 32, TinyPlacementOptions(), "layered");
   ASSERT_TRUE(asset);

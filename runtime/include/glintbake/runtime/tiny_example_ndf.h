@@ -61,7 +61,11 @@ constexpr double kTinyRefine = 0.005;  // split a tile while w t (d + t) > kTiny
 constexpr double kTinyFlakesExactUpTo = 4.0;
 constexpr double kTinyFlakesUpTo = 6.0;
 constexpr double kTinyWindowSigmas = 6.0;
-constexpr int64_t kTinyMaxCells = 1 << 18;  // stochastic: most layout cells one query visits
+// Stochastic layouts: most layout cells one query visits (48 x 48; wider footprints are clamped,
+// see footprintRange). Tiled: most copies of the example one query visits (only footprints far
+// narrower across one axis of the transform than along the other reach it before the top tile).
+constexpr int64_t kTinyMaxCells = 48 * 48;
+constexpr int64_t kTinyMaxCopies = int64_t(1) << 18;
 
 // The bin-averaged NDF image (R x R, row 0 at s_y = +1, bins outside the unit disk 0) of the texels
 // [x0, x0 + side) x [y0, y0 + side) of an n x n example: the mean over those texels of their lobes
@@ -154,6 +158,12 @@ class TinyExampleNdf final : public NdfSource {
 
   format::AssetKind kind() const override { return format::AssetKind::kTinyExample; }
   int resolution() const override { return open_ ? int(record_.ndf_res) : 0; }
+  // pyramid_min_sigma 2 (the finest tiles), exact_max_sigma and handover_max_sigma the flakes' band.
+  // Stochastic layouts: pyramid_max_sigma is the widest footprint whose 6-sigma window (and, with
+  // overlaps, the cells around it) stays within kTinyMaxCells cells, about 3.5 cells; wider
+  // footprints are answered as that one at the same centre (a clamp, as the pyramids' top level:
+  // such a window already holds some 1,500 examples, so its NDF is close to the layout's mean).
+  // Tiled: no clamp (the periodic sum is the top tile from n sigma on).
   FootprintRange footprintRange() const override;
   // The example's size (the plane is unbounded).
   MapSize mapSize() const override;
@@ -183,12 +193,14 @@ class TinyExampleNdf final : public NdfSource {
   RuntimeStatus flakeMass(const Footprint& f, double* value) const;
   RuntimeStatus flakeAverage(const Footprint& f, const SRect& rect, double* value) const;
   RuntimeStatus addFlakeImage(const Footprint& f, double weight, float* out) const;
-  RuntimeStatus flakeSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
+  // total: flakeMass() of the footprint.
+  RuntimeStatus flakeSample(const Footprint& f, double total, double u1, double u2, NdfSample* sample) const;
   RuntimeStatus tileEval(const Footprint& f, const SPoint& s, double* value) const;
   RuntimeStatus tileMass(const Footprint& f, double* value) const;
   RuntimeStatus tileAverage(const Footprint& f, const SRect& rect, double* value) const;
   RuntimeStatus addTileImage(const Footprint& f, double weight, float* out) const;
-  RuntimeStatus tileSample(const Footprint& f, double u1, double u2, NdfSample* sample) const;
+  // total: tileMass() of the footprint.
+  RuntimeStatus tileSample(const Footprint& f, double total, double u1, double u2, NdfSample* sample) const;
   template <typename F>
   bool traverse(const Footprint& f, F&& visit, int64_t* entered = nullptr) const;
   // traverse(), handing the tiles over in batches of one frame.
