@@ -4,8 +4,8 @@
 #  1. a runtime-only configuration (container library + runtime-lite, no OpenImageIO, Ceres, TBB
 #     or Eigen), as shared libraries, built and tested as a renderer would build it;
 #  2. the full project, Release, with warnings as errors (GLINTBAKE_WERROR), every test;
-#  3. sanitizers (scripts/sanitize.sh): the unit tests and the malformed-input CLI tests under
-#     ASan+UBSan in a Debug build of the whole project (--all there runs every CLI test too), the
+#  3. sanitizers (scripts/sanitize.sh): the whole suite (CLI tests included; not the install,
+#     report and statistical tests) under ASan+UBSan in a Debug build of the whole project, the
 #     runtime's concurrency test under TSan;
 #  4. a short run of every libFuzzer target (scripts/fuzz.sh, clang), seeded from valid files of
 #     every kind.

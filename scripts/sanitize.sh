@@ -6,10 +6,9 @@
 #   build-asan/  the whole project under ASan+UBSan (libraries, tools and tests; no benchmarks, and
 #                no Python module: see CMakeLists.txt), at -O1 with line tables only (-g1): faster
 #                to run than -O0, and full debug information is not needed for symbolised reports.
-#                By default (CI) it runs the unit tests and the CLI tests of malformed input
-#                (cli.hardening, cli.contract), so the tools themselves meet every damaged file;
-#                with --all, the whole CTest suite but the tests listed below.
-#   scripts/sanitize.sh [--all]
+#                Runs the whole CTest suite but the tests listed below, the CLI tests included, so
+#                the tools themselves meet every damaged file and every option.
+#   scripts/sanitize.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 generator=()
@@ -17,10 +16,12 @@ command -v ninja >/dev/null && generator=(-G Ninja)
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 jobs=${GLINTBAKE_JOBS:-$(nproc)}
-# Full malloc stacks (fast_unwind_on_malloc=0) so that the one third-party leak suppression can
-# match its library's frame. They cost: a tool's start-up takes about 3 times the CPU it takes
-# with the fast unwinder, which the CLI tests, starting hundreds of tools, pay every time.
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:fast_unwind_on_malloc=0:abort_on_error=1}
+# Leak checks everywhere. The one third-party leak suppression (tests/sanitizers/lsan.supp) can only
+# match its library's frame with full malloc stacks (fast_unwind_on_malloc=0), which triple a
+# tool's start-up under ASan; so the tests that meet that leak (the ingest of truncated PNGs) run
+# apart with them, and everything else with the fast unwinder.
+asan_fast=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
+asan_full_stacks=${ASAN_OPTIONS:-detect_leaks=1:fast_unwind_on_malloc=0:abort_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
@@ -46,11 +47,8 @@ cmake --build build-asan -j "$jobs" >/dev/null
 #  - the statistical tests: millions of samples each (chi-square, Monte Carlo, 500-sweep CP
 #    references), minutes apiece under ASan; their code paths also run in the quick tests here.
 excluded='^install[.]|^cli[.]report$|SamplesFollowTheirPdf|ClusteredLevelsStayClose|MillionSample|ChiSquare|MonteCarlo|^LtcTable[.]|FiveHundredPlainSweeps|RecoversExactLowRank'
-if [[ "${1:-}" == "--all" ]]; then
-  ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800 -E "$excluded"
-else
-  # The other CLI tests start hundreds of tools each, 5-10 times slower under ASan than in the
-  # Release build: together about as long as the rest of CI, so they run with --all only.
-  ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800 -E "$excluded" \
-    -R '^cli[.](hardening|contract)$|^[A-Z]'
-fi
+full_stacks='^Ingest[.]'
+ASAN_OPTIONS=$asan_fast ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800 \
+  -E "$excluded|$full_stacks"
+ASAN_OPTIONS=$asan_full_stacks ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800 \
+  -E "$excluded" -R "$full_stacks"
