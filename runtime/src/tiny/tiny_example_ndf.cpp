@@ -117,6 +117,11 @@ double polygonIntegral(const Poly& p, const WeightedImage* images, int count, in
   const int i0 = binColumn(std::max(lo_x, -1.0), res), i1 = binColumn(std::min(hi_x, 1.0), res);
   const int j0 = binRow(std::min(hi_y, 1.0), res), j1 = binRow(std::max(lo_y, -1.0), res);
   double total = 0.0;
+  auto binValue = [&](int j, int i) {
+    double v = 0.0;
+    for (int k = 0; k < count; ++k) v += images[k].weight * double(images[k].image[size_t(j) * res + i]);
+    return v;
+  };
   Poly band, tmp, cell;
   for (int j = j0; j <= j1; ++j) {
     const double top = 1.0 - j * bin, bottom = 1.0 - (j + 1) * bin;
@@ -134,9 +139,7 @@ double polygonIntegral(const Poly& p, const WeightedImage* images, int count, in
     for (int i = i0; i <= i1; ++i) {
       const double left = -1.0 + i * bin, right = -1.0 + (i + 1) * bin;
       if (left >= inner_l && right <= inner_r) {
-        double v = 0.0;
-        for (int k = 0; k < count; ++k) v += images[k].weight * double(images[k].image[size_t(j) * res + i]);
-        total += v * ((right - left) * (top - bottom));
+        total += binValue(j, i) * ((right - left) * (top - bottom));
         continue;
       }
       clipAxis(band, 0, left, false, &tmp);
@@ -144,9 +147,7 @@ double polygonIntegral(const Poly& p, const WeightedImage* images, int count, in
       if (cell.n < 3) continue;
       const double a = area(cell);
       if (!(a > 0.0)) continue;
-      double v = 0.0;
-      for (int k = 0; k < count; ++k) v += images[k].weight * double(images[k].image[size_t(j) * res + i]);
-      total += v * a;
+      total += binValue(j, i) * a;
     }
   }
   return total;
@@ -269,12 +270,8 @@ struct PlacementCache {
   void walkTo(int64_t j) {
     if (width == 0) return;
     const int64_t span = rows / 2, lo = j - span, hi = j + span;
-    if (last < first || lo > last || lo < first) {
-      first = lo;
-      last = lo - 1;
-    } else {
-      first = lo;
-    }
+    if (last < first || lo > last || lo < first) last = lo - 1;  // nothing of the new band resident
+    first = lo;
     for (int64_t row = last + 1; row <= hi; ++row) {
       format::TinyPlacement* slot = cells + slotOf(row) * width;
       for (int64_t i = 0; i < width; ++i) slot[i] = format::tinyCellPlacement(*record, i0 + i, row, layout);
@@ -677,6 +674,9 @@ static double tinyFlakeShare(double sigma) {
   if (sigma >= kTinyFlakesUpTo) return 0.0;
   return std::log(kTinyFlakesUpTo / sigma) / std::log(kTinyFlakesUpTo / kTinyFlakesExactUpTo);
 }
+
+// The answer of the two paths, the flakes' share a of it (the tiles' value t unused when a >= 1).
+static double blendPaths(double a, double f, double t) { return a >= 1.0 ? f : a * f + (1.0 - a) * t; }
 
 // The footprint in the transformed example's grid (the flakes' coordinates).
 Footprint TinyExampleNdf::flakeFootprint(const Footprint& f) const {
@@ -1204,7 +1204,7 @@ RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double*
     if (RuntimeStatus st = flakeEval(fp, s, &f); st != RuntimeStatus::kOk) return st;
   if (a < 1.0)
     if (RuntimeStatus st = tileEval(fp, s, &t); st != RuntimeStatus::kOk) return st;
-  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  *value = blendPaths(a, f, t);
   return RuntimeStatus::kOk;
 }
 
@@ -1216,7 +1216,7 @@ RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
     if (RuntimeStatus st = flakeMass(fp, &f); st != RuntimeStatus::kOk) return st;
   if (a < 1.0)
     if (RuntimeStatus st = tileMass(fp, &t); st != RuntimeStatus::kOk) return st;
-  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  *value = blendPaths(a, f, t);
   return RuntimeStatus::kOk;
 }
 
@@ -1237,7 +1237,7 @@ RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, do
     if (RuntimeStatus st = flakeAverage(fp, rect, &f); st != RuntimeStatus::kOk) return st;
   if (a < 1.0)
     if (RuntimeStatus st = tileAverage(fp, rect, &t); st != RuntimeStatus::kOk) return st;
-  *value = a >= 1.0 ? f : a * f + (1.0 - a) * t;
+  *value = blendPaths(a, f, t);
   return RuntimeStatus::kOk;
 }
 
@@ -1282,7 +1282,7 @@ RuntimeStatus TinyExampleNdf::sample(const Footprint& fp, double u1, double u2, 
   // pdf() with the masses above (the same sums: the same bits).
   double e = 0.0;
   if (RuntimeStatus est = eval(fp, out->s, &e); est != RuntimeStatus::kOk) return est;
-  const double m = a >= 1.0 ? mf : a * mf + (1.0 - a) * mt;
+  const double m = blendPaths(a, mf, mt);
   out->pdf = m > 0.0 ? e / m : 0.0;
   return RuntimeStatus::kOk;
 }
