@@ -3,8 +3,8 @@
 # Sanitizer builds (Debug, so the DCHECKs run too):
 #   build-tsan/  runtime-only under TSan; runs the runtime's concurrency tests (threads hammering
 #                eval, average, sample, pdf and mass on one shared asset).
-#   build-asan/  the whole project under ASan+UBSan (libraries, tools and tests; no benchmarks, and
-#                no Python module: see CMakeLists.txt), at -O1 with line tables only (-g1): faster
+#   build-asan/  the whole project under ASan+UBSan (libraries, tools, the Python module and tests;
+#                no benchmarks), at -O1 with line tables only (-g1): faster
 #                to run than -O0, and full debug information is not needed for symbolised reports.
 #                Runs the whole CTest suite but the tests listed below, the CLI tests included, so
 #                the tools themselves meet every damaged file and every option.

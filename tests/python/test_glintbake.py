@@ -66,6 +66,16 @@ def test_sample_pdf_and_average():
     assert image.shape == (4, 4) and image.dtype == np.float32
 
 
+@pytest.mark.skipif("address" not in os.environ.get("GLINTBAKE_SANITIZE", ""), reason="not an ASan build")
+def test_runs_under_address_sanitizer():
+    """In an ASan build these tests prove something only if the interpreter carries the sanitizer
+    runtime and the module is instrumented."""
+    with open("/proc/self/maps") as maps:
+        assert "libasan" in maps.read()
+    with open(glintbake._glintbake.__file__, "rb") as module:
+        assert b"__asan_init" in module.read()
+
+
 def test_refused_queries_are_nan_and_bad_shapes_raise():
     asset = glintbake.open(PYRAMID)
     values = asset.eval(np.array([[4.0, 4.0, -1.0], [4.0, 4.0, 1.0]]), np.array([0.1, 0.1]))
