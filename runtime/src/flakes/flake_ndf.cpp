@@ -114,6 +114,16 @@ struct KernelTerms {
   float spatial_cut;         // lanes with a spatial exponent below it only
 };
 
+// The float constants of one point query's leaf reach test (reachMask in flake_kernel.inc).
+struct LeafTerms {
+  float sx, sy, sp, sm;  // s, s_x + s_y, s_x - s_y
+  float a, b, inv2v;
+  float budget_cut;     // kMaxExponent plus a margin against rounding
+  float var_slack;      // 1 plus a margin: variances and shifts are widened by it
+  float spatial_bound;  // the spatial truncation plus a margin
+  float bound_sr2;      // sigma_r^2 widened
+};
+
 // Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
 // room the branch-free writes and the padding to a whole vector take).
 constexpr int kLaneList = 512;
@@ -151,6 +161,13 @@ void laneValues(bool wide, LaneList* list, int n, float cutoff) {
 #endif
   (void)wide;
   sse::laneValues(list, n, cutoff);
+}
+uint32_t reachMask(bool wide, const LeafBounds& lb, const LeafTerms& c, float bx, float by) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::reachMask(lb, c, bx, by);
+#endif
+  (void)wide;
+  return sse::reachMask(lb, c, bx, by);
 }
 
 }  // namespace
@@ -505,7 +522,6 @@ void FlakeNdf::Impl::forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms&
 }
 
 double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) const {
-  using flakes::F4;
   // Largest lobe variance and mean shift over a tile: C_k <= (sigma_r^2 + b |J|^2) I and
   // |mu_k - n_k| <= a |J| |u_Q - u_k|.
   auto tile = [&](const TileBound& bound, double dmax, double budget) {
@@ -516,49 +532,23 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
     return ex * ex + ey * ey <= 2.0 * budget * var;
   };
-  const F4 zero = F4::splat(0.0f), two = F4::splat(2.0f);
-  const F4 fsx = F4::splat(float(sx)), fsy = F4::splat(float(sy));
-  const F4 fsp = F4::splat(float(sx + sy)), fsm = F4::splat(float(sx - sy));
-  const F4 a = F4::splat(float(t.a)), b = F4::splat(float(t.b)), inv2v = F4::splat(float(t.inv2v));
-  // The same test per leaf, four leaves at a time in float, from each leaf's box of positions; the
-  // budget and variance widened against float rounding.
-  const F4 budget_cut = F4::splat(float(kMaxExponent) + 1e-3f), var_slack = F4::splat(1.0f + 1e-4f);
-  const F4 spatial_bound = F4::splat(float(t.spatial_cut) + 1e-3f);
-  const F4 bound_sr2 = F4::splat(float(sigma_r2) * (1.0f + 1e-4f));
+  // The same test per leaf (reachMask), in float from each leaf's box of positions; the budget and
+  // variance widened against float rounding.
+  LeafTerms lt;
+  lt.sx = float(sx);
+  lt.sy = float(sy);
+  lt.sp = float(sx + sy);
+  lt.sm = float(sx - sy);
+  lt.a = float(t.a);
+  lt.b = float(t.b);
+  lt.inv2v = float(t.inv2v);
+  lt.budget_cut = float(kMaxExponent) + 1e-3f;
+  lt.var_slack = 1.0f + 1e-4f;
+  lt.spatial_bound = float(t.spatial_cut) + 1e-3f;
+  lt.bound_sr2 = float(sigma_r2) * (1.0f + 1e-4f);
+  const bool wide = flakes::hasAvx2();
   auto leaves = [&](const LeafBounds& lb, const TileBound& tb, double base_x, double base_y) {
-    const F4 bx = F4::splat(float(base_x)), by = F4::splat(float(base_y));
-    uint32_t mask = 0;
-    for (int h = 0; h < kLeaves; h += 4) {
-      // u_Q - u_k over the leaf: [base - phi, base - plo] along each axis.
-      const F4 x_near = bx - F4::load(lb.phi_x + h), x_far = bx - F4::load(lb.plo_x + h);
-      const F4 y_near = by - F4::load(lb.phi_y + h), y_far = by - F4::load(lb.plo_y + h);
-      const F4 dx_min = max(max(x_near, zero - x_far), zero), dy_min = max(max(y_near, zero - y_far), zero);
-      const F4 dx_max = max(flakes::abs4(x_near), flakes::abs4(x_far));
-      const F4 dy_max = max(flakes::abs4(y_near), flakes::abs4(y_far));
-      const F4 spatial_min = (dx_min * dx_min + dy_min * dy_min) * inv2v;
-      const F4 budget = budget_cut - spatial_min;
-      const F4 jmax = F4::load(lb.jmax + h);
-      const F4 shift = jmax * a * sqrt(dx_max * dx_max + dy_max * dy_max) * var_slack;
-      const F4 var = bound_sr2 + b * jmax * jmax * var_slack;
-      // The box of the lobe means, and the distance of s from it along x, y and the diagonals
-      // (the latter times sqrt 2, from the box of m_x + m_y and m_x - m_y).
-      const F4 lo_x = F4::load(lb.lo_x + h) - shift, hi_x = F4::load(lb.hi_x + h) + shift;
-      const F4 lo_y = F4::load(lb.lo_y + h) - shift, hi_y = F4::load(lb.hi_y + h) + shift;
-      const F4 ex = max(max(lo_x - fsx, fsx - hi_x), zero);
-      const F4 ey = max(max(lo_y - fsy, fsy - hi_y), zero);
-      const F4 ep = max(max((lo_x + lo_y) - fsp, fsp - (hi_x + hi_y)), zero);
-      const F4 em = max(max((lo_x - hi_y) - fsm, fsm - (hi_x - lo_y)), zero);
-      // q = r^T C^-1 r >= (u . r)^2 / (u^T C u) for every unit u, and >= |r|^2 / lambda_max(C).
-      const F4 room = two * budget;
-      const int pass = lessEqualMask(ex * ex + ey * ey, room * var) &
-                       lessEqualMask(ex * ex, room * (bound_sr2 + b * F4::load(lb.jxx + h) * var_slack)) &
-                       lessEqualMask(ey * ey, room * (bound_sr2 + b * F4::load(lb.jyy + h) * var_slack)) &
-                       lessEqualMask(ep * ep, two * room * (bound_sr2 + b * F4::load(lb.jpp + h) * var_slack)) &
-                       lessEqualMask(em * em, two * room * (bound_sr2 + b * F4::load(lb.jmm + h) * var_slack)) &
-                       lessEqualMask(spatial_min, spatial_bound);
-      mask |= uint32_t(pass) << h;
-    }
-    return mask & (leafMask(tb.leaves));
+    return reachMask(wide, lb, lt, float(base_x), float(base_y)) & leafMask(tb.leaves);
   };
   // The kernel (flake_kernel.inc): s split into a float and its remainder, so that s - n_k keeps
   // double accuracy; det C from the expansion sr^4 + sr^2 b tr(J J^T) + b^2 det(J J^T), which does
@@ -579,7 +569,6 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   c.b2 = float(t.b * t.b);
   c.keep_cut = float(kMaxExponent) + 0.01f;
   c.spatial_cut = float(t.spatial_cut);
-  const bool wide = flakes::hasAvx2();
   LaneList list;
   int n = 0;
   double sums[4] = {0.0, 0.0, 0.0, 0.0};

@@ -82,6 +82,9 @@ struct F8 {
     return {_mm256_and_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ), x.v)};
   }
   GLINTBAKE_AVX2_FN friend int lessMask(F8 a, F8 b) { return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)); }
+  GLINTBAKE_AVX2_FN friend int lessEqualMask(F8 a, F8 b) {
+    return _mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ));
+  }
   GLINTBAKE_AVX2_FN friend F8 floorV(F8 x) {
     const __m256 t = _mm256_cvtepi32_ps(_mm256_cvttps_epi32(x.v));
     return {_mm256_sub_ps(t, _mm256_and_ps(_mm256_cmp_ps(t, x.v, _CMP_GT_OQ), _mm256_set1_ps(1.0f)))};
