@@ -21,6 +21,12 @@ Error invalid(const std::string& message) { return makeError(ErrorCode::kInvalid
 
 }  // namespace
 
+BakeStatus checkBlockDividesResolution(int block, int res) {
+  if (res >= 1 && block >= 1 && res % block == 0) return okStatus();
+  return makeError(ErrorCode::kBadArgument,
+                   "--block " + std::to_string(block) + " does not divide the NDF resolution " + std::to_string(res));
+}
+
 bool isExactLevel(const format::NdfLevelRecord& record, const TensorPackOptions& options) {
   const uint64_t centres = uint64_t(record.grid_width) * uint64_t(record.grid_height);
   const uint64_t level_bytes = centres * uint64_t(record.ndf_res) * uint64_t(record.ndf_res) * 4u;
@@ -48,10 +54,7 @@ BakeStatus TensorAssembler::level(const format::NdfLevelRecord& record) {
   if (in_region_ || (level_ >= 0 && !index_.empty())) return invalid("a level begins before the last one ended");
   const int res = int(record.ndf_res);
   if (ndf_res_ == 0) {
-    if (res < 1 || res % options_.block != 0) {
-      return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options_.block) +
-                                                    " does not divide the NDF resolution " + std::to_string(res));
-    }
+    if (BakeStatus s = checkBlockDividesResolution(options_.block, res); !s) return s;
     ndf_res_ = res;
     blocks_per_side_ = res / options_.block;
     report_.ndf_res = res;

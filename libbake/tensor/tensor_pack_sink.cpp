@@ -53,10 +53,7 @@ BakeStatus TensorPackSink::addLevel(const format::NdfLevelRecord& record) {
   if (cancel_ && cancel_->load(std::memory_order_relaxed)) return cancelledError();
   const int res = int(record.ndf_res);
   if (ndf_res_ == 0) {
-    if (res < 1 || res % options_.block != 0) {
-      return makeError(ErrorCode::kBadArgument, "--block " + std::to_string(options_.block) +
-                                                    " does not divide the NDF resolution " + std::to_string(res));
-    }
+    if (BakeStatus s = checkBlockDividesResolution(options_.block, res); !s) return s;
     ndf_res_ = res;
     blocks_per_side_ = res / options_.block;
   } else if (res != ndf_res_) {

@@ -55,6 +55,9 @@ struct RegionSummary {
 // every kept block its own group of rank B.
 bool isExactLevel(const format::NdfLevelRecord& record, const TensorPackOptions& options);
 
+// kBadArgument unless the block side divides the NDF resolution res (>= 1) of a level.
+BakeStatus checkBlockDividesResolution(int block, int res);
+
 class TensorRegionConsumer {
  public:
   virtual ~TensorRegionConsumer() = default;
