@@ -4,11 +4,15 @@
 // (beckmann, scratches, flakes); GLINTBAKE_BENCH_MAPS=a.png,b.png benchmarks real maps instead.
 // Queries cycle through 1024 precomputed random footprints and s-plane points drawn where the NDF
 // is not negligible (sampled from it), so that caches and branch predictors see varied queries.
+// GLINTBAKE_BENCH_ASSETS=a.gbk,b.gbk adds `asset_eval` and `asset_sample`: the same queries through
+// baked NDF assets (openNdfAsset: flakes, lobes, pyramid and the blends between them) at footprints
+// from 1 texel to past the pyramid's hand-over, so that every path and band of an asset is timed.
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
+#include <glintbake/runtime/ndf_source.h>
 
 #include <benchmark/benchmark.h>
 
@@ -84,22 +88,72 @@ struct Query {
   double u1, u2;
 };
 
-std::vector<Query> queries(const Subject& subject, double sigma) {
+std::vector<Query> queries(const rt::NdfSource& source, int width, int height, double sigma) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Query> q(1024);
   for (Query& x : q) {
-    x.fp = {u(rng) * subject.map.width, u(rng) * subject.map.height, sigma};
+    x.fp = {u(rng) * width, u(rng) * height, sigma};
     rt::NdfSample smp;
     // A point where the NDF is not negligible: a sample of it (retry the rare rejected tail).
+    int tries = 0;
     do {
-      subject.ndf.sample(x.fp, u(rng), u(rng), &smp);
+      if (++tries > 1000) std::abort();  // an NDF that never yields a sample: no benchmark
+      source.sample(x.fp, u(rng), u(rng), &smp);
     } while (!(smp.pdf > 0.0));
     x.s = smp.s;
     x.u1 = u(rng);
     x.u2 = u(rng);
   }
   return q;
+}
+std::vector<Query> queries(const Subject& subject, double sigma) {
+  return queries(subject.ndf, subject.map.width, subject.map.height, sigma);
+}
+
+// The baked assets of GLINTBAKE_BENCH_ASSETS.
+struct AssetSubject {
+  std::string name;
+  std::unique_ptr<rt::NdfSource> source;
+};
+std::vector<AssetSubject>& assets() {
+  static std::vector<AssetSubject> all = [] {
+    std::vector<AssetSubject> v;
+    const char* env = std::getenv("GLINTBAKE_BENCH_ASSETS");
+    if (!env || !*env) return v;
+    std::stringstream list(env);
+    std::string path;
+    while (std::getline(list, path, ',')) {
+      AssetSubject a;
+      if (rt::openNdfAsset(path.c_str(), &a.source) != rt::RuntimeStatus::kOk) {
+        std::fprintf(stderr, "bench_flakes: cannot open %s\n", path.c_str());
+        std::abort();
+      }
+      a.name = path.substr(path.find_last_of('/') + 1);
+      v.push_back(std::move(a));
+    }
+    return v;
+  }();
+  return all;
+}
+
+void assetBench(benchmark::State& state, size_t index, double sigma, bool sample) {
+  const rt::NdfSource& src = *assets()[index].source;
+  const rt::MapSize size = src.mapSize();
+  const std::vector<Query> q = queries(src, int(size.width), int(size.height), sigma);
+  size_t i = 0;
+  for (auto _ : state) {
+    if (sample) {
+      rt::NdfSample smp;
+      src.sample(q[i].fp, q[i].u1, q[i].u2, &smp);
+      benchmark::DoNotOptimize(smp);
+    } else {
+      double v;
+      src.eval(q[i].fp, q[i].s, &v);
+      benchmark::DoNotOptimize(v);
+    }
+    i = (i + 1) & 1023;
+  }
 }
 
 // Point eval and sample of one of a subject's evaluators (the exact flakes or the clustered lobes).
@@ -162,6 +216,15 @@ const int registered = [] {
     }
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
         ->Unit(benchmark::kMicrosecond);
+  }
+  for (size_t k = 0; k < assets().size(); ++k) {
+    for (double sigma : {1.0, 4.0, 5.0, 8.0, 12.0, 16.0, 20.0, 22.0, 24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 128.0}) {
+      const std::string tag = assets()[k].name + "/sigma:" + std::to_string(int(sigma));
+      benchmark::RegisterBenchmark(("asset_eval/" + tag).c_str(), assetBench, k, sigma, false)
+          ->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("asset_sample/" + tag).c_str(), assetBench, k, sigma, true)
+          ->Unit(benchmark::kMicrosecond);
+    }
   }
   return 0;
 }();

@@ -14,12 +14,25 @@ struct FlakeNdfAccess {
   // exponent cutoff and kernels.
   static RuntimeStatus windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s, double window_sigmas,
                                     double* value);
+  // FlakeNdf::eval (value) and windowedEval with inner_window_sigmas (<= 6; inner) from one
+  // traversal: the inner window's flakes are a subset of the full one's with the same lane values,
+  // so inner equals windowedEval up to the order of the summation.
+  static RuntimeStatus evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
+                                           double inner_window_sigmas, double* value, double* inner);
   // The sum of the footprint weights of the flakes in that disk (the integral of windowedEval).
   static RuntimeStatus windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value);
   // A flake of that disk in proportion to its weight (u1 picks its row, u2 the flake in the row;
   // mass from windowedMass) and its lobe; v1, v2 are u1, u2 rescaled within the picked intervals.
   static RuntimeStatus windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1, double u2,
                                     double mass, flakes::Lobe* lobe, double* v1, double* v2);
+};
+
+class LobeNdf;
+struct LobeNdfAccess {
+  // Whether the lobes answer a footprint of this sigma from the exact flakes (their finest level
+  // keeps every flake as a lobe): then LobeNdf::eval is norm times FlakeNdfAccess::windowedEval
+  // with *window_sigmas, on flakes equal to the FlakeNdf built from the same source.
+  static bool exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm);
 };
 
 }  // namespace glintbake::runtime

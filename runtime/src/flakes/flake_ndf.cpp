@@ -131,6 +131,7 @@ struct LaneList {
   alignas(64) float spatial[kLaneList + 16];
   alignas(64) float num[kLaneList + 16];
   alignas(64) float det[kLaneList + 16];
+  alignas(64) float value[kLaneList + 16];  // the second pass's lane values
 };
 
 namespace sse {
@@ -215,7 +216,9 @@ struct FlakeNdf::Impl {
   // truncation disk (scalar paths: average, image).
   template <typename Visit>
   void forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms& t, Visit&& visit) const;
-  double evalAt(const FootprintTerms& t, double sx, double sy) const;
+  // The P-NDF at s. With inner non-null, also the sum over the flakes whose spatial exponent is
+  // below inner_cut alone (the eval of a narrower window, from the same lane values).
+  double evalAt(const FootprintTerms& t, double sx, double sy, float inner_cut = 0.0f, double* inner = nullptr) const;
   // The footprint weights exp(-d^2 / 2v) of the window's flake positions along one axis, in order,
   // passed to visit(index, weight) until it returns false (a recurrence of two products per
   // flake, refreshed by exp every kWeightRefresh flakes).
@@ -521,7 +524,7 @@ void FlakeNdf::Impl::forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms&
   }
 }
 
-double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) const {
+double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy, float inner_cut, double* inner) const {
   // Largest lobe variance and mean shift over a tile: C_k <= (sigma_r^2 + b |J|^2) I and
   // |mu_k - n_k| <= a |J| |u_Q - u_k|.
   auto tile = [&](const TileBound& bound, double dmax, double budget) {
@@ -572,6 +575,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
   LaneList list;
   int n = 0;
   double sums[4] = {0.0, 0.0, 0.0, 0.0};
+  double inner_sum = 0.0;
   auto drain = [&] {
     const int padded = (n + 15) & ~15;
     for (int i = n; i < padded; ++i) {
@@ -581,10 +585,14 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     }
     laneValues(wide, &list, padded, float(kMaxExponent));
     for (int i = 0; i < n; i += 4) {
-      sums[0] += double(list.spatial[i]);
-      sums[1] += double(list.spatial[i + 1]);
-      sums[2] += double(list.spatial[i + 2]);
-      sums[3] += double(list.spatial[i + 3]);
+      sums[0] += double(list.value[i]);
+      sums[1] += double(list.value[i + 1]);
+      sums[2] += double(list.value[i + 2]);
+      sums[3] += double(list.value[i + 3]);
+    }
+    if (inner) {
+      for (int i = 0; i < n; ++i)
+        if (list.spatial[i] < inner_cut) inner_sum += double(list.value[i]);
     }
     n = 0;
   };
@@ -593,6 +601,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy) con
     if (n > kLaneList - kLeafFlakes) drain();
   });
   drain();
+  if (inner) *inner = inner_sum * t.wnorm / kTwoPi;
   return ((sums[0] + sums[1]) + (sums[2] + sums[3])) * t.wnorm / kTwoPi;
 }
 
@@ -668,6 +677,21 @@ RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& f
   FootprintTerms t;
   if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   *value = flakes::inSquare(s) ? f.impl_->evalAt(t, s.x, s.y) : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus FlakeNdfAccess::evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
+                                                  double inner_window_sigmas, double* value, double* inner) {
+  if (!f.impl_ || !value || !inner || !validFootprint(fp) || !flakes::validPoint(s) ||
+      !(inner_window_sigmas > 0.0 && inner_window_sigmas <= kWindowSigmas))
+    return RuntimeStatus::kInvalidArgument;
+  FootprintTerms t;
+  if (!f.impl_->terms(fp, &t)) return RuntimeStatus::kInvalidArgument;
+  *value = *inner = 0.0;
+  // The lanes a window of inner_window_sigmas keeps: spatial exponent below its cut, as in
+  // windowedEval's kernel (float comparison).
+  const float inner_cut = float(inner_window_sigmas * inner_window_sigmas / 2);
+  if (flakes::inSquare(s)) *value = f.impl_->evalAt(t, s.x, s.y, inner_cut, inner);
   return RuntimeStatus::kOk;
 }
 

@@ -5,6 +5,7 @@
 #include "../format_status.h"
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
+#include "flake_access.h"
 
 #include <algorithm>
 #include <cmath>
@@ -106,6 +107,21 @@ RuntimeStatus HandoverNdf::blend(const Footprint& fp, double* value, Query&& que
 }
 
 RuntimeStatus HandoverNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  if (value && validFootprint(fp)) {
+    // Between the flakes and lobes that answer from the exact flakes in a narrower window, both
+    // sums come from one traversal of the flakes.
+    const Mix mix = mixFor(fp.sigma);
+    double window = 0.0, norm = 0.0;
+    if (mix.t > 0.0 && mix.t < 1.0 && mix.lower == paths_.flakes.get() && paths_.lobes &&
+        mix.upper == paths_.lobes.get() && LobeNdfAccess::exactWindow(*paths_.lobes, fp.sigma, &window, &norm)) {
+      double full = 0.0, inner = 0.0;
+      if (RuntimeStatus st = FlakeNdfAccess::evalWithInnerWindow(*paths_.flakes, fp, s, window, &full, &inner);
+          st != RuntimeStatus::kOk)
+        return st;
+      *value = (1.0 - mix.t) * full + mix.t * (norm * inner);
+      return RuntimeStatus::kOk;
+    }
+  }
   return blend(fp, value, [&](const NdfSource& src, double* v) { return src.eval(fp, s, v); });
 }
 

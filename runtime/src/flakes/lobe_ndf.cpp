@@ -663,6 +663,14 @@ RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double*
   return RuntimeStatus::kOk;
 }
 
+bool LobeNdfAccess::exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm) {
+  const LobeNdf::Impl* m = lobes.impl_.get();
+  if (!m || !m->exact.isBuilt() || !(sigma >= 0.0) || m->levelFor(sigma) != 0) return false;
+  *window_sigmas = kWindowSigmas;
+  *norm = kWindowNorm;
+  return true;
+}
+
 RuntimeStatus LobeNdf::mass(const Footprint& footprint, double* value) const {
   if (!impl_ || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
   Terms t;

@@ -7,6 +7,8 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
 #include <glintbake/reference/pndf.h>
+#include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/lobe_ndf.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 
@@ -39,9 +41,9 @@ std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes
   EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
   if (with_flakes) {
-    EXPECT_TRUE(
-        bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r, bake::ndf::defaultHandover(o.sigma0, lobes), nullptr)
-            .ok());
+    EXPECT_TRUE(bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r,
+                                              bake::ndf::defaultHandover(o.sigma0, lobes), nullptr)
+                    .ok());
   }
   EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
   EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
@@ -144,6 +146,45 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
       EXPECT_NEAR(pdf * m, e, 1e-12 * e);
     }
   }
+}
+
+// Between the flakes and the lobes that answer from the exact flakes in their narrower window, the
+// asset evaluates both from one traversal: the blend of the two paths evaluated apart, at points
+// where the NDF matters and anywhere, near the map's edges too (periodic windows).
+TEST(Handover, FlakesToLobesBandIsTheBlendOfBothPaths) {
+  const bake::NormalMap map = beckmann(32, 9);
+  std::unique_ptr<runtime::NdfSource> asset;
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "band.gbk", true, 16).c_str(), &asset), RuntimeStatus::kOk);
+  const runtime::InterleavedTexels texels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(),
+                                          3);
+  runtime::FlakeNdf flakes;
+  runtime::LobeNdf lobes;
+  ASSERT_EQ(flakes.build(texels, 1, 0.005, 32), RuntimeStatus::kOk);
+  ASSERT_EQ(lobes.build(texels, 1, 0.005, 16, 32), RuntimeStatus::kOk);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int compared = 0;
+  for (double sigma : {4.2, 4.7, 5.4}) {
+    const double t = std::log(sigma / 4.0) / std::log(std::sqrt(2.0));
+    for (int i = 0; i < 120; ++i) {
+      const Footprint fp{i % 3 == 0 ? 0.3 : u(rng) * 32.0, i % 5 == 0 ? 31.8 : u(rng) * 32.0, sigma};
+      SPoint s{u(rng) * 1.2 - 0.6, u(rng) * 1.2 - 0.6};
+      if (i % 2 == 0) {
+        runtime::NdfSample smp;
+        ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
+        s = smp.s;
+      }
+      double v = -1.0, f = -1.0, l = -1.0;
+      ASSERT_EQ(asset->eval(fp, s, &v), RuntimeStatus::kOk);
+      ASSERT_EQ(flakes.eval(fp, s, &f), RuntimeStatus::kOk);
+      ASSERT_EQ(lobes.eval(fp, s, &l), RuntimeStatus::kOk);
+      const double expected = (1.0 - t) * f + t * l;
+      EXPECT_NEAR(v, expected, 1e-12 * expected + 1e-300)
+          << "sigma " << sigma << " at (" << fp.x << ", " << fp.y << ")";
+      compared += expected > 1e-3;
+    }
+  }
+  EXPECT_GT(compared, 150);  // most of them where the NDF is not negligible
 }
 
 // Where a compressed pyramid takes over from the lobes: above its first level from which every

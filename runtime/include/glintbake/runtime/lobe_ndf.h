@@ -86,6 +86,7 @@ class LobeNdf final : public AccumulatingNdfSource {
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
 
  private:
+  friend struct LobeNdfAccess;  // the runtime's hand-over (internal)
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
