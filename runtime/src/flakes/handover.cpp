@@ -133,8 +133,18 @@ RuntimeStatus HandoverNdf::mass(const Footprint& fp, double* value) const {
   return blend(fp, value, [&](const NdfSource& src, double* v) { return src.mass(fp, v); });
 }
 
+const NdfSource* HandoverNdf::onlyPath(const Mix& mix) {
+  if (mix.t <= 0.0) return mix.lower;
+  if (mix.t >= 1.0) return mix.upper;
+  return nullptr;
+}
+
 RuntimeStatus HandoverNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
   if (!value) return RuntimeStatus::kInvalidArgument;
+  // One path: its own pdf (its eval over its mass, the density its sample reports).
+  if (validFootprint(fp)) {
+    if (const NdfSource* only = onlyPath(mixFor(fp.sigma))) return only->pdf(fp, s, value);
+  }
   double e = 0.0, m = 0.0;
   if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
   if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
@@ -146,26 +156,29 @@ RuntimeStatus HandoverNdf::sample(const Footprint& fp, double u1, double u2, Ndf
   if (!out || !validFootprint(fp) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
   const Mix mix = mixFor(fp.sigma);
+  // One path: its sample and density, which are pdf()'s.
+  if (const NdfSource* only = onlyPath(mix)) return only->sample(fp, u1, u2, out);
+  // A path in proportion to its weighted mass, u1 rescaled within the choice.
+  double ma = 0.0, mb = 0.0;
+  if (RuntimeStatus s = mix.lower->mass(fp, &ma); s != RuntimeStatus::kOk) return s;
+  if (RuntimeStatus s = mix.upper->mass(fp, &mb); s != RuntimeStatus::kOk) return s;
+  const double wa = (1.0 - mix.t) * ma, wb = mix.t * mb;
+  if (!(wa + wb > 0.0)) return RuntimeStatus::kInvalidArgument;
+  const double x = u1 * (wa + wb);
+  const bool first = x < wa;
+  const double v = first ? x / wa : (x - wa) / wb;
+  const double u = std::fmin(std::fmax(v, 0.0), 0.99999999999999989);
+  const NdfSource& src = first ? static_cast<const NdfSource&>(*mix.lower) : *mix.upper;
   NdfSample picked;
-  if (mix.t <= 0.0 || mix.t >= 1.0) {
-    const NdfSource& src = mix.t <= 0.0 ? static_cast<const NdfSource&>(*mix.lower) : *mix.upper;
-    if (RuntimeStatus s = src.sample(fp, u1, u2, &picked); s != RuntimeStatus::kOk) return s;
-  } else {
-    // A path in proportion to its weighted mass, u1 rescaled within the choice.
-    double ma = 0.0, mb = 0.0;
-    if (RuntimeStatus s = mix.lower->mass(fp, &ma); s != RuntimeStatus::kOk) return s;
-    if (RuntimeStatus s = mix.upper->mass(fp, &mb); s != RuntimeStatus::kOk) return s;
-    const double wa = (1.0 - mix.t) * ma, wb = mix.t * mb;
-    if (!(wa + wb > 0.0)) return RuntimeStatus::kInvalidArgument;
-    const double x = u1 * (wa + wb);
-    const bool first = x < wa;
-    const double v = first ? x / wa : (x - wa) / wb;
-    const double u = std::fmin(std::fmax(v, 0.0), 0.99999999999999989);
-    const NdfSource& src = first ? static_cast<const NdfSource&>(*mix.lower) : *mix.upper;
-    if (RuntimeStatus s = src.sample(fp, u, u2, &picked); s != RuntimeStatus::kOk) return s;
-  }
+  if (RuntimeStatus s = src.sample(fp, u, u2, &picked); s != RuntimeStatus::kOk) return s;
+  // pdf(): the blended eval over the blended mass, the latter from the masses above (mass()'s
+  // expression, so the same bits).
+  double e = 0.0;
+  if (RuntimeStatus s = eval(fp, picked.s, &e); s != RuntimeStatus::kOk) return s;
+  const double m = (1.0 - mix.t) * ma + mix.t * mb;
   out->s = picked.s;
-  return pdf(fp, picked.s, &out->pdf);
+  out->pdf = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
 }
 
 RuntimeStatus HandoverNdf::image(const Footprint& fp, float* out, size_t out_count) const {

@@ -62,6 +62,8 @@ class HandoverNdf final : public NdfSource {
     double t;
   };
   Mix mixFor(double sigma) const;
+  // The path that answers alone (t = 0 or 1), or null inside a band.
+  static const NdfSource* onlyPath(const Mix& mix);
   template <typename Query>
   RuntimeStatus blend(const Footprint& footprint, double* value, Query&& query) const;
 
