@@ -41,7 +41,9 @@ RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resoluti
   RuntimeStatus built = p.flakes->build(texels, int(rec.rate), rec.sigma_r, resolution);
   if (built == RuntimeStatus::kOk && format::hasLobes(rec)) {
     p.lobes.reset(new (std::nothrow) LobeNdf());
-    built = p.lobes ? p.lobes->build(texels, int(rec.rate), rec.sigma_r, int(rec.lobes_per_tile), resolution)
+    // The lobes answer their finest level from these flakes (FlakePaths destroys the lobes first).
+    built = p.lobes ? LobeNdfAccess::build(*p.lobes, texels, int(rec.rate), rec.sigma_r, int(rec.lobes_per_tile),
+                                           resolution, p.flakes.get())
                     : RuntimeStatus::kOutOfMemory;
   }
   if (built == RuntimeStatus::kInvalidArgument) return RuntimeStatus::kInvalidAsset;  // non-finite normals

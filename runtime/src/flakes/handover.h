@@ -25,7 +25,9 @@ namespace glintbake::runtime {
 // The evaluators of a flakes section.
 struct FlakePaths {
   std::unique_ptr<FlakeNdf> flakes;
-  std::unique_ptr<LobeNdf> lobes;  // null when the record has no clustered path
+  // Null when the record has no clustered path; its finest level uses `flakes` (declared after
+  // them, so destroyed first).
+  std::unique_ptr<LobeNdf> lobes;
   format::FlakesRecord record;
 };
 

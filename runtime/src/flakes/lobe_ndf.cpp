@@ -244,10 +244,13 @@ struct LobeNdf::Impl {
   Array<Block> blocks;
   Array<Bound> bounds;
   // With every flake its own lobe on level 0 (lobes == kLanes), that level's eval is the exact
-  // flakes' with the lobes' window: answered by their evaluator, which prunes by normal.
-  FlakeNdf exact;
+  // flakes' with the lobes' window: answered by their evaluator, which prunes by normal. exact is
+  // own_exact, or the FlakeNdf of the same source that an asset's hand-over shares (build's shared).
+  FlakeNdf own_exact;
+  const FlakeNdf* exact = nullptr;
 
-  RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in);
+  RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in,
+                      const FlakeNdf* shared);
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
   void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
@@ -270,7 +273,8 @@ struct LobeNdf::Impl {
   double massOf(const Terms& t) const;
 };
 
-RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in) {
+RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in,
+                                   const FlakeNdf* shared) {
   width = src.width();
   height = src.height();
   if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) return RuntimeStatus::kInvalidArgument;
@@ -353,8 +357,13 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
     }
   }
   if (lobes == kLanes) {
-    InterleavedTexels texels(width, height, repeat, normals.data, 2);
-    if (RuntimeStatus st = exact.build(texels, rate, sigma_r, res); st != RuntimeStatus::kOk) return st;
+    if (shared) {
+      exact = shared;
+    } else {
+      InterleavedTexels texels(width, height, repeat, normals.data, 2);
+      if (RuntimeStatus st = own_exact.build(texels, rate, sigma_r, res); st != RuntimeStatus::kOk) return st;
+      exact = &own_exact;
+    }
   }
   return RuntimeStatus::kOk;
 }
@@ -554,9 +563,9 @@ double LobeNdf::Impl::laneWeights(const Block& b, const Bound& bound, double bx,
 }
 
 double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
-  if (t.level == &levels[0] && exact.isBuilt()) {
+  if (t.level == &levels[0] && exact) {
     double v = 0.0;
-    FlakeNdfAccess::windowedEval(exact, {t.ux, t.uy, t.sigma}, {sx, sy}, kWindowSigmas, &v);
+    FlakeNdfAccess::windowedEval(*exact, {t.ux, t.uy, t.sigma}, {sx, sy}, kWindowSigmas, &v);
     return v * kWindowNorm;
   }
   // The kernel (lobe_kernel.inc) on the tiles whose lobes may reach s; the lanes kept by its
@@ -605,9 +614,9 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
-  if (t.level == &levels[0] && exact.isBuilt()) {
+  if (t.level == &levels[0] && exact) {
     double m = 0.0;
-    FlakeNdfAccess::windowedMass(exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, &m);
+    FlakeNdfAccess::windowedMass(*exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, &m);
     return m * kWindowNorm;
   }
   double sum = 0.0;
@@ -622,12 +631,18 @@ LobeNdf::LobeNdf() = default;
 LobeNdf::~LobeNdf() = default;
 
 RuntimeStatus LobeNdf::build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution) {
-  impl_.reset();
-  auto impl = std::unique_ptr<Impl>(new (std::nothrow) Impl());
+  return LobeNdfAccess::build(*this, source, rate, sigma_r, lobes_per_tile, resolution, nullptr);
+}
+
+RuntimeStatus LobeNdfAccess::build(LobeNdf& lobes, const TexelSource& source, int rate, double sigma_r,
+                                   int lobes_per_tile, int resolution, const FlakeNdf* shared) {
+  lobes.impl_.reset();
+  if (shared && !shared->isBuilt()) return RuntimeStatus::kInvalidArgument;
+  auto impl = std::unique_ptr<LobeNdf::Impl>(new (std::nothrow) LobeNdf::Impl());
   if (!impl) return RuntimeStatus::kOutOfMemory;
-  if (RuntimeStatus s = impl->build(source, rate, sigma_r, lobes_per_tile, resolution); s != RuntimeStatus::kOk)
+  if (RuntimeStatus s = impl->build(source, rate, sigma_r, lobes_per_tile, resolution, shared); s != RuntimeStatus::kOk)
     return s;
-  impl_ = std::move(impl);
+  lobes.impl_ = std::move(impl);
   return RuntimeStatus::kOk;
 }
 
@@ -665,7 +680,7 @@ RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double*
 
 bool LobeNdfAccess::exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm) {
   const LobeNdf::Impl* m = lobes.impl_.get();
-  if (!m || !m->exact.isBuilt() || !(sigma >= 0.0) || m->levelFor(sigma) != 0) return false;
+  if (!m || !m->exact || !(sigma >= 0.0) || m->levelFor(sigma) != 0) return false;
   *window_sigmas = kWindowSigmas;
   *norm = kWindowNorm;
   return true;
@@ -743,10 +758,10 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
     out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
     return RuntimeStatus::kOk;
   };
-  if (t.level == &m.levels[0] && m.exact.isBuilt()) {  // a flake of the window by its weight
+  if (t.level == &m.levels[0] && m.exact) {  // a flake of the window by its weight
     flakes::Lobe g;
     double v1 = 0.5, v2 = 0.5;
-    if (FlakeNdfAccess::windowedPick(m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
+    if (FlakeNdfAccess::windowedPick(*m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
                                      &v1, &v2) != RuntimeStatus::kOk)
       return RuntimeStatus::kInvalidArgument;
     return finish(g, v1, v2);
