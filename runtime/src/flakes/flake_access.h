@@ -19,6 +19,10 @@ struct FlakeNdfAccess {
   // so inner equals windowedEval up to the order of the summation.
   static RuntimeStatus evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
                                            double inner_window_sigmas, double* value, double* inner);
+  // FlakeNdf::sample; without with_pdf the density is not evaluated (out->pdf = 0), for callers
+  // that evaluate their own.
+  static RuntimeStatus sample(const FlakeNdf& f, const Footprint& fp, double u1, double u2, NdfSample* out,
+                              bool with_pdf);
   // The sum of the footprint weights of the flakes in that disk (the integral of windowedEval).
   static RuntimeStatus windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value);
   // A flake of that disk in proportion to its weight (u1 picks its row, u2 the flake in the row;
@@ -36,6 +40,9 @@ struct LobeNdfAccess {
   // LobeNdf::build, with the exact flakes of its finest level taken from `shared` (may be null:
   // built as by LobeNdf::build), a built FlakeNdf of the same source, rate and sigma_r that
   // outlives the lobes; kInvalidArgument when it is not built.
+  // LobeNdf::sample, with or without the density (as FlakeNdfAccess::sample).
+  static RuntimeStatus sample(const LobeNdf& lobes, const Footprint& fp, double u1, double u2, NdfSample* out,
+                              bool with_pdf);
   static RuntimeStatus build(LobeNdf& lobes, const TexelSource& source, int rate, double sigma_r, int lobes_per_tile,
                              int resolution, const FlakeNdf* shared);
 };

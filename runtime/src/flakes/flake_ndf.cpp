@@ -877,9 +877,14 @@ RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, floa
 }
 
 RuntimeStatus FlakeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
-  if (!impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+  return FlakeNdfAccess::sample(*this, footprint, u1, u2, out, true);
+}
+
+RuntimeStatus FlakeNdfAccess::sample(const FlakeNdf& ndf, const Footprint& footprint, double u1, double u2,
+                                     NdfSample* out, bool with_pdf) {
+  if (!ndf.impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
-  const Impl& m = *impl_;
+  const FlakeNdf::Impl& m = *ndf.impl_;
   FootprintTerms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double sum_x = m.weightSum(t, true), sum_y = m.weightSum(t, false);
@@ -915,7 +920,7 @@ RuntimeStatus FlakeNdf::sample(const Footprint& footprint, double u1, double u2,
   const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11, l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
   out->s.x = g.mx + l11 * z0;
   out->s.y = g.my + l21 * z0 + l22 * z1;
-  out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
+  out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
   return RuntimeStatus::kOk;
 }
 

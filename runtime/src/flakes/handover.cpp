@@ -171,8 +171,16 @@ RuntimeStatus HandoverNdf::sample(const Footprint& fp, double u1, double u2, Ndf
   const double v = first ? x / wa : (x - wa) / wb;
   const double u = std::fmin(std::fmax(v, 0.0), 0.99999999999999989);
   const NdfSource& src = first ? static_cast<const NdfSource&>(*mix.lower) : *mix.upper;
+  // The flakes and lobes draw the point without their own density (the blend's is needed).
   NdfSample picked;
-  if (RuntimeStatus s = src.sample(fp, u, u2, &picked); s != RuntimeStatus::kOk) return s;
+  RuntimeStatus drawn;
+  if (&src == paths_.flakes.get())
+    drawn = FlakeNdfAccess::sample(*paths_.flakes, fp, u, u2, &picked, false);
+  else if (paths_.lobes && &src == paths_.lobes.get())
+    drawn = LobeNdfAccess::sample(*paths_.lobes, fp, u, u2, &picked, false);
+  else
+    drawn = src.sample(fp, u, u2, &picked);
+  if (drawn != RuntimeStatus::kOk) return drawn;
   // pdf(): the blended eval over the blended mass, the latter from the masses above (mass()'s
   // expression, so the same bits).
   double e = 0.0;

@@ -741,9 +741,14 @@ RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float
 }
 
 RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
-  if (!impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+  return LobeNdfAccess::sample(*this, footprint, u1, u2, out, true);
+}
+
+RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footprint, double u1, double u2,
+                                    NdfSample* out, bool with_pdf) {
+  if (!lobes.impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
-  const Impl& m = *impl_;
+  const LobeNdf::Impl& m = *lobes.impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double total = m.massOf(t);
@@ -755,7 +760,7 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
     const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
     out->s.x = g.mx + l11 * z0;
     out->s.y = g.my + l21 * z0 + l22 * z1;
-    out->pdf = inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
+    out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
     return RuntimeStatus::kOk;
   };
   if (t.level == &m.levels[0] && m.exact) {  // a flake of the window by its weight
