@@ -127,9 +127,9 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
   ASSERT_EQ(asset->eval({13.2, 7.7, 9.0}, s, &a), RuntimeStatus::kOk);
   ASSERT_EQ(pyramid->eval({13.2, 7.7, 9.0}, s, &b), RuntimeStatus::kOk);
   EXPECT_EQ(a, b);
-  // Both bands (flakes to lobes, lobes to pyramid): sample, pdf, eval and mass agree, and the
-  // mass of the blend stays that of a footprint inside the map.
-  for (double sigma : {4.7, 6.8}) {
+  // Both bands (flakes to lobes, lobes to pyramid) and the flakes and the pyramid alone: sample,
+  // pdf, eval and mass agree, and the mass stays that of a footprint inside the map.
+  for (double sigma : {2.0, 4.7, 6.8, 9.0}) {
     const Footprint fp{13.2, 7.7, sigma};
     double m = 0.0;
     ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
