@@ -37,12 +37,12 @@ struct LobeNdfAccess {
   // keeps every flake as a lobe): then LobeNdf::eval is norm times FlakeNdfAccess::windowedEval
   // with *window_sigmas, on flakes equal to the FlakeNdf built from the same source.
   static bool exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm);
-  // LobeNdf::build, with the exact flakes of its finest level taken from `shared` (may be null:
-  // built as by LobeNdf::build), a built FlakeNdf of the same source, rate and sigma_r that
-  // outlives the lobes; kInvalidArgument when it is not built.
   // LobeNdf::sample, with or without the density (as FlakeNdfAccess::sample).
   static RuntimeStatus sample(const LobeNdf& lobes, const Footprint& fp, double u1, double u2, NdfSample* out,
                               bool with_pdf);
+  // LobeNdf::build, with the exact flakes of its finest level taken from `shared` (may be null:
+  // the lobes build their own), a built FlakeNdf of the same source, rate and sigma_r that
+  // outlives the lobes; kInvalidArgument when it is not built.
   static RuntimeStatus build(LobeNdf& lobes, const TexelSource& source, int rate, double sigma_r, int lobes_per_tile,
                              int resolution, const FlakeNdf* shared);
 };
