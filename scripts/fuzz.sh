@@ -43,7 +43,10 @@ for target in "${targets[@]}"; do
     extra=(-detect_leaks=0)
     runner=(env ASAN_OPTIONS=detect_leaks=0)
   else
-    cp tests/format/*.gbk "$corpus"/
+    # The frozen files of every kind, and two assets with a flakes section and lobes (4 x 4 map,
+    # R 8), which the frozen files lack (tests/fuzz/assets/: `ndfgen tests/fuzz/images/rgb8.png
+    # --ndf-res 8` and `tensorpack --rank 4 --ndf-res 8 --block 4` on the same map).
+    cp tests/format/*.gbk tests/fuzz/assets/*.gbk "$corpus"/
   fi
   log=build-fuzz/$target.log
   if ! "${runner[@]}" build-fuzz/bin/$target "$corpus" -max_total_time="$run_seconds" -rss_limit_mb=2048 -timeout=10 \
