@@ -153,7 +153,7 @@ BakeStatus TensorAssembler::group(const GroupStats& g, const uint8_t* raw, size_
   if (!in_region_ || region_groups_seen_ >= region_.group_count) return invalid(where + ": more groups than announced");
   if (g.blocks != region_rows_[size_t(region_groups_seen_)] || g.rank < 1 || g.rank > int(format::kTensorMaxRank) ||
       !std::isfinite(g.error_squared) || !std::isfinite(g.norm_squared) || !std::isfinite(g.negative_mass) ||
-      !std::isfinite(g.absolute_mass))
+      !std::isfinite(g.absolute_mass) || !std::isfinite(g.error_l1) || !std::isfinite(g.data_l1))
     return invalid(where + ": a group disagrees with the region's index");
   const uint64_t expected = format::tensorGroupSectionBytes(uint64_t(options_.block), uint64_t(g.rank),
                                                             uint64_t(g.blocks), uint32_t(options_.precision));
@@ -173,6 +173,8 @@ BakeStatus TensorAssembler::group(const GroupStats& g, const uint8_t* raw, size_
   TensorPackLevelReport& lrep = report_.levels.back();
   lrep.error_squared += g.error_squared;
   lrep.norm_squared += g.norm_squared;
+  lrep.error_l1 += g.error_l1;
+  lrep.data_l1 += g.data_l1;
   ++lrep.groups;
   report_.cp_seconds += g.seconds;
   report_.negative_mass_fraction += g.negative_mass;  // normalised in finish()
@@ -214,6 +216,12 @@ BakeStatus TensorAssembler::endLevel() {
   }
   const double spread_squared = std::max(lrep.norm_squared - mean_squared, 0.0);
   lrep.variation = lrep.norm_squared > 0.0 ? std::sqrt(spread_squared / lrep.norm_squared) : 0.0;
+  // NDF images are non-negative, so the level's sum |D| is the sum of its summed image; the
+  // dropped blocks' error is their mass, what the kept ones do not hold.
+  double mass = 0.0;
+  for (double v : level_sum_) mass += v;
+  const double dropped_mass = std::max(mass - lrep.data_l1, 0.0);
+  lrep.l1_error = mass > 0.0 ? (lrep.error_l1 + dropped_mass) / mass : 0.0;
   std::vector<double>().swap(level_sum_);
   std::vector<format::TensorIndexEntry>().swap(index_);
   return okStatus();

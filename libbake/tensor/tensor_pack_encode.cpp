@@ -165,6 +165,8 @@ Result<EncodedGroup> encodeGroup(const GroupTensor& tensor, CpFactors& f, int le
         const double data = tensor.at(k, i, j);
         g.error_squared += (data - model) * (data - model);
         g.norm_squared += data * data;
+        g.error_l1 += std::abs(data - model);
+        g.data_l1 += std::abs(data);
         g.absolute_mass += std::abs(model);
         if (model < 0.0) g.negative_mass -= model;
       }

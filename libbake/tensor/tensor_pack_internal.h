@@ -28,6 +28,8 @@ struct EncodedGroup {
   double norm_squared = 0.0;   // |T|_F^2
   double negative_mass = 0.0;  // sum of max(0, -model) over the group's bins
   double absolute_mass = 0.0;  // sum of |model|
+  double error_l1 = 0.0;       // sum of |T - stored model|
+  double data_l1 = 0.0;        // sum of |T|
   double seconds = 0.0;        // time of decomposition and encoding
 };
 

@@ -206,6 +206,8 @@ BakeStatus TensorPackSink::writeFront() {
     stats.norm_squared = g.norm_squared;
     stats.negative_mass = g.negative_mass;
     stats.absolute_mass = g.absolute_mass;
+    stats.error_l1 = g.error_l1;
+    stats.data_l1 = g.data_l1;
     stats.seconds = g.seconds;
     return consumer_.group(stats, g.section.data(), g.section.size(), nullptr, 0, format::Codec::kRaw);
   };

@@ -73,6 +73,8 @@ BakeStatus TensorShardRecorder::group(const GroupStats& g, const uint8_t* raw, s
   gr.norm_squared = g.norm_squared;
   gr.negative_mass = g.negative_mass;
   gr.absolute_mass = g.absolute_mass;
+  gr.error_l1 = g.error_l1;
+  gr.data_l1 = g.data_l1;
   try {
     if (raw) {
       format::Codec used = format::Codec::kRaw;
@@ -151,6 +153,8 @@ BakeStatus replayTensorRegion(const uint8_t* data, size_t size, TensorRegionCons
     stats.norm_squared = gr.norm_squared;
     stats.negative_mass = gr.negative_mass;
     stats.absolute_mass = gr.absolute_mass;
+    stats.error_l1 = gr.error_l1;
+    stats.data_l1 = gr.data_l1;
     if (BakeStatus st = consumer.group(stats, nullptr, size_t(gr.raw_size), data + at, size_t(gr.stored_size),
                                        format::Codec(gr.codec));
         !st)

@@ -78,6 +78,7 @@ Json levelJson(const tensor::TensorPackLevelReport& l) {
   j["stored_bytes"] = l.stored_bytes;
   j["relative_error"] = l.relative_error;
   j["variation"] = l.variation;
+  j["l1_error"] = l.l1_error;
   j["exact"] = l.exact;
   return j;
 }

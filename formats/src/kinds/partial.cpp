@@ -24,7 +24,7 @@ const char* checkTensorShardRegion(const uint8_t* data, size_t size, TensorShard
   TensorShardRegionRecord r;
   if (!data || size < sizeof(r)) return "shard-unit: truncated region record";
   std::memcpy(&r, data, sizeof(r));
-  if (r.magic != TensorShardRegionRecord().magic || r.version != 1 || r.reserved != 0)
+  if (r.magic != TensorShardRegionRecord().magic || r.version != TensorShardRegionRecord().version || r.reserved != 0)
     return "shard-unit: bad region record";
   if (r.ndf_res < 2 || r.ndf_res > kMaxNdfResolution || r.blocks_per_side < 1 || r.ndf_res % r.blocks_per_side != 0)
     return "shard-unit: NDF resolution or blocks out of range";

@@ -221,6 +221,22 @@ double decodedError(const Decoded& d, const CaptureSink& ref) {
   return std::sqrt(err / norm);
 }
 
+// sum |D - decoded| / sum |D| over the images of level l (dropped blocks decode to 0).
+double decodedL1Error(const Decoded& d, const CaptureSink& ref, size_t l) {
+  double err = 0.0, mass = 0.0;
+  const size_t image = size_t(d.info.ndf_res) * d.info.ndf_res;
+  const size_t centres = ref.levels[l].images.size() / image;
+  for (size_t c = 0; c < centres; ++c) {
+    const std::vector<float> rec = d.image(int(l), c);
+    for (size_t n = 0; n < image; ++n) {
+      const double x = ref.levels[l].images[c * image + n];
+      err += std::abs(x - rec[n]);
+      mass += std::abs(x);
+    }
+  }
+  return err / mass;
+}
+
 BakeStatus packFromMap(const NormalMap& map, const TensorPackOptions& o, const std::string& path,
                        TensorPackReport* report, const ndf::PyramidOptions& pyr = smallPyramid()) {
   format::Writer w;
@@ -531,6 +547,13 @@ TEST(TensorPack, IndexBlankBlocksAndPrefixSumsAreConsistent) {
   }
   const double err = decodedError(d, ref);
   EXPECT_NEAR(rep.relative_error, err, 1e-4 + 1e-3 * err);
+  // Each level's L1 error is that of its decoded images, the dropped blocks' mass included, and
+  // lies well above the Frobenius error on these sparse images (CP spreads mass over many bins).
+  for (size_t l = 0; l < d.levels.size(); ++l) {
+    const double l1 = decodedL1Error(d, ref, l);
+    EXPECT_NEAR(rep.levels[l].l1_error, l1, 1e-4 + 1e-3 * l1) << "level " << l;
+    EXPECT_GT(rep.levels[l].l1_error, rep.levels[l].relative_error) << "level " << l;
+  }
 }
 
 TEST(TensorPack, Float16FactorsHalveTheFactorBytesAtAboutTheSameError) {

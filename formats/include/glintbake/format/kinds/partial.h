@@ -57,7 +57,7 @@ const char* checkShardSectionHeader(const ShardSectionHeader& header, uint64_t s
 //               `codec`), in group order
 struct TensorShardRegionRecord {
   uint32_t magic = 0x52535447;  // "GTSR"
-  uint32_t version = 1;
+  uint32_t version = 2;  // 2: group records carry the L1 error (1: without it, refused)
   uint32_t level = 0, region = 0;
   uint32_t x0 = 0, y0 = 0, width = 0, height = 0;  // the region's centres on the level's grid
   uint32_t ndf_res = 0, blocks_per_side = 0;
@@ -74,8 +74,9 @@ struct TensorShardGroupRecord {
   uint64_t raw_size = 0, stored_size = 0;
   double error_squared = 0.0, norm_squared = 0.0;   // |T - stored model|_F^2, |T|_F^2
   double negative_mass = 0.0, absolute_mass = 0.0;  // sums of max(0, -model) and |model|
+  double error_l1 = 0.0, data_l1 = 0.0;             // sums of |T - stored model| and |T|
 };
-static_assert(sizeof(TensorShardGroupRecord) == 64, "TensorShardGroupRecord is 64 bytes");
+static_assert(sizeof(TensorShardGroupRecord) == 80, "TensorShardGroupRecord is 80 bytes");
 
 // Where the parts of a region's shard-unit lie (byte offsets into it).
 struct TensorShardRegionLayout {

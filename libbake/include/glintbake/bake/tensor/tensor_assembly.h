@@ -34,6 +34,8 @@ struct GroupStats {
   double norm_squared = 0.0;   // |T|_F^2
   double negative_mass = 0.0;  // sum of max(0, -model)
   double absolute_mass = 0.0;  // sum of |model|
+  double error_l1 = 0.0;       // sum of |T - stored model|
+  double data_l1 = 0.0;        // sum of |T|
   double seconds = 0.0;        // compression time (reported, never stored)
 };
 

@@ -97,6 +97,11 @@ struct TensorPackLevelReport {
   double relative_error = 0.0;  // |D - model|_F / |D|_F over every bin of the level (dropped blocks included)
   double error_squared = 0.0;   // |D - model|_F^2
   double norm_squared = 0.0;    // |D|_F^2
+  // sum |D - model| / sum |D| over every bin of the level (dropped blocks included): the mean
+  // relative L1 error of its NDF images, the measure the fidelity targets use. CP spreads a
+  // little mass over many bins, which the Frobenius error (dominated by the peaks) hardly sees.
+  double l1_error = 0.0;
+  double error_l1 = 0.0, data_l1 = 0.0;  // sum |D - model| over the kept blocks, and sum |D| over them
   // |D - mean image|_F / |D|_F: how far the level's images stand from their mean (what a single
   // smooth image per level would miss). A compression error well below it keeps the glints.
   double variation = 0.0;

@@ -56,6 +56,12 @@ Json tensorShardAssembly(const bake::tensor::TensorPackOptions& pack, const Tens
 void readTensorShardAssembly(const Json& assembly, bake::tensor::TensorPackOptions* pack, TensorAssetEnd* end,
                              bool* flakes);
 
+// The hand-over a compressed pyramid calls for: the pyramid answers from the first level from
+// which every level is faithful (stored exactly, or compressed within a Frobenius error of 0.15
+// and a quarter of the level's variation and within a mean L1 error of 0.06 of its images), the
+// clustered lobes below (bake::ndf::compressedHandover).
+bake::ndf::FlakesHandover tensorHandover(const bake::tensor::TensorPackReport& report, int lobes_per_tile);
+
 // The gated error and its one-line description (tensorpack's --json and messages).
 GatedError gatedError(const bake::tensor::TensorPackReport& report, const bake::ndf::FlakesHandover& handover);
 std::string achievedText(const bake::tensor::TensorPackReport& report, const GatedError& gated);
