@@ -38,7 +38,7 @@ constexpr double kFaithfulVariationShare = 0.25;
 // their compression error nearly whole, and the blend between centres adds its own. The Frobenius
 // bounds alone are blind to what CP does on maps of one dominant peak: on the curved-scratches map
 // of the demo data rank 16 keeps levels 0 and 1 at Frobenius 0.052 and 0.035 (a tenth of their
-// variation) while their images are 0.2-0.3 off in L1, and footprints of 16-40 texels were
+// variation) while their images are 0.40 and 0.30 off in L1, and footprints of 16-40 texels were
 // answered from them at 0.20-0.32.
 constexpr double kFaithfulL1Error = 0.06;
 

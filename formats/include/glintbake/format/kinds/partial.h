@@ -57,7 +57,7 @@ const char* checkShardSectionHeader(const ShardSectionHeader& header, uint64_t s
 //               `codec`), in group order
 struct TensorShardRegionRecord {
   uint32_t magic = 0x52535447;  // "GTSR"
-  uint32_t version = 2;  // 2: group records carry the L1 error (1: without it, refused)
+  uint32_t version = 2;         // 2: group records carry the L1 error (1: without it, refused)
   uint32_t level = 0, region = 0;
   uint32_t x0 = 0, y0 = 0, width = 0, height = 0;  // the region's centres on the level's grid
   uint32_t ndf_res = 0, blocks_per_side = 0;
