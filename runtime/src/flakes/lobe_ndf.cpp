@@ -12,11 +12,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 
 namespace glintbake::runtime {
 namespace {
+
+// The merge costs are the reduction's inner loop: inlined so that the processor overlaps them.
+#if defined(__GNUC__)
+#define GLINTBAKE_LOBE_INLINE inline __attribute__((always_inline))
+#else
+#define GLINTBAKE_LOBE_INLINE inline
+#endif
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
@@ -31,7 +39,6 @@ constexpr double kMaxSpatial = kWindowSigmas * kWindowSigmas / 2;
 const double kWindowNorm = 1.0 / (1.0 - std::exp(-kMaxSpatial));
 constexpr double kMaxExponent = 18.0;  // lobes below e^-18 of their peak at s are left out
 constexpr int kMaxWindowTiles = 40;    // tiles per side of a window at most
-constexpr int kLloydPasses = 4;
 constexpr int kMaxSide = 1 << 16;
 constexpr uint64_t kMaxFlakes = uint64_t(1) << 30;
 constexpr float kPaddingPosition = 1e15f;  // position of unused lanes: weight 0
@@ -103,75 +110,115 @@ Gauss4 momentMatch(const Gauss4* items, const int* idx, int n) {
   return g;
 }
 
-// Where k-means places a lobe: its normal mean and its spread (the std of its normals), so that
-// narrow and wide lobes of the same mean (the inside of a flake and its edges) stay apart.
-struct Feature {
-  double v[3];
-};
-Feature featureOf(const Gauss4& a) { return {{a.m[0], a.m[1], std::sqrt(std::max(a.ss[0] + a.ss[2], 0.0))}}; }
-double distance2(const Feature& a, const double* c) {
-  const double dx = a.v[0] - c[0], dy = a.v[1] - c[1], dz = a.v[2] - c[2];
-  return dx * dx + dy * dy + dz * dz;
+// ln x for x > 0, to about 1e-11 relative: the exponent from the bits, then the atanh series of
+// the mantissa in [sqrt(1/2), sqrt(2)). Pure double arithmetic, so it gives the same bits on every
+// machine; the reduction below calls it a few thousand times per tile.
+GLINTBAKE_LOBE_INLINE double fastLog(double x) {
+  if (!(x >= std::numeric_limits<double>::min())) return std::log(std::max(x, 1e-300));  // subnormal, 0 or less
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  int e = int((bits >> 52) & 0x7ff) - 1023;
+  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;  // mantissa in [1, 2)
+  double m;
+  std::memcpy(&m, &bits, sizeof m);
+  if (m > 1.41421356237309504880) {
+    m *= 0.5;
+    ++e;
+  }
+  const double t = (m - 1.0) / (m + 1.0), t2 = t * t;
+  const double series = 1.0 + t2 * (1.0 / 3 + t2 * (1.0 / 5 + t2 * (1.0 / 7 + t2 * (1.0 / 9 + t2 * (1.0 / 11)))));
+  return 2.0 * t * series + double(e) * 0.69314718055994530942;
 }
 
-// Groups items[0..n) (weights > 0) into at most k lobes: k-means on the normal means, seeded with
-// the heaviest item and then the items farthest from every seed (ties to the lower index), then the
-// moments of every group. Writes the lobes to out and returns their count.
+// ln det of the normal covariance S_ss of a lobe (positive: S_ss >= sigma_r^2 I).
+double logDetNormals(const Gauss4& g) { return fastLog(g.ss[0] * g.ss[2] - g.ss[1] * g.ss[1]); }
+
+// The cost of replacing lobes x and y by their moment-matched union, on their normal marginals:
+//   B = 1/2 [(w_x + w_y) ln det S_xy - w_x ln det S_x - w_y ln det S_y],
+// an upper bound on the Kullback-Leibler divergence the merge adds to the mixture (Runnalls 2007,
+// "Kullback-Leibler approach to Gaussian mixture reduction", IEEE Trans. AES 43(3)). ld_x and
+// ld_y are ln det S_x and ln det S_y.
+GLINTBAKE_LOBE_INLINE double mergeCost(const Gauss4& x, const Gauss4& y, double ld_x, double ld_y) {
+  const double w = x.w + y.w, fx = x.w / w, fy = y.w / w;
+  const double dx = x.m[0] - y.m[0], dy = x.m[1] - y.m[1];
+  const double a = fx * x.ss[0] + fy * y.ss[0] + fx * fy * dx * dx;
+  const double b = fx * x.ss[1] + fy * y.ss[1] + fx * fy * dx * dy;
+  const double c = fx * x.ss[2] + fy * y.ss[2] + fx * fy * dy * dy;
+  const double det = a * c - b * b;
+  return 0.5 * (w * fastLog(det) - x.w * ld_x - y.w * ld_y);
+}
+
+// Groups items[0..n) (weights > 0) into at most k lobes by greedy pairwise merging: while more
+// than k remain, the pair of least merge cost (ties to the lower slot) is replaced by its
+// moment-matched union (so every lobe keeps the exact weight, mean and covariance of the items it
+// stands for). The cost is taken on the normal marginals because the footprints a level answers
+// are at least 1 / kTileRatio times its tiles: across a tile the footprint weight changes little
+// and what the image sees is the mixture of the tile's normal distributions. Every row caches its
+// cheapest partner, so a merge costs one new row of costs and a rescan of the rows that pointed at
+// the pair. Writes the lobes to out and returns their count.
 int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
   if (n <= k) {
     for (int i = 0; i < n; ++i) out[i] = items[i];
     return n;
   }
-  Feature f[kMaxItems] = {};
-  for (int i = 0; i < n; ++i) f[i] = featureOf(items[i]);
-  double centre[kLanes][3];
-  int seeds = 0, heaviest = 0;
-  for (int i = 1; i < n; ++i)
-    if (items[i].w > items[heaviest].w) heaviest = i;
-  auto seed = [&](int i) {
-    for (int d = 0; d < 3; ++d) centre[seeds][d] = f[i].v[d];
-    ++seeds;
+  // The live items are g[0..count): a merge keeps the union in the lower slot and moves the last
+  // item into the upper one, so that every row of costs stays dense (the diagonal is +inf).
+  Gauss4 g[kMaxItems];
+  double ld[kMaxItems];
+  double cost[kMaxItems][kMaxItems];
+  int best[kMaxItems];  // the cheapest partner of every item
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i) {
+    g[i] = items[i];
+    ld[i] = logDetNormals(g[i]);
+    cost[i][i] = inf;
+  }
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) cost[i][j] = cost[j][i] = mergeCost(g[i], g[j], ld[i], ld[j]);
+  int count = n;
+  auto rescan = [&](int i) {
+    const double* row = cost[i];
+    double c = row[0];
+    for (int j = 1; j < count; ++j) c = std::min(c, row[j]);
+    int b = 0;
+    while (row[b] != c) ++b;
+    best[i] = b;
   };
-  seed(heaviest);
-  double nearest[kMaxItems];
-  for (int i = 0; i < n; ++i) nearest[i] = distance2(f[i], centre[0]);
-  while (seeds < k) {
-    int far = -1;
-    for (int i = 0; i < n; ++i)
-      if (nearest[i] > 0.0 && (far < 0 || nearest[i] > nearest[far])) far = i;
-    if (far < 0) break;  // every item sits on a seed
-    seed(far);
-    for (int i = 0; i < n; ++i) nearest[i] = std::min(nearest[i], distance2(f[i], centre[seeds - 1]));
-  }
-  int group[kMaxItems];
-  for (int pass = 0; pass <= kLloydPasses; ++pass) {
-    for (int i = 0; i < n; ++i) {
-      int best = 0;
-      double bd = distance2(f[i], centre[0]);
-      for (int c = 1; c < seeds; ++c) {
-        const double d = distance2(f[i], centre[c]);
-        if (d < bd) bd = d, best = c;
-      }
-      group[i] = best;
+  for (int i = 0; i < n; ++i) rescan(i);
+  while (count > k) {
+    int bi = 0;
+    for (int i = 1; i < count; ++i)
+      if (cost[i][best[i]] < cost[bi][best[bi]]) bi = i;
+    int bj = best[bi];
+    if (bj < bi) std::swap(bi, bj);
+    const int pair[2] = {bi, bj};
+    g[bi] = momentMatch(g, pair, 2);
+    ld[bi] = logDetNormals(g[bi]);
+    // Move the last item into slot bj.
+    const int last = --count;
+    if (bj != last) {
+      g[bj] = g[last];
+      ld[bj] = ld[last];
+      best[bj] = best[last];
+      for (int j = 0; j <= last; ++j) cost[bj][j] = cost[last][j];
+      for (int j = 0; j <= last; ++j) cost[j][bj] = cost[j][last];
+      cost[bj][bj] = inf;
     }
-    if (pass == kLloydPasses) break;
-    double sum[kLanes][4] = {};
-    for (int i = 0; i < n; ++i) {
-      for (int d = 0; d < 3; ++d) sum[group[i]][d] += items[i].w * f[i].v[d];
-      sum[group[i]][3] += items[i].w;
+    for (int j = 0; j < count; ++j)
+      if (j != bi) cost[bi][j] = cost[j][bi] = mergeCost(g[bi], g[j], ld[bi], ld[j]);
+    for (int i = 0; i < count; ++i) {
+      if (best[i] == last) best[i] = bj;  // renamed
     }
-    for (int c = 0; c < seeds; ++c)
-      if (sum[c][3] > 0.0)
-        for (int d = 0; d < 3; ++d) centre[c][d] = sum[c][d] / sum[c][3];
+    rescan(bi);
+    for (int i = 0; i < count; ++i) {
+      if (i == bi) continue;
+      if (best[i] == bi || best[i] == bj)
+        rescan(i);
+      else if (cost[i][bi] <= cost[i][best[i]])
+        best[i] = bi;
+    }
   }
-  int idx[kMaxItems];
-  int count = 0;
-  for (int c = 0; c < seeds; ++c) {
-    int members = 0;
-    for (int i = 0; i < n; ++i)
-      if (group[i] == c) idx[members++] = i;
-    if (members > 0) out[count++] = momentMatch(items, idx, members);
-  }
+  for (int i = 0; i < count; ++i) out[i] = g[i];
   return count;
 }
 

@@ -86,13 +86,16 @@ TEST(LobeNdf, UnclusteredLevelIsTheExactFlakesButForTheWindow) {
   }
 }
 
+// The merging keeps lobes of different orientations apart: k-means on the normal means gave 0.062
+// (beckmann) and 0.058 (scratches) here, the greedy reduction 0.040 and 0.013.
 TEST(LobeNdf, ClusteredLevelsStayCloseToTheExactFlakes) {
-  for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kBrushed}) {
+  for (bake::MapKind kind :
+       {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kBrushed, bake::MapKind::kScratches}) {
     Pair p(mapOf(kind, 128, 8), 16);
     for (double sigma : {24.0}) {
       EXPECT_GT(p.lobes.tileFor(sigma), 4);
       const double e = p.imageError({70.2, 33.9, sigma});
-      EXPECT_LT(e, 0.2) << "kind " << int(kind) << " sigma " << sigma;
+      EXPECT_LT(e, 0.05) << "kind " << int(kind) << " sigma " << sigma;
       std::printf("kind %d sigma %g: relative L1 %.3f\n", int(kind), sigma, e);
     }
   }

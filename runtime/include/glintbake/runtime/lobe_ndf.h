@@ -16,9 +16,13 @@
 //
 // The hierarchy: level 0 tiles hold 4 x 4 flakes, every level doubles the tile side up to the
 // whole map. A tile of level 0 groups its flakes, a tile above groups the lobes of its four
-// children, each into at most `lobes_per_tile` lobes by k-means (deterministic farthest-point
-// seeds, four Lloyd passes) on the lobe normal means and spreads (the std of a lobe's normals, so
-// that the narrow inside of a flake and its wide edges stay apart), then moment matching. A
+// children, each into at most `lobes_per_tile` lobes by greedy pairwise merging: the pair whose
+// moment-matched union raises the Kullback-Leibler bound of Runnalls (2007, "Kullback-Leibler
+// approach to Gaussian mixture reduction") least on the normal marginals is merged until the tile
+// keeps lobes_per_tile (lobes of different orientation stay apart, as the arms of two crossing
+// scratches, which k-means on the normal means merged; image relative L1 at 24 texels against
+// every flake as its own lobe, k-means -> this: curved scratches 0.159 -> 0.057, sharp flakes
+// 0.144 -> 0.034, leather 0.087 -> 0.066, on the 1024^2 and 512^2 maps of the README). A
 // footprint is answered on the level whose tiles are at most 0.35 times its std (so the footprint
 // weight varies little across a tile and 19-36 tiles span the window per side), from every lobe within
 // 3 standard deviations of the footprint centre; tiles whose lobes cannot reach s are skipped.
