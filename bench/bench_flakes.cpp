@@ -7,6 +7,7 @@
 // GLINTBAKE_BENCH_ASSETS=a.gbk,b.gbk adds `asset_eval` and `asset_sample`: the same queries through
 // baked NDF assets (openNdfAsset: flakes, lobes, pyramid and the blends between them) at footprints
 // from 1 texel to past the pyramid's hand-over, so that every path and band of an asset is timed.
+// `lobe_build` times the lobe hierarchy a reader builds at load (16 lobes per tile).
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/reference/pndf.h>
@@ -187,6 +188,17 @@ void sampleBench(benchmark::State& state, size_t subject, double sigma, bool lob
   }
 }
 
+// What loading an asset with flakes costs: the lobe hierarchy of the whole map (16 lobes per tile).
+void lobeBuildBench(benchmark::State& state, size_t subject) {
+  const Subject& s = *subjects()[subject];
+  const auto texels = mapTexels(s.map);
+  for (auto _ : state) {
+    rt::LobeNdf lobes;
+    if (lobes.build(texels, 1, 0.005, 16, 128) != rt::RuntimeStatus::kOk) std::abort();
+    benchmark::DoNotOptimize(&lobes);
+  }
+}
+
 void referenceBench(benchmark::State& state, size_t subject, double sigma) {
   const Subject& s = *subjects()[subject];
   const std::vector<Query> q = queries(s, sigma);
@@ -214,6 +226,9 @@ const int registered = [] {
       benchmark::RegisterBenchmark(("lobe_sample/" + tag).c_str(), sampleBench, k, sigma, true)
           ->Unit(benchmark::kMicrosecond);
     }
+    benchmark::RegisterBenchmark(("lobe_build/" + name).c_str(), lobeBuildBench, k)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(3);
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
         ->Unit(benchmark::kMicrosecond);
   }

@@ -110,42 +110,84 @@ Gauss4 momentMatch(const Gauss4* items, const int* idx, int n) {
   return g;
 }
 
-// ln x for x > 0, to about 1e-11 relative: the exponent from the bits, then the atanh series of
-// the mantissa in [sqrt(1/2), sqrt(2)). Pure double arithmetic, so it gives the same bits on every
-// machine; the reduction below calls it a few thousand times per tile.
-GLINTBAKE_LOBE_INLINE double fastLog(double x) {
-  if (!(x >= std::numeric_limits<double>::min())) return std::log(std::max(x, 1e-300));  // subnormal, 0 or less
+// ln(|x| + 1e-300) (ln x for x > 1e-284, finite for every finite x), to about 1e-11 relative: the
+// exponent from the bits, then the atanh series of the mantissa m in [1, 2) (t = (m - 1) / (m + 1)
+// <= 1/3, eleven terms). Branch-free double arithmetic, so that the compiler vectorises the loops
+// that call it and every machine gets the same bits.
+GLINTBAKE_LOBE_INLINE double logPositive(double x) {
+  x = std::fabs(x) + 1e-300;  // without a comparison, which would keep the loops scalar
   uint64_t bits;
   std::memcpy(&bits, &x, sizeof bits);
-  int e = int((bits >> 52) & 0x7ff) - 1023;
-  bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;  // mantissa in [1, 2)
-  double m;
-  std::memcpy(&m, &bits, sizeof m);
-  if (m > 1.41421356237309504880) {
-    m *= 0.5;
-    ++e;
-  }
+  // The biased exponent as a double (2^52 + e, less 2^52), and the mantissa.
+  const uint64_t eb = (bits >> 52) | 0x4330000000000000ULL;
+  const uint64_t mb = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL;
+  double e, m;
+  std::memcpy(&e, &eb, sizeof e);
+  std::memcpy(&m, &mb, sizeof m);
+  e -= 4503599627370496.0 + 1023.0;
   const double t = (m - 1.0) / (m + 1.0), t2 = t * t;
-  const double series = 1.0 + t2 * (1.0 / 3 + t2 * (1.0 / 5 + t2 * (1.0 / 7 + t2 * (1.0 / 9 + t2 * (1.0 / 11)))));
-  return 2.0 * t * series + double(e) * 0.69314718055994530942;
+  double series = 1.0 / 19 + t2 * (1.0 / 21);
+  series = 1.0 / 17 + t2 * series;
+  series = 1.0 / 15 + t2 * series;
+  series = 1.0 / 13 + t2 * series;
+  series = 1.0 / 11 + t2 * series;
+  series = 1.0 / 9 + t2 * series;
+  series = 1.0 / 7 + t2 * series;
+  series = 1.0 / 5 + t2 * series;
+  series = 1.0 / 3 + t2 * series;
+  series = 1.0 + t2 * series;
+  return 2.0 * t * series + e * 0.69314718055994530942;
 }
 
-// ln det of the normal covariance S_ss of a lobe (positive: S_ss >= sigma_r^2 I).
-double logDetNormals(const Gauss4& g) { return fastLog(g.ss[0] * g.ss[2] - g.ss[1] * g.ss[1]); }
+// The normal marginals of the items being reduced, one array per term (so that a row of merge
+// costs is one vectorised loop): weight, mean, S_ss {xx, xy, yy} and ln det S_ss.
+struct Marginals {
+  double w[kMaxItems], m0[kMaxItems], m1[kMaxItems];
+  double sxx[kMaxItems], sxy[kMaxItems], syy[kMaxItems], ld[kMaxItems];
+  void set(int i, const Gauss4& g) {
+    w[i] = g.w;
+    m0[i] = g.m[0];
+    m1[i] = g.m[1];
+    sxx[i] = g.ss[0];
+    sxy[i] = g.ss[1];
+    syy[i] = g.ss[2];
+    ld[i] = logPositive(g.ss[0] * g.ss[2] - g.ss[1] * g.ss[1]);
+  }
+};
 
-// The cost of replacing lobes x and y by their moment-matched union, on their normal marginals:
+// costRow: row i of the merge costs against items [from, count): the cost of replacing lobes x and y by their
+// moment-matched union, on their normal marginals,
 //   B = 1/2 [(w_x + w_y) ln det S_xy - w_x ln det S_x - w_y ln det S_y],
 // an upper bound on the Kullback-Leibler divergence the merge adds to the mixture (Runnalls 2007,
-// "Kullback-Leibler approach to Gaussian mixture reduction", IEEE Trans. AES 43(3)). ld_x and
-// ld_y are ln det S_x and ln det S_y.
-GLINTBAKE_LOBE_INLINE double mergeCost(const Gauss4& x, const Gauss4& y, double ld_x, double ld_y) {
-  const double w = x.w + y.w, fx = x.w / w, fy = y.w / w;
-  const double dx = x.m[0] - y.m[0], dy = x.m[1] - y.m[1];
-  const double a = fx * x.ss[0] + fy * y.ss[0] + fx * fy * dx * dx;
-  const double b = fx * x.ss[1] + fy * y.ss[1] + fx * fy * dx * dy;
-  const double c = fx * x.ss[2] + fy * y.ss[2] + fx * fy * dy * dy;
-  const double det = a * c - b * b;
-  return 0.5 * (w * fastLog(det) - x.w * ld_x - y.w * ld_y);
+// "Kullback-Leibler approach to Gaussian mixture reduction", IEEE Trans. AES 43(3)). Symmetric to
+// the bit (every term is), so rows computed for j > i can be mirrored; +inf on the diagonal.
+GLINTBAKE_LOBE_INLINE void costRowImpl(const Marginals& p, int i, int from, int count, double* row) {
+  const double wi = p.w[i], m0 = p.m0[i], m1 = p.m1[i], sxx = p.sxx[i], sxy = p.sxy[i], syy = p.syy[i];
+  const double li = wi * p.ld[i];
+  for (int j = from; j < count; ++j) {
+    const double wj = p.w[j], w = wi + wj, inv = 1.0 / w;
+    const double fi = wi * inv, fj = wj * inv, f = fi * fj;
+    const double dx = m0 - p.m0[j], dy = m1 - p.m1[j];
+    const double a = fi * sxx + fj * p.sxx[j] + f * (dx * dx);
+    const double b = fi * sxy + fj * p.sxy[j] + f * (dx * dy);
+    const double c = fi * syy + fj * p.syy[j] + f * (dy * dy);
+    row[j] = 0.5 * (w * logPositive(a * c - b * b) - (li + wj * p.ld[j]));
+  }
+  row[i] = std::numeric_limits<double>::infinity();
+}
+
+#if GLINTBAKE_FLAKES_AVX2
+GLINTBAKE_FLAKES_AVX2_BEGIN
+// The same loop vectorised four doubles wide (AVX2 without fused multiply-add: the same bits).
+void costRowAvx2(const Marginals& p, int i, int from, int count, double* row) { costRowImpl(p, i, from, count, row); }
+GLINTBAKE_FLAKES_AVX2_END
+#endif
+
+void costRow(const Marginals& p, int i, int from, int count, double* row) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (flakes::hasAvx2()) return costRowAvx2(p, i, from, count, row);
+#endif
+  costRowImpl(p, i, from, count, row);
 }
 
 // Groups items[0..n) (weights > 0) into at most k lobes by greedy pairwise merging: while more
@@ -162,60 +204,72 @@ int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
     return n;
   }
   // The live items are g[0..count): a merge keeps the union in the lower slot and moves the last
-  // item into the upper one, so that every row of costs stays dense (the diagonal is +inf).
+  // item into the upper one, so that every row of costs stays dense.
   Gauss4 g[kMaxItems];
-  double ld[kMaxItems];
+  Marginals p;
   double cost[kMaxItems][kMaxItems];
   int best[kMaxItems];  // the cheapest partner of every item
-  const double inf = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
     g[i] = items[i];
-    ld[i] = logDetNormals(g[i]);
-    cost[i][i] = inf;
+    p.set(i, g[i]);
   }
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) cost[i][j] = cost[j][i] = mergeCost(g[i], g[j], ld[i], ld[j]);
+  for (int i = 0; i < n; ++i) {
+    costRow(p, i, i + 1, n, cost[i]);
+    for (int j = i + 1; j < n; ++j) cost[j][i] = cost[i][j];
+  }
   int count = n;
+  double best_cost[kMaxItems];  // cost[i][best[i]]
   auto rescan = [&](int i) {
     const double* row = cost[i];
-    double c = row[0];
-    for (int j = 1; j < count; ++j) c = std::min(c, row[j]);
     int b = 0;
-    while (row[b] != c) ++b;
+    for (int j = 1; j < count; ++j)
+      if (row[j] < row[b]) b = j;
     best[i] = b;
+    best_cost[i] = row[b];
   };
   for (int i = 0; i < n; ++i) rescan(i);
   while (count > k) {
     int bi = 0;
     for (int i = 1; i < count; ++i)
-      if (cost[i][best[i]] < cost[bi][best[bi]]) bi = i;
+      if (best_cost[i] < best_cost[bi]) bi = i;
     int bj = best[bi];
     if (bj < bi) std::swap(bi, bj);
     const int pair[2] = {bi, bj};
     g[bi] = momentMatch(g, pair, 2);
-    ld[bi] = logDetNormals(g[bi]);
+    p.set(bi, g[bi]);
     // Move the last item into slot bj.
     const int last = --count;
     if (bj != last) {
       g[bj] = g[last];
-      ld[bj] = ld[last];
+      p.set(bj, g[bj]);
       best[bj] = best[last];
+      best_cost[bj] = best_cost[last];
       for (int j = 0; j <= last; ++j) cost[bj][j] = cost[last][j];
       for (int j = 0; j <= last; ++j) cost[j][bj] = cost[j][last];
-      cost[bj][bj] = inf;
+      cost[bj][bj] = std::numeric_limits<double>::infinity();
     }
-    for (int j = 0; j < count; ++j)
-      if (j != bi) cost[bi][j] = cost[j][bi] = mergeCost(g[bi], g[j], ld[bi], ld[j]);
-    for (int i = 0; i < count; ++i) {
-      if (best[i] == last) best[i] = bj;  // renamed
-    }
+    costRow(p, bi, 0, count, cost[bi]);
+    for (int j = 0; j < count; ++j) cost[j][bi] = cost[bi][j];
     rescan(bi);
+    // A row keeps its partner unless the union costs less, or unless its partner was one of the
+    // pair: then the union if it costs no more than the old best (every other entry of the row is
+    // unchanged and no cheaper), else a rescan. A partner in the last slot has moved to bj.
     for (int i = 0; i < count; ++i) {
       if (i == bi) continue;
-      if (best[i] == bi || best[i] == bj)
-        rescan(i);
-      else if (cost[i][bi] <= cost[i][best[i]])
+      const bool merged = best[i] == bi || best[i] == bj;
+      if (best[i] == last) best[i] = bj;
+      const double c = cost[i][bi];
+      if (merged) {
+        if (c <= best_cost[i]) {
+          best[i] = bi;
+          best_cost[i] = c;
+        } else {
+          rescan(i);
+        }
+      } else if (c < best_cost[i]) {
         best[i] = bi;
+        best_cost[i] = c;
+      }
     }
   }
   for (int i = 0; i < count; ++i) out[i] = g[i];

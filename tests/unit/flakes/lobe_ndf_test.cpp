@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -244,6 +245,25 @@ TEST(LobeNdf, KernelsGiveTheSameBits) {
       EXPECT_EQ(wide, portable) << "sigma " << sigma;
     }
   }
+}
+
+// The reduction's merge costs run four wide under AVX2 and two wide otherwise: the same hierarchy.
+TEST(LobeNdf, BuildGivesTheSameBitsWithEitherKernel) {
+  const bake::NormalMap map = mapOf(bake::MapKind::kScratches, 128, 21);
+  const auto texels = mapTexels(map);
+  LobeNdf wide, portable;
+  runtime::usePortableFlakeKernels(false);
+  ASSERT_EQ(wide.build(texels, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  runtime::usePortableFlakeKernels(true);
+  ASSERT_EQ(portable.build(texels, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  std::vector<float> a(64 * 64), b(64 * 64);
+  for (double sigma : {14.0, 30.0, 60.0}) {
+    const Footprint fp{41.3, 87.9, sigma};
+    ASSERT_EQ(wide.image(fp, a.data(), a.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(portable.image(fp, b.data(), b.size()), RuntimeStatus::kOk);
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "sigma " << sigma;
+  }
+  runtime::usePortableFlakeKernels(false);
 }
 
 TEST(LobeNdf, DeterministicAndRejectsBadArguments) {
