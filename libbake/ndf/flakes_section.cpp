@@ -33,14 +33,16 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile) {
 }
 
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
-                                  double max_level_error, int lobes_per_tile, const bool* level_exact) {
+                                  double max_level_error, int lobes_per_tile, const bool* level_exact,
+                                  const double* level_variation) {
   if (lobes_per_tile <= 0 || levels <= 0) return defaultHandover(levels > 0 ? level_sigmas[0] : 0.0, lobes_per_tile);
   int first = levels;  // the first level from which every level is faithful
   while (first > 0 && level_errors[first - 1] <= max_level_error) --first;
   FlakesHandover h;
   h.flakes_up_to = kFlakesUpTo;
   h.lobes_per_tile = lobes_per_tile;
-  if (first < levels && level_exact && level_exact[first]) {
+  const bool glinty = first < levels && level_variation && level_variation[first] > kGlintyVariation;
+  if (first < levels && level_exact && level_exact[first] && !glinty) {
     // An exact level answers every footprint from its own sigma up as the uncompressed pyramid
     // does, within a percent on the real maps of the fidelity table; the lobes above their finest
     // tiles are coarser than that on maps of dense glints. So the lobes hand over at that sigma.

@@ -258,12 +258,16 @@ class TensorPack(ToolTestCase):
         self.assertEqual(doc["max_rank"], 16)
         self.assertEqual(doc["parameters"]["exact_levels_mib"], 0.1)
         # The exact levels are faithful: the lobes hand over at the first of them and the pyramid
-        # answers alone from sqrt(2) times its sigma.
-        first = next(lv["sigma"] for lv in levels if lv["exact"])
+        # answers alone from sqrt(2) times its sigma, or, where that level's images vary as glints
+        # do (variation above 0.5, as on this flake map), at sqrt(2) times it and from twice it.
+        first_level = next(lv for lv in levels if lv["exact"])
+        first = first_level["sigma"]
+        glinty = first_level["variation"] > 0.5
+        self.assertTrue(glinty, first_level)
         self.assertEqual(doc["gated_error"]["from_sigma"], first)
         info = self.run_json("glintinfo", "info", self.path("e.gbk"), "--json")
-        self.assertAlmostEqual(info["footprints"]["clustered_max_sigma"], first, places=6)
-        self.assertAlmostEqual(info["footprints"]["handover_max_sigma"], 2 ** 0.5 * first, places=6)
+        self.assertAlmostEqual(info["footprints"]["clustered_max_sigma"], 2 ** 0.5 * first, places=6)
+        self.assertAlmostEqual(info["footprints"]["handover_max_sigma"], 2 * first, places=6)
         for bad in ("-1", "2000", "nan"):
             self.assert_fails(clitest.BAD_ARGS, "tensorpack", m, "-o", self.path("x.gbk"), *PYRAMID,
                               "--exact-levels", bad, outputs=[self.path("x.gbk")])

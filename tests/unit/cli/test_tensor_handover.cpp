@@ -56,6 +56,14 @@ TEST(TensorHandover, CompressedLevelsAnswerOnlyWhenTheirImagesAreCloseInL1) {
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 16 * kSqrt2);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0);
 
+  // A first exact level whose images vary as glints do (kGlintyVariation): the lobes answer up to
+  // sqrt(2) times it, the pyramid alone from twice it.
+  bake::tensor::TensorPackReport glints = pyramid(0.05, 0.3);
+  glints.levels[2].variation = 0.9;
+  const bake::ndf::FlakesHandover g = cli::tensorHandover(glints, 16);
+  EXPECT_DOUBLE_EQ(g.lobes_up_to, 32 * kSqrt2);
+  EXPECT_DOUBLE_EQ(g.pyramid_from, 64.0);
+
   // Without lobes the flakes hand over to the pyramid at its finest level, faithful or not.
   const bake::ndf::FlakesHandover none = cli::tensorHandover(pyramid(0.05, 0.3), 0);
   EXPECT_EQ(none.lobes_per_tile, 0);

@@ -202,6 +202,14 @@ TEST(Handover, CompressedPyramidsHandOverAtTheirFirstFaithfulLevel) {
   h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact);
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
+  // An exact level whose images vary strongly (glints) hands over as a compressed one does.
+  const double smooth[4] = {0.6, 0.5, 0.3, 0.1}, glinty[4] = {0.99, 0.97, 0.9, 0.7};
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, smooth);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, glinty);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 64.0);
   const double none[4] = {2.0, 2.0, 2.0, 2.0};
   h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 16);
   EXPECT_GE(h.lobes_up_to, 1e6);

@@ -122,15 +122,16 @@ Json rankHistogramJson(const tensor::TensorPackReport& r) {
 }
 
 bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report, int lobes_per_tile) {
-  std::vector<double> sigmas, errors;
+  std::vector<double> sigmas, errors, variations;
   std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
   for (size_t l = 0; l < report.levels.size(); ++l) {
     sigmas.push_back(report.levels[l].sigma);
     errors.push_back(unfaithfulness(report.levels[l]));
+    variations.push_back(report.levels[l].variation);
     exact[l] = report.levels[l].exact;
   }
   return bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes_per_tile,
-                                       exact.get());
+                                       exact.get(), variations.data());
 }
 
 TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::TensorPackReport& report,

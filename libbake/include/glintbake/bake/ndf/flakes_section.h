@@ -42,9 +42,21 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
 // an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such level exists the
 // lobes answer every footprint they can (the runtime bounds them by their window) and the pyramid only above.
 // When that first level is stored exactly (level_exact[l], may be null), the lobes answer up to its
-// sigma and the pyramid alone from sqrt(2) times it.
+// sigma and the pyramid alone from sqrt(2) times it, unless its images vary across the map by more
+// than kGlintyVariation (level_variation[l], may be null: the relative spread of the level's images
+// about their mean): then the lobes answer up to sqrt(2) times its sigma and the pyramid alone from
+// twice it, as above a compressed level.
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
-                                  double max_level_error, int lobes_per_tile, const bool* level_exact = nullptr);
+                                  double max_level_error, int lobes_per_tile, const bool* level_exact = nullptr,
+                                  const double* level_variation = nullptr);
+
+// Above an exact level the pyramid blends the images of its centres and of the next level. Where
+// those images differ little (variation up to this bound: isotropic noise, bumps, fine scratches
+// and brushed maps, 0.15-0.27 at their first exact level) that blend is closer to the reference
+// than the clustered lobes (at 1.5 x the level's sigma, 0.010-0.020 against 0.029-0.054); where
+// the glints dominate (flakes and leather, 0.88-0.90) it is farther (0.064-0.116 against
+// 0.023-0.044): measured on the real maps of the README.
+constexpr double kGlintyVariation = 0.5;
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
 // mode, rate (1..16) and sigma_r, and the hand-over. The record is checked by
