@@ -155,8 +155,8 @@ struct Marginals {
   }
 };
 
-// costRow: row i of the merge costs against items [from, count): the cost of replacing lobes x and y by their
-// moment-matched union, on their normal marginals,
+// costRow: row i of the merge costs against items [from, count). The cost of replacing lobes x
+// and y by their moment-matched union, on their normal marginals,
 //   B = 1/2 [(w_x + w_y) ln det S_xy - w_x ln det S_x - w_y ln det S_y],
 // an upper bound on the Kullback-Leibler divergence the merge adds to the mixture (Runnalls 2007,
 // "Kullback-Leibler approach to Gaussian mixture reduction", IEEE Trans. AES 43(3)). Symmetric to
