@@ -43,9 +43,9 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   h.lobes_per_tile = lobes_per_tile;
   const bool glinty = first < levels && level_variation && level_variation[first] > kGlintyVariation;
   if (first < levels && level_exact && level_exact[first] && !glinty) {
-    // An exact level answers every footprint from its own sigma up as the uncompressed pyramid
-    // does, within a percent on the real maps of the fidelity table; the lobes above their finest
-    // tiles are coarser than that on maps of dense glints. So the lobes hand over at that sigma.
+    // An exact level whose images vary little blends closer to the reference from its own sigma up
+    // than the lobes above their finest tiles (kGlintyVariation), so the lobes hand over at that
+    // sigma; above a glinty one they go on as above a compressed level (below).
     h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, level_sigmas[first]);
     h.pyramid_from = std::max(kHalfOctave * level_sigmas[first], h.lobes_up_to);
     return h;

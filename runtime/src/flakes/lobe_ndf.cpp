@@ -19,7 +19,8 @@
 namespace glintbake::runtime {
 namespace {
 
-// The merge costs are the reduction's inner loop: inlined so that the processor overlaps them.
+// The reduction's merge costs: inlined into their loop (which the compiler then vectorises) and
+// into the AVX2 copy of that loop (which would otherwise call the SSE2 code).
 #if defined(__GNUC__)
 #define GLINTBAKE_LOBE_INLINE inline __attribute__((always_inline))
 #else
@@ -220,12 +221,8 @@ int clusterLobes(const Gauss4* items, int n, int k, Gauss4* out) {
   int count = n;
   double best_cost[kMaxItems];  // cost[i][best[i]]
   auto rescan = [&](int i) {
-    const double* row = cost[i];
-    int b = 0;
-    for (int j = 1; j < count; ++j)
-      if (row[j] < row[b]) b = j;
-    best[i] = b;
-    best_cost[i] = row[b];
+    best[i] = int(std::min_element(cost[i], cost[i] + count) - cost[i]);  // the first of equal minima
+    best_cost[i] = cost[i][best[i]];
   };
   for (int i = 0; i < n; ++i) rescan(i);
   while (count > k) {
