@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <new>
 
 namespace glintbake::runtime {
@@ -339,6 +340,9 @@ struct LobeNdf::Impl {
   int res = 128, lobes = kLanes;
   Level levels[20];
   int level_count = 0;
+  // Level 0 is built by build(); a level above on its first query (or by prepare()), once, from
+  // the level below: std::call_once orders its writes before every reader of that level.
+  mutable std::once_flag level_built[20];
   Array<Block> blocks;
   Array<Bound> bounds;
   // With every flake its own lobe on level 0 (lobes == kLanes), that level's eval is the exact
@@ -350,6 +354,9 @@ struct LobeNdf::Impl {
   RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in,
                       const FlakeNdf* shared);
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
+  // Levels 1..li built (thread-safe); returns levels[li].
+  const Level& levelBuilt(int li) const;
+  void buildLevel(int li);
   void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
   bool terms(const Footprint& fp, Terms* t) const;
@@ -442,18 +449,6 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
                 clusterLobes(items, n, lobes, grouped));
     }
   }
-  // Every level above: the lobes of the four children, grouped again.
-  for (int li = 1; li < level_count; ++li) {
-    const Level& l = levels[li];
-    for (int ty = 0; ty < l.tiles_y; ++ty) {
-      for (int tx = 0; tx < l.tiles_x; ++tx) {
-        int n = 0;
-        gatherChildren(levels[li - 1], tx, ty, items, &n);
-        storeTile(l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx), grouped,
-                  clusterLobes(items, n, lobes, grouped));
-      }
-    }
-  }
   if (lobes == kLanes) {
     if (shared) {
       exact = shared;
@@ -464,6 +459,31 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
     }
   }
   return RuntimeStatus::kOk;
+}
+
+// A level above 0: the lobes of the four children of every tile, grouped again. Most of the
+// build's time is here (level 1 about three quarters of it), so it waits for a query that needs it.
+void LobeNdf::Impl::buildLevel(int li) {
+  Gauss4 items[kMaxItems], grouped[kLanes];
+  const Level& l = levels[li];
+  for (int ty = 0; ty < l.tiles_y; ++ty) {
+    for (int tx = 0; tx < l.tiles_x; ++tx) {
+      int n = 0;
+      gatherChildren(levels[li - 1], tx, ty, items, &n);
+      storeTile(l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx), grouped, clusterLobes(items, n, lobes, grouped));
+    }
+  }
+}
+
+const Level& LobeNdf::Impl::levelBuilt(int li) const {
+  if (li > 0) {
+    std::call_once(level_built[li], [this, li] {
+      levelBuilt(li - 1);
+      // The only writer of this level's blocks, before any reader of them (call_once).
+      const_cast<Impl*>(this)->buildLevel(li);
+    });
+  }
+  return levels[li];
 }
 
 // The lobes of the (up to four) children of tile (tx, ty) of the level above `child`, positions
@@ -546,7 +566,7 @@ int LobeNdf::Impl::levelFor(double sigma) const {
 bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
   t->sigma = fp.sigma;
   t->sp2 = fp.sigma * fp.sigma;
-  t->level = &levels[levelFor(fp.sigma)];
+  t->level = &levelBuilt(levelFor(fp.sigma));
   t->tile_texels = t->level->tile * step;
   t->ux = fp.x;
   t->uy = fp.y;
@@ -745,6 +765,9 @@ RuntimeStatus LobeNdfAccess::build(LobeNdf& lobes, const TexelSource& source, in
 }
 
 bool LobeNdf::isBuilt() const { return impl_ != nullptr; }
+void LobeNdf::prepare() const {
+  if (impl_) impl_->levelBuilt(impl_->level_count - 1);
+}
 int LobeNdf::resolution() const { return impl_ ? impl_->res : 0; }
 MapSize LobeNdf::mapSize() const { return impl_ ? MapSize{impl_->width, impl_->height} : MapSize{}; }
 MapWrap LobeNdf::wrap() const { return impl_ && !impl_->repeat ? MapWrap::kClamp : MapWrap::kRepeat; }

@@ -254,8 +254,10 @@ TEST(LobeNdf, BuildGivesTheSameBitsWithEitherKernel) {
   LobeNdf wide, portable;
   runtime::usePortableFlakeKernels(false);
   ASSERT_EQ(wide.build(texels, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  wide.prepare();
   runtime::usePortableFlakeKernels(true);
   ASSERT_EQ(portable.build(texels, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
+  portable.prepare();
   std::vector<float> a(64 * 64), b(64 * 64);
   for (double sigma : {14.0, 30.0, 60.0}) {
     const Footprint fp{41.3, 87.9, sigma};
