@@ -84,7 +84,7 @@ struct NdfBlendAxis {
 
   // The centres around a position (texels) with their weights for a footprint of std sigma over a
   // level of std sigma_l: the Gaussian of std tau' (strides, at most max_spread) integrated against
-  // each centre's tent, tau * (F(d + 1) - 2 F(d) + F(d - 1)) with d = (g - i) / tau and
+  // each centre's tent, tau * (F(d + 1/tau) - 2 F(d) + F(d - 1/tau)) with d = (g - i) / tau and
   // F(z) = z Phi(z) + phi(z); plain bilinear weights when tau' = 0. Indices wrapped (repeat) or
   // clamped, equal indices merged, weights normalised to sum 1. Writes at most kMaxBlendAxis
   // entries; returns their count.
@@ -123,9 +123,14 @@ struct NdfBlendAxis {
     auto ramp = [](double z) {
       return z * 0.5 * std::erfc(-z * 0.70710678118654752) + 0.39894228040143267794 * std::exp(-0.5 * z * z);
     };
+    // ramp((g - i) / tau) for centres i - 1, i and i + 1: the second difference of neighbouring
+    // centres shares two of its three values, so each centre costs one erfc and one exp.
+    double r_prev = ramp((g - double(first - 1)) * inv_tau), r_cur = ramp((g - double(first)) * inv_tau);
     for (int i = first; i <= last; ++i) {
-      const double d = (g - double(i)) * inv_tau;
-      const double wi = tau * (ramp(d + inv_tau) - 2.0 * ramp(d) + ramp(d - inv_tau));
+      const double r_next = ramp((g - double(i + 1)) * inv_tau);
+      const double wi = tau * (r_prev - 2.0 * r_cur + r_next);
+      r_prev = r_cur;
+      r_cur = r_next;
       if (!(wi > 0.0)) continue;
       const int k = repeat ? ((i % n) + n) % n : (i < 0 ? 0 : (i >= n ? n - 1 : i));
       int e = 0;
