@@ -14,6 +14,11 @@ constexpr int kMaxSubIntervals = 16;
 
 // Lobes whose smallest std is at least this many bins are point-evaluated (see splatWideLobe).
 constexpr double kWideLobeBins = 1.5;
+// Flakes whose spatial exponent |u_k - u_Q|^2 / 2 (sigma_h^2 + sigma_p^2) exceeds kTailExponent
+// (weight below e^-3 of the footprint centre's) have their lobes truncated at kTailLobeTruncation
+// standard deviations at most (splat.h, "Truncation").
+constexpr double kTailExponent = 3.0;
+constexpr double kTailLobeTruncation = 3.0;
 
 // Standard normal CDF and density by linear interpolation of tables (step 1/512 over [-8, 8], built
 // once from std::erfc and std::exp at start-up). Interpolation error: h^2/8 max|phi'| = 1.2e-7 for
@@ -263,12 +268,18 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
   const double s2 = sh2 + sp2;
   const double radius = params_.footprint_truncation * std::sqrt(s2);
   const double radius2 = radius * radius;
-  const double spatial_norm = f.area / (2.0 * kPi * s2);
+  // The footprint weights are scaled by the inverse of the share of the Gaussian inside the
+  // truncation disk, so that an image of a footprint inside the map integrates to 1 at any
+  // truncation (the flakes beyond stand for the same distribution as those inside).
+  const double inside = -std::expm1(-0.5 * params_.footprint_truncation * params_.footprint_truncation);
+  const double spatial_norm = f.area / (2.0 * kPi * s2 * inside);
   const double inv_2s2 = 0.5 / s2;
   const double t = sh2 / s2;         // mean shift factor of mu_k
   const double kc = sh2 * sp2 / s2;  // J diag(kc) J^T term of C_k
   const double sr2 = params_.sigma_r * params_.sigma_r;
   const double trunc = params_.lobe_truncation;
+  const double tail_trunc = std::min(trunc, kTailLobeTruncation);
+  const double tail_d2 = kTailExponent / inv_2s2;
 
   // Virtual flake indices whose centres may lie within the radius (unwrapped: periodic images of a
   // repeating map are visited as distinct positions).
@@ -310,7 +321,7 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
       const double cxy = kc * (j00 * j10 + j01 * j11);
       const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
       const double mass = spatial_norm * std::exp(-d2 * inv_2s2);
-      splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, trunc);
+      splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
       ++used;
     }
   }

@@ -18,8 +18,13 @@
 //
 // Truncation (documented defaults):
 //  - footprint: flakes farther than footprint_truncation * sqrt(sigma_h^2 + sigma_p^2) from u_Q are
-//    skipped; at 4 std the missing spatial mass is exp(-8) = 3.4e-4;
-//  - lobe: each lobe is integrated over +-4 std of both conditional axes (missing mass < 1.3e-4).
+//    skipped, and the weights of the others are divided by the share of the footprint inside that
+//    disk, 1 - exp(-T^2 / 2), so that images keep unit mass (at 4 std the flakes left out hold
+//    exp(-8) = 3.4e-4 of the weight);
+//  - lobe: each lobe is integrated over +-4 std of both conditional axes (missing mass < 1.3e-4),
+//    the lobes of flakes in the footprint's tail (weight below e^-3 of the centre's, 5% of the
+//    footprint's mass and 62% of its flakes at 4 std) over +-3 std (missing mass < 5.4e-3 of theirs,
+//    so < 2.7e-4 of the image's), which saves a fifth of the bins a footprint's lobes cover.
 //
 // Image layout (formats/SPEC.md): R x R bins over s in [-1,1]^2, row 0 at s_y = +1, column 0 at
 // s_x = -1; each bin stores its average density (mass / bin area); bins whose centre lies outside
