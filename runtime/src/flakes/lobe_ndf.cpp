@@ -42,6 +42,9 @@ const double kWindowNorm = 1.0 / (1.0 - std::exp(-kMaxSpatial));
 constexpr double kMaxExponent = 18.0;  // lobes below e^-18 of their peak at s are left out
 constexpr int kMaxWindowTiles = 40;    // tiles per side of a window at most
 constexpr int kMaxSide = 1 << 16;
+// Levels at most: tiles of 4 << l flakes per side, up to a side of 2^16 texels at rate 16 (2^20
+// flakes) at l = 18.
+constexpr int kMaxLevels = 20;
 constexpr uint64_t kMaxFlakes = uint64_t(1) << 30;
 constexpr float kPaddingPosition = 1e15f;  // position of unused lanes: weight 0
 // Items grouped into one tile at most: the flakes of a level-0 tile, or the lobes of four children.
@@ -338,11 +341,11 @@ struct LobeNdf::Impl {
   bool repeat = true;
   double step = 1.0, sigma_h2 = 0.0, sigma_r2 = 0.0;
   int res = 128, lobes = kLanes;
-  Level levels[20];
+  Level levels[kMaxLevels];
   int level_count = 0;
   // Level 0 is built by build(); a level above on its first query (or by prepare()), once, from
   // the level below: std::call_once orders its writes before every reader of that level.
-  mutable std::once_flag level_built[20];
+  mutable std::once_flag level_built[kMaxLevels];
   Array<Block> blocks;
   Array<Bound> bounds;
   // With every flake its own lobe on level 0 (lobes == kLanes), that level's eval is the exact

