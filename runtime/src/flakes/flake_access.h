@@ -37,9 +37,10 @@ struct LobeNdfAccess {
   // keeps every flake as a lobe): then LobeNdf::eval is norm times FlakeNdfAccess::windowedEval
   // with *window_sigmas, on flakes equal to the FlakeNdf built from the same source.
   static bool exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm);
-  // LobeNdf::sample, with or without the density (as FlakeNdfAccess::sample).
+  // LobeNdf::sample, with or without the density (as FlakeNdfAccess::sample). known_mass, when not
+  // null, is LobeNdf::mass of the footprint (the same bits), which saves weighing the window twice.
   static RuntimeStatus sample(const LobeNdf& lobes, const Footprint& fp, double u1, double u2, NdfSample* out,
-                              bool with_pdf);
+                              bool with_pdf, const double* known_mass = nullptr);
   // LobeNdf::build, with the exact flakes of its finest level taken from `shared` (may be null:
   // the lobes build their own), a built FlakeNdf of the same source, rate and sigma_r that
   // outlives the lobes; kInvalidArgument when it is not built.

@@ -124,6 +124,10 @@ struct LeafTerms {
   float bound_sr2;      // sigma_r^2 widened
 };
 
+// Widest window (flakes) whose disk-row sums come from running sums on the stack (windowedMass,
+// windowedPick): the windows of the lobes' exact level are at most about 140 flakes wide.
+constexpr int kPrefixFlakes = 1024;
+
 // Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
 // room the branch-free writes and the padding to a whole vector take).
 constexpr int kLaneList = 512;
@@ -231,6 +235,13 @@ struct FlakeNdf::Impl {
   template <typename Visit>
   void forEachDiskRow(const FootprintTerms& t, Visit&& visit) const;
   double diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x1) const;
+  // The running sums of the footprint weights along x over the window, prefix[i] = the sum over
+  // flakes t.x0 .. t.x0 + i - 1 (i = 0 .. width), so that a disk row's sum is one difference;
+  // false (nothing written) when the window is wider than kPrefixFlakes.
+  bool columnPrefix(const FootprintTerms& t, double* prefix) const;
+  double rowSum(const FootprintTerms& t, const double* prefix, int64_t x0, int64_t x1) const {
+    return x1 < x0 ? 0.0 : prefix[x1 + 1 - t.x0] - prefix[x0 - t.x0];
+  }
   double weightSum(const FootprintTerms& t, bool along_x) const;
   double mass(const FootprintTerms& t) const { return t.wnorm * weightSum(t, true) * weightSum(t, false); }
 };
@@ -653,6 +664,18 @@ double FlakeNdf::Impl::diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x
   return s;
 }
 
+bool FlakeNdf::Impl::columnPrefix(const FootprintTerms& t, double* prefix) const {
+  if (t.empty || t.x1 - t.x0 + 1 > kPrefixFlakes) return false;
+  double sum = 0.0;
+  prefix[0] = 0.0;
+  forEachWeightIn(t.ux, t.x0, t.x1, t.inv2v, [&](int64_t f, double g) {
+    sum += g;
+    prefix[f - t.x0 + 1] = sum;
+    return true;
+  });
+  return true;
+}
+
 // Sum of exp(-d^2 / 2v) over the window's flake positions along one axis (the footprint weights
 // are separable: their total is wnorm times the product of the two sums).
 double FlakeNdf::Impl::weightSum(const FootprintTerms& t, bool along_x) const {
@@ -702,8 +725,10 @@ RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& f
   FootprintTerms t;
   if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   double sum = 0.0;
+  double prefix[kPrefixFlakes + 1];
+  const bool running = m.columnPrefix(t, prefix);
   m.forEachDiskRow(t, [&](int64_t, double gy, int64_t x0, int64_t x1) {
-    sum += gy * m.diskRowSum(t, x0, x1);
+    sum += gy * (running ? m.rowSum(t, prefix, x0, x1) : m.diskRowSum(t, x0, x1));
     return true;
   });
   *value = t.wnorm * sum;
@@ -721,8 +746,10 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
   double target = u1 * mass / t.wnorm, row_weight = 0.0;
   int64_t fy = 0, x0 = 0, x1 = -1;
   bool found = false;
+  double prefix[kPrefixFlakes + 1];
+  const bool running = m.columnPrefix(t, prefix);
   m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
-    const double w = gy * m.diskRowSum(t, a, b);
+    const double w = gy * (running ? m.rowSum(t, prefix, a, b) : m.diskRowSum(t, a, b));
     if (!(w > 0.0)) return true;
     fy = y, x0 = a, x1 = b, row_weight = w;
     if (target < w) {
@@ -735,16 +762,26 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
   if (x1 < x0) return RuntimeStatus::kInvalidArgument;
   if (!found) target = row_weight;
   *v1 = std::clamp(target / row_weight, 0.0, 0.99999999999999989);
-  double rest = u2 * m.diskRowSum(t, x0, x1), g = 0.0;
   int64_t fx = x0;
-  m.forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t x, double w) {
-    fx = x;
-    g = w;
-    if (rest < w || x == x1) return false;
-    rest -= w;
-    return true;
-  });
-  *v2 = g > 0.0 ? std::clamp(rest / g, 0.0, 0.99999999999999989) : 0.5;
+  if (running) {
+    // The first flake of the row whose running sum passes the target, by bisection.
+    const double before = prefix[x0 - t.x0], chord = prefix[x1 + 1 - t.x0] - before;
+    const double goal = before + u2 * chord;
+    const double* end = std::upper_bound(prefix + (x0 - t.x0) + 1, prefix + (x1 - t.x0) + 1, goal);
+    fx = std::min<int64_t>(x1, t.x0 + (end - prefix) - 1);
+    const double lo = prefix[fx - t.x0], g = prefix[fx + 1 - t.x0] - lo;
+    *v2 = g > 0.0 ? std::clamp((goal - lo) / g, 0.0, 0.99999999999999989) : 0.5;
+  } else {
+    double rest = u2 * m.diskRowSum(t, x0, x1), g = 0.0;
+    m.forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t x, double w) {
+      fx = x;
+      g = w;
+      if (rest < w || x == x1) return false;
+      rest -= w;
+      return true;
+    });
+    *v2 = g > 0.0 ? std::clamp(rest / g, 0.0, 0.99999999999999989) : 0.5;
+  }
   const int64_t gx = ((fx % m.fine_w) + m.fine_w) % m.fine_w, gy = ((fy % m.fine_h) + m.fine_h) % m.fine_h;
   const uint32_t where = m.slot.data[size_t(gy) * size_t(m.fine_w) + size_t(gx)];
   m.lobeOf(m.blocks.data[where / kLeafFlakes], int(where % kLeafFlakes), t.ux - m.flakePosition(fx),

@@ -177,7 +177,7 @@ RuntimeStatus HandoverNdf::sample(const Footprint& fp, double u1, double u2, Ndf
   if (&src == paths_.flakes.get())
     drawn = FlakeNdfAccess::sample(*paths_.flakes, fp, u, u2, &picked, false);
   else if (paths_.lobes && &src == paths_.lobes.get())
-    drawn = LobeNdfAccess::sample(*paths_.lobes, fp, u, u2, &picked, false);
+    drawn = LobeNdfAccess::sample(*paths_.lobes, fp, u, u2, &picked, false, first ? &ma : &mb);
   else
     drawn = src.sample(fp, u, u2, &picked);
   if (drawn != RuntimeStatus::kOk) return drawn;

@@ -41,6 +41,9 @@ constexpr double kMaxSpatial = kWindowSigmas * kWindowSigmas / 2;
 const double kWindowNorm = 1.0 / (1.0 - std::exp(-kMaxSpatial));
 constexpr double kMaxExponent = 18.0;  // lobes below e^-18 of their peak at s are left out
 constexpr int kMaxWindowTiles = 40;    // tiles per side of a window at most
+// Tiles whose masses sample() keeps for its pick (a window's tiles, with a margin for the split
+// of a repeating window at the map's edges; more fall back to a second weighing walk).
+constexpr int kMaxSampleTiles = (kMaxWindowTiles + 2) * (kMaxWindowTiles + 2);
 constexpr int kMaxSide = 1 << 16;
 // Levels at most: tiles of 4 << l flakes per side, up to a side of 2^16 texels at rate 16 (2^20
 // flakes) at l = 18.
@@ -323,6 +326,15 @@ void laneValues(bool wide, LaneList* list, int n, float cutoff) {
 #endif
   (void)wide;
   sse::laneValues(list, n, cutoff);
+}
+
+void laneWeightKernel(bool wide, const Block& b, int count, float sp2, float bx, float by, float scale, float cut,
+                      float* lanes) {
+#if GLINTBAKE_FLAKES_AVX2
+  if (wide) return avx2::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
+#endif
+  (void)wide;
+  sse::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
 }
 
 // The footprint terms of one query: centre (reduced into the map for repeating maps), sigma_p^2,
@@ -661,25 +673,12 @@ void LobeNdf::Impl::forEachLobe(const Block& b, const Bound& bound, double bx, d
 
 double LobeNdf::Impl::laneWeights(const Block& b, const Bound& bound, double bx, double by, double sp2,
                                   float* lanes) const {
-  using flakes::F4;
-  const F4 vsp2 = F4::splat(float(sp2)), half = F4::splat(0.5f), spatial_cut = F4::splat(float(kMaxSpatial));
-  const F4 vbx = F4::splat(float(bx)), vby = F4::splat(float(by)), zero = F4::splat(0.0f);
-  const F4 scale = F4::splat(float(kWindowNorm / kTwoPi));
+  // The kernel (lobe_kernel.inc) in whole vectors; lanes past the count are 0 and add nothing.
+  laneWeightKernel(flakes::hasAvx2(), b, int(bound.count), float(sp2), float(bx), float(by),
+                   float(kWindowNorm / kTwoPi), float(kMaxSpatial), lanes);
   double sum = 0.0;
-  for (uint32_t h = 0; h < uint32_t(kLanes); h += 4) {
-    if (h >= bound.count) {
-      zero.store(lanes + h);
-      continue;
-    }
-    const F4 a00 = F4::load(b.uxx + h) + vsp2, a01 = F4::load(b.uxy + h), a11 = F4::load(b.uyy + h) + vsp2;
-    const F4 det_a = a00 * a11 - a01 * a01;
-    const F4 inv = F4::splat(1.0f) / det_a;
-    const F4 dx = vbx - F4::load(b.cx + h), dy = vby - F4::load(b.cy + h);
-    const F4 spatial = half * (a11 * dx * dx - F4::splat(2.0f) * a01 * dx * dy + a00 * dy * dy) * inv;
-    const F4 w = selectLess(spatial, spatial_cut, scale * F4::load(b.w + h) * flakes::expNeg4(spatial) / sqrt(det_a));
-    w.store(lanes + h);
+  for (uint32_t h = 0; h < bound.count; h += 4)
     sum += (double(lanes[h]) + double(lanes[h + 1])) + (double(lanes[h + 2]) + double(lanes[h + 3]));
-  }
   return sum;
 }
 
@@ -869,13 +868,31 @@ RuntimeStatus LobeNdf::sample(const Footprint& footprint, double u1, double u2, 
 }
 
 RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footprint, double u1, double u2,
-                                    NdfSample* out, bool with_pdf) {
+                                    NdfSample* out, bool with_pdf, const double* known_mass) {
   if (!lobes.impl_ || !out || !validFootprint(footprint) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
   const LobeNdf::Impl& m = *lobes.impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  const double total = m.massOf(t);
+  const bool exact_level = t.level == &m.levels[0] && m.exact;
+  // The clustered levels' mass tile by tile (massOf's sum, in its order), kept for the pick.
+  double tile_mass[kMaxSampleTiles];
+  int tiles = 0;
+  float lanes[kLanes];
+  double total = 0.0;
+  if (known_mass) {
+    total = *known_mass;
+    tiles = kMaxSampleTiles + 1;  // no masses kept: the pick weighs the tiles as it walks
+  } else if (exact_level) {
+    total = m.massOf(t);
+  } else {
+    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+      const double w = m.laneWeights(b, bound, bx, by, t.sp2, lanes);
+      total += w;
+      if (tiles < kMaxSampleTiles) tile_mass[tiles] = w;
+      ++tiles;
+    });
+  }
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   auto finish = [&](const flakes::Lobe& g, double v1, double v2) {
     const double radius = std::sqrt(-2.0 * std::log1p(-v1));
@@ -887,7 +904,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
     out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
     return RuntimeStatus::kOk;
   };
-  if (t.level == &m.levels[0] && m.exact) {  // a flake of the window by its weight
+  if (exact_level) {  // a flake of the window by its weight
     flakes::Lobe g;
     double v1 = 0.5, v2 = 0.5;
     if (FlakeNdfAccess::windowedPick(*m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
@@ -900,7 +917,6 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   // end takes the last lobe of the last tile with mass.
   double target = u1 * total, v1 = 0.99999999999999989;
   flakes::Lobe picked{0.0, 0.0, 1.0, 0.0, 1.0};
-  float lanes[kLanes];
   const Block* last_block = nullptr;
   const Bound* last_bound = nullptr;
   double last_bx = 0.0, last_by = 0.0;
@@ -921,15 +937,36 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
     m.lobeAt(b, std::max(lane, 0), bx, by, t.sp2, &picked);
     found = true;
   };
+  // The tile from the masses kept above (the last with mass when rounding runs past the end),
+  // then a second walk of the window to reach it.
+  int chosen = -1, last_with_mass = -1;
+  if (tiles <= kMaxSampleTiles) {
+    for (int k = 0; k < tiles && chosen < 0; ++k) {
+      if (!(tile_mass[k] > 0.0)) continue;
+      last_with_mass = k;
+      if (target < tile_mass[k]) chosen = k;
+      else target -= tile_mass[k];
+    }
+    if (chosen < 0) {
+      if (last_with_mass < 0) return RuntimeStatus::kInvalidArgument;  // no tile had mass
+      chosen = last_with_mass;
+      target = std::numeric_limits<double>::infinity();
+    }
+  }
+  int ordinal = 0;
   m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
     if (found) return;
-    const double tile_mass = m.laneWeights(b, bound, bx, by, t.sp2, lanes);
-    if (!(tile_mass > 0.0)) return;
-    if (target < tile_mass) {
+    if (chosen >= 0) {
+      if (ordinal++ == chosen) pickIn(b, bound, bx, by);
+      return;
+    }
+    const double mass = m.laneWeights(b, bound, bx, by, t.sp2, lanes);
+    if (!(mass > 0.0)) return;
+    if (target < mass) {
       pickIn(b, bound, bx, by);
       return;
     }
-    target -= tile_mass;
+    target -= mass;
     last_block = &b;
     last_bound = &bound;
     last_bx = bx;
