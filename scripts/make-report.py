@@ -169,7 +169,7 @@ class Runner:
         doc = json.loads(proc.stdout) if capture_json else None
         with _cache_lock:
             self.runs += 1
-            self.cache[key] = {"doc": doc, "seconds": seconds}
+            self.cache[key] = {"doc": doc, "seconds": seconds, "args": [os.path.basename(args[0])] + args[1:]}
         return doc, seconds
 
     def save(self):

@@ -80,10 +80,14 @@ void integrateLobeOverGrid(const Lobe& g, double weight, const double* xs, int n
         const double zy = (y - g.my) / sy;
         const double wy = weight * 0.5 * pw * node_weight[q] * kInvSqrt2Pi / sy * std::exp(-0.5 * zy * zy);
         const double m = g.mx + slope * (y - g.my);
-        double prev = normalCdf((xs[0] - m) / sc);
+        // The conditional CDF is 0 below m - kReach sc and 1 above m + kReach sc (to the
+        // accuracy's truncation): erfc only at the edges between, nothing added where it is flat.
+        const double flat_lo = m - kReach * sc, flat_hi = m + kReach * sc;
+        auto cdf = [&](double x) { return x <= flat_lo ? 0.0 : (x >= flat_hi ? 1.0 : normalCdf((x - m) / sc)); };
+        double prev = cdf(xs[0]);
         for (int c = 0; c < nc; ++c) {
-          const double cur = normalCdf((xs[c + 1] - m) / sc);
-          out[r * stride + c] += Acc(wy * (cur - prev));
+          const double cur = cdf(xs[c + 1]);
+          if (cur != prev) out[r * stride + c] += Acc(wy * (cur - prev));
           prev = cur;
         }
       }

@@ -25,7 +25,9 @@
 // with sigma_p^2 times the share of flakes near s: on 1024^2 maps about 0.6-0.9 us at
 // sigma_p = 0, 1.5-2 us at 1 texel, 7-11 us at 4 and 20-40 us at 8 (bench/bench_flakes.cpp).
 // mass() and sample() sum the separable footprint weights by a product recurrence (an exp every
-// 16 flakes), so that sampling costs little more than the eval of its pdf.
+// 16 flakes), so that sampling costs little more than the eval of its pdf; the narrower disk
+// windows of the clustered lobes' exact level weigh each row from running sums of the column
+// weights, in time linear in the window's side.
 //
 // Queries follow the NdfSource contract: eval() is the closed form inside [-1, 1]^2 and 0 outside;
 // average() its exact mean over a rectangle (numerical integration to about 1e-10 of each lobe's

@@ -32,7 +32,10 @@
 // keeps every flake as its own lobe, and its eval, mass and sampling are those of the exact flakes
 // (flake_ndf.h, which prunes by normal within tiles) with the 3-sigma window. On 1024^2 maps
 // (bench/bench_flakes.cpp) eval costs about 6-9 us at sigma_p = 6 texels, 17-28 us at 12 and
-// 25-40 us on the clustered levels (24, 48); sample about twice that.
+// 15-40 us on the clustered levels (24, 48). Sample: on level 0 the disk rows' weights come from
+// running sums of the column weights (linear in the window's side), so it costs about one eval;
+// on the clustered levels one weighing of the window's tiles (AVX2 where the processor has it),
+// whose tile masses the pick reuses, plus the eval of its density: about 1.7-2 evals.
 //
 // What it gives up against the exact path: the shape of each group beyond its covariance. It is
 // close where a tile's flakes form a few tight groups (sharp flakes, scratches) or vary smoothly,
