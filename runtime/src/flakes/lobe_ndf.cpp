@@ -944,8 +944,10 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
     for (int k = 0; k < tiles && chosen < 0; ++k) {
       if (!(tile_mass[k] > 0.0)) continue;
       last_with_mass = k;
-      if (target < tile_mass[k]) chosen = k;
-      else target -= tile_mass[k];
+      if (target < tile_mass[k])
+        chosen = k;
+      else
+        target -= tile_mass[k];
     }
     if (chosen < 0) {
       if (last_with_mass < 0) return RuntimeStatus::kInvalidArgument;  // no tile had mass
