@@ -134,17 +134,39 @@ double TensorNdf::Impl::blockMass(const Blend& b, uint64_t block) const {
   return m > 0.0 ? m : 0.0;
 }
 
-double TensorNdf::Impl::totalMass(const Blend& b) const {
+double TensorNdf::Impl::totalMass(const Blend& b, double* masses, bool* kept) const {
+  if (kept) *kept = false;
+  if (nb2 > kMassBlocks) {
+    double total = 0.0;
+    for (uint64_t k = 0; k < nb2; ++k) total += blockMass(b, k);
+    return total;
+  }
+  // Centre by centre over every block (each centre's masses are contiguous): every block's sum
+  // adds its terms in blockMass's order, so the same bits.
+  double acc[kMassBlocks];
+  std::fill(acc, acc + nb2, 0.0);
+  for (int t = 0; t < b.count; ++t) {
+    const double w = b.weight[t];
+    const double* m = b.mass[t];
+    for (uint64_t k = 0; k < nb2; ++k) acc[k] += w * m[k];
+  }
   double total = 0.0;
-  for (uint64_t k = 0; k < nb2; ++k) total += blockMass(b, k);
+  for (uint64_t k = 0; k < nb2; ++k) {
+    const double mk = acc[k] > 0.0 ? acc[k] : 0.0;
+    if (masses) masses[k] = mk;
+    total += mk;
+  }
+  if (kept) *kept = masses != nullptr;
   return total;
 }
 
 double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
-  const double total = totalMass(b);
+  double masses[kMassBlocks];
+  bool kept = false;
+  const double total = totalMass(b, masses, &kept);
   if (!(total > 0.0)) return 0.0;
   const uint64_t block = uint64_t(j / bins) * uint64_t(nb) + uint64_t(i / bins);
-  const double m = blockMass(b, block);
+  const double m = kept ? masses[block] : blockMass(b, block);
   if (!(m > 0.0)) return 0.0;
   CpMix mix;
   mixBlock(b, block, &mix);
@@ -253,7 +275,9 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
   const Impl& m = *impl_;
   Impl::Blend b;
   m.blend(footprint, &b);
-  const double total = m.totalMass(b);
+  double masses[Impl::kMassBlocks];
+  bool kept = false;
+  const double total = m.totalMass(b, masses, &kept);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
 
   // 1. Block by clamped blended mass; u1 is rescaled to [0, 1) within the chosen block.
@@ -261,7 +285,7 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
   double before = 0.0, chosen_mass = 0.0;
   uint64_t chosen = 0;
   for (uint64_t k = 0; k < m.nb2; ++k) {
-    const double mk = m.blockMass(b, k);
+    const double mk = kept ? masses[k] : m.blockMass(b, k);
     if (!(mk > 0.0)) continue;
     chosen = k;
     chosen_mass = mk;

@@ -2,11 +2,13 @@
 // NdfPyramid on hand-made containers: exact centre values, trilinear weights, range averages,
 // sampling (pdf consistency and a chi-square test), the C API, and malformed assets.
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/ndf_pyramid_blend.h>
 #include <glintbake/runtime/glintbake_ndf_c.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -363,6 +365,51 @@ TEST_F(NdfPyramidTest, SamplerPassesChiSquare) {
   const double limit = dof + 3.72 * std::sqrt(2.0 * dof) + 8.0;
   std::printf("[ measured ] chi-square %.1f with %d degrees of freedom (limit %.1f)\n", chi2, dof, limit);
   EXPECT_LT(chi2, limit);
+}
+
+// The blend's ramp F(z) = z Phi(z) + phi(z), interpolated from a table, against the closed form;
+// and the weights it gives against the closed form's second differences.
+TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
+  auto exact = [](double z) {
+    return z * 0.5 * std::erfc(-z / std::sqrt(2.0)) + 0.39894228040143267794 * std::exp(-0.5 * z * z);
+  };
+  const format::NdfRamp& ramp = format::NdfRamp::table();
+  double worst = 0.0;
+  for (int k = -12000; k <= 12000; ++k) {
+    const double z = k * 7.3e-4 + 1e-5;  // off the nodes, past both ends
+    worst = std::max(worst, std::fabs(ramp(z) - exact(z)));
+  }
+  EXPECT_LT(worst, 1e-10);
+  // Weights of one axis (16 centres, repeating, stride 4) at spreads up to the level's limit.
+  format::NdfBlendAxis axis;
+  axis.set(64.0, 2.0, 4.0, 16, true);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(0.0, 64.0), extra(0.1, 6.0);
+  double worst_w = 0.0;
+  for (int q = 0; q < 500; ++q) {
+    const double p = pos(rng), sigma_l = 2.0, sigma = std::sqrt(sigma_l * sigma_l + 4.0 * 4.0 / 6.0 + extra(rng));
+    int idx[format::kMaxBlendAxis];
+    double w[format::kMaxBlendAxis];
+    const int n = axis.gaussianWeights(p, sigma, sigma_l, 1.5, idx, w);
+    // The same weights from the closed form: tau * second differences of F, wrapped and normalised.
+    const double tau = std::min(axis.spread(sigma, sigma_l), 1.5), g = (p - 2.0) / 4.0;
+    double ref[16] = {}, total = 0.0;
+    for (int i = int(std::floor(g - 3.5 * tau - 1.0)); i <= int(std::floor(g + 3.5 * tau + 1.0)) + 1; ++i) {
+      const double d = (g - i) / tau;
+      const double wi = tau * (exact(d + 1.0 / tau) - 2.0 * exact(d) + exact(d - 1.0 / tau));
+      if (!(wi > 0.0)) continue;
+      ref[((i % 16) + 16) % 16] += wi;
+      total += wi;
+    }
+    double sum = 0.0;
+    for (int e = 0; e < n; ++e) {
+      worst_w = std::max(worst_w, std::fabs(w[e] - ref[idx[e]] / total));
+      sum += w[e];
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+  }
+  EXPECT_LT(worst_w, 1e-8);
+  std::printf("[ figures  ] ramp error %.2g, weight error %.2g\n", worst, worst_w);
 }
 
 TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {

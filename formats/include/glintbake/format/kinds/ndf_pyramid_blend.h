@@ -31,6 +31,46 @@ namespace glintbake::format {
 constexpr int kMaxBlendAxis = 16;
 constexpr int kMaxBlendCentres = 2 * kMaxBlendAxis * kMaxBlendAxis;
 
+// F(z) = z Phi(z) + phi(z) (the Gaussian's CDF integrated once), whose second differences are the
+// blend's tent-integrated weights: a cubic Hermite interpolant of F and F' = Phi between nodes
+// 1/64 apart on [-8, 8] (error below max |F''''| h^4 / 384 = 7e-11), 0 below and z above (F
+// differs from them by less than 1e-16 there). Four multiply-adds instead of erfc and exp: the
+// weights were most of a pyramid query's time.
+class NdfRamp {
+ public:
+  static constexpr int kPerUnit = 64;
+  static constexpr double kReach = 8.0;
+  static constexpr int kNodes = int(2 * kReach) * kPerUnit + 1;
+
+  static const NdfRamp& table() {
+    static const NdfRamp t;
+    return t;
+  }
+  double operator()(double z) const {
+    if (!(z > -kReach)) return 0.0;
+    if (z >= kReach) return z;
+    const double u = (z + kReach) * kPerUnit;
+    int i = int(u);
+    if (i > kNodes - 2) i = kNodes - 2;
+    const double t = u - double(i), t2 = t * t, t3 = t2 * t;
+    const double h00 = 2.0 * t3 - 3.0 * t2 + 1.0, h10 = t3 - 2.0 * t2 + t;
+    const double h01 = -2.0 * t3 + 3.0 * t2, h11 = t3 - t2;
+    constexpr double kStep = 1.0 / kPerUnit;
+    return h00 * f_[i] + h01 * f_[i + 1] + kStep * (h10 * d_[i] + h11 * d_[i + 1]);
+  }
+
+ private:
+  NdfRamp() {
+    for (int i = 0; i < kNodes; ++i) {
+      const double z = -kReach + double(i) / kPerUnit;
+      const double cdf = 0.5 * std::erfc(-z * 0.70710678118654752);
+      f_[i] = z * cdf + 0.39894228040143267794 * std::exp(-0.5 * z * z);
+      d_[i] = cdf;
+    }
+  }
+  double f_[kNodes], d_[kNodes];
+};
+
 // One axis of a level's centre grid, with the divisions of the blend done once at init.
 struct NdfBlendAxis {
   double size = 1.0, inv_size = 1.0;      // map texels along the axis and their reciprocal
@@ -85,7 +125,7 @@ struct NdfBlendAxis {
   // The centres around a position (texels) with their weights for a footprint of std sigma over a
   // level of std sigma_l: the Gaussian of std tau' (strides, at most max_spread) integrated against
   // each centre's tent, tau * (F(d + 1/tau) - 2 F(d) + F(d - 1/tau)) with d = (g - i) / tau and
-  // F(z) = z Phi(z) + phi(z); plain bilinear weights when tau' = 0. Indices wrapped (repeat) or
+  // F(z) = z Phi(z) + phi(z) (NdfRamp); plain bilinear weights when tau' = 0. Indices wrapped (repeat) or
   // clamped, equal indices merged, weights normalised to sum 1. Writes at most kMaxBlendAxis
   // entries; returns their count.
   int gaussianWeights(double pos, double sigma, double sigma_l, double max_spread, int* idx, double* w) const {
@@ -120,11 +160,9 @@ struct NdfBlendAxis {
     int count = 0;
     double total = 0.0;
     const double inv_tau = 1.0 / tau;
-    auto ramp = [](double z) {
-      return z * 0.5 * std::erfc(-z * 0.70710678118654752) + 0.39894228040143267794 * std::exp(-0.5 * z * z);
-    };
+    const NdfRamp& ramp = NdfRamp::table();
     // ramp((g - i) / tau) for centres i - 1, i and i + 1: the second difference of neighbouring
-    // centres shares two of its three values, so each centre costs one erfc and one exp.
+    // centres shares two of its three values, so each centre costs one ramp.
     double r_prev = ramp((g - double(first - 1)) * inv_tau), r_cur = ramp((g - double(first)) * inv_tau);
     for (int i = first; i <= last; ++i) {
       const double r_next = ramp((g - double(i + 1)) * inv_tau);
