@@ -239,7 +239,10 @@ struct FlakeNdf::Impl {
   // flakes t.x0 .. t.x0 + i - 1 (i = 0 .. width), so that a disk row's sum is one difference;
   // false (nothing written) when the window is wider than kPrefixFlakes.
   bool columnPrefix(const FootprintTerms& t, double* prefix) const;
+  // A disk row's sum of weights: from the running sums when columnPrefix wrote them (prefix not
+  // null), else added up flake by flake.
   double rowSum(const FootprintTerms& t, const double* prefix, int64_t x0, int64_t x1) const {
+    if (!prefix) return diskRowSum(t, x0, x1);
     return x1 < x0 ? 0.0 : prefix[x1 + 1 - t.x0] - prefix[x0 - t.x0];
   }
   double weightSum(const FootprintTerms& t, bool along_x) const;
@@ -725,10 +728,10 @@ RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& f
   FootprintTerms t;
   if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   double sum = 0.0;
-  double prefix[kPrefixFlakes + 1];
-  const bool running = m.columnPrefix(t, prefix);
+  double buffer[kPrefixFlakes + 1];
+  const double* prefix = m.columnPrefix(t, buffer) ? buffer : nullptr;
   m.forEachDiskRow(t, [&](int64_t, double gy, int64_t x0, int64_t x1) {
-    sum += gy * (running ? m.rowSum(t, prefix, x0, x1) : m.diskRowSum(t, x0, x1));
+    sum += gy * m.rowSum(t, prefix, x0, x1);
     return true;
   });
   *value = t.wnorm * sum;
@@ -746,10 +749,10 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
   double target = u1 * mass / t.wnorm, row_weight = 0.0;
   int64_t fy = 0, x0 = 0, x1 = -1;
   bool found = false;
-  double prefix[kPrefixFlakes + 1];
-  const bool running = m.columnPrefix(t, prefix);
+  double buffer[kPrefixFlakes + 1];
+  const double* prefix = m.columnPrefix(t, buffer) ? buffer : nullptr;
   m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
-    const double w = gy * (running ? m.rowSum(t, prefix, a, b) : m.diskRowSum(t, a, b));
+    const double w = gy * m.rowSum(t, prefix, a, b);
     if (!(w > 0.0)) return true;
     fy = y, x0 = a, x1 = b, row_weight = w;
     if (target < w) {
@@ -763,7 +766,7 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
   if (!found) target = row_weight;
   *v1 = std::clamp(target / row_weight, 0.0, 0.99999999999999989);
   int64_t fx = x0;
-  if (running) {
+  if (prefix) {
     // The first flake of the row whose running sum passes the target, by bisection.
     const double before = prefix[x0 - t.x0], chord = prefix[x1 + 1 - t.x0] - before;
     const double goal = before + u2 * chord;
@@ -772,7 +775,7 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
     const double lo = prefix[fx - t.x0], g = prefix[fx + 1 - t.x0] - lo;
     *v2 = g > 0.0 ? std::clamp((goal - lo) / g, 0.0, 0.99999999999999989) : 0.5;
   } else {
-    double rest = u2 * m.diskRowSum(t, x0, x1), g = 0.0;
+    double rest = u2 * m.rowSum(t, nullptr, x0, x1), g = 0.0;
     m.forEachWeightIn(t.ux, x0, x1, t.inv2v, [&](int64_t x, double w) {
       fx = x;
       g = w;

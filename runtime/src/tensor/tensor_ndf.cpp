@@ -134,9 +134,8 @@ double TensorNdf::Impl::blockMass(const Blend& b, uint64_t block) const {
   return m > 0.0 ? m : 0.0;
 }
 
-double TensorNdf::Impl::totalMass(const Blend& b, double* masses, bool* kept) const {
-  if (kept) *kept = false;
-  if (nb2 > kMassBlocks) {
+double TensorNdf::Impl::totalMass(const Blend& b, double* masses) const {
+  if (!keepsMasses()) {
     double total = 0.0;
     for (uint64_t k = 0; k < nb2; ++k) total += blockMass(b, k);
     return total;
@@ -156,17 +155,15 @@ double TensorNdf::Impl::totalMass(const Blend& b, double* masses, bool* kept) co
     if (masses) masses[k] = mk;
     total += mk;
   }
-  if (kept) *kept = masses != nullptr;
   return total;
 }
 
 double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
   double masses[kMassBlocks];
-  bool kept = false;
-  const double total = totalMass(b, masses, &kept);
+  const double total = totalMass(b, masses);
   if (!(total > 0.0)) return 0.0;
   const uint64_t block = uint64_t(j / bins) * uint64_t(nb) + uint64_t(i / bins);
-  const double m = kept ? masses[block] : blockMass(b, block);
+  const double m = keepsMasses() ? masses[block] : blockMass(b, block);
   if (!(m > 0.0)) return 0.0;
   CpMix mix;
   mixBlock(b, block, &mix);
@@ -276,8 +273,7 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
   Impl::Blend b;
   m.blend(footprint, &b);
   double masses[Impl::kMassBlocks];
-  bool kept = false;
-  const double total = m.totalMass(b, masses, &kept);
+  const double total = m.totalMass(b, masses);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
 
   // 1. Block by clamped blended mass; u1 is rescaled to [0, 1) within the chosen block.
@@ -285,7 +281,7 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
   double before = 0.0, chosen_mass = 0.0;
   uint64_t chosen = 0;
   for (uint64_t k = 0; k < m.nb2; ++k) {
-    const double mk = kept ? masses[k] : m.blockMass(b, k);
+    const double mk = m.keepsMasses() ? masses[k] : m.blockMass(b, k);
     if (!(mk > 0.0)) continue;
     chosen = k;
     chosen_mass = mk;

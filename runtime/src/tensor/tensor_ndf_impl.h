@@ -61,13 +61,13 @@ struct TensorNdf::Impl {
   // Raw (unclamped) integral of the blended block over [x0, x1] x [y0, y1] in block-local bin
   // coordinates (0 <= x0 <= x1 <= B, rows from the top), in bin-area units.
   double blockRangeIntegral(const Blend& b, uint64_t block, double x0, double x1, double y0, double y1) const;
-  // Blended clamped mass of one block, max(0, sum_t w_t m_t), and of the whole blend. With masses
-  // (room for kMassBlocks), totalMass also writes every block's clamped mass there (the same
-  // bits as blockMass), when the image has at most kMassBlocks blocks; returns false in *kept
-  // otherwise.
+  // Blended clamped mass of one block, max(0, sum_t w_t m_t), and of the whole blend. When
+  // keepsMasses(), totalMass also writes every block's clamped mass to `masses` (room for
+  // kMassBlocks; the same bits as blockMass).
   static constexpr uint64_t kMassBlocks = 256;
+  bool keepsMasses() const { return nb2 <= kMassBlocks; }
   double blockMass(const Blend& b, uint64_t block) const;
-  double totalMass(const Blend& b, double* masses = nullptr, bool* kept = nullptr) const;
+  double totalMass(const Blend& b, double* masses = nullptr) const;
   // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf().
   double binPdf(const Blend& b, int i, int j) const;
   // Image bin column (or row) n -> block column `block` and bin within it `local`.
