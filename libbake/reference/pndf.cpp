@@ -51,12 +51,17 @@ double lobeDensity(const FlakeLobe& lobe, double sx, double sy) {
   return lobe.weight / (kTwoPi * std::sqrt(det)) * std::exp(-0.5 * q);
 }
 
-std::vector<FlakeLobe> footprintLobes(const FlakeSet& set, const Footprint& fp, double sigma_r) {
+void footprintLobes(const FlakeSet& set, const Footprint& fp, double sigma_r, std::vector<FlakeLobe>* lobes) {
   GLINTBAKE_CHECK(fp.sigma > 0.0 && sigma_r > 0.0);
-  std::vector<FlakeLobe> lobes;
+  lobes->clear();
   detail::forEachFlakeInFootprint(set, fp, [&](const Flake& flake, double ux, double uy) {
-    lobes.push_back(flakeLobe(set, flake, ux, uy, fp, sigma_r));
+    lobes->push_back(flakeLobe(set, flake, ux, uy, fp, sigma_r));
   });
+}
+
+std::vector<FlakeLobe> footprintLobes(const FlakeSet& set, const Footprint& fp, double sigma_r) {
+  std::vector<FlakeLobe> lobes;
+  footprintLobes(set, fp, sigma_r, &lobes);
   return lobes;
 }
 

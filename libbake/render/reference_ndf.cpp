@@ -9,34 +9,31 @@ namespace glintbake::bake::render {
 
 using runtime::RuntimeStatus;
 
-ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r)
-    : map_size_{flakes.width, flakes.height},
-      wrap_(flakes.wrap == bake::Wrap::kRepeat ? runtime::MapWrap::kRepeat : runtime::MapWrap::kClamp) {
+ReferencePndf::ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r) {
+  gather(flakes, footprint, sigma_r);
+}
+
+void ReferencePndf::gather(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r) {
+  map_size_ = runtime::MapSize{flakes.width, flakes.height};
+  wrap_ = flakes.wrap == bake::Wrap::kRepeat ? runtime::MapWrap::kRepeat : runtime::MapWrap::kClamp;
   reference::Footprint fp;
   fp.x = footprint.x;
   fp.y = footprint.y;
   fp.sigma = footprint.sigma;
-  const std::vector<reference::FlakeLobe> lobes = reference::footprintLobes(flakes, fp, sigma_r);
-  lobes_.reserve(lobes.size());
-  cdf_.reserve(lobes.size());
-  for (const reference::FlakeLobe& l : lobes) {
-    if (!(l.weight > 0.0)) continue;
-    Lobe e;
-    e.lobe = l;
-    const double l00 = std::sqrt(l.cov[0]);
-    const double l10 = l.cov[1] / l00;
-    e.chol[0] = l00;
-    e.chol[1] = l10;
-    e.chol[2] = std::sqrt(std::max(0.0, l.cov[2] - l10 * l10));
-    lobes_.push_back(e);
-    total_ += l.weight;
-    cdf_.push_back(total_);
+  reference::footprintLobes(flakes, fp, sigma_r, &lobes_);
+  lobes_.erase(std::remove_if(lobes_.begin(), lobes_.end(), [](const reference::FlakeLobe& l) { return !(l.weight > 0.0); }),
+               lobes_.end());
+  cdf_.resize(lobes_.size());
+  total_ = 0.0;
+  for (size_t k = 0; k < lobes_.size(); ++k) {
+    total_ += lobes_[k].weight;
+    cdf_[k] = total_;
   }
 }
 
 double ReferencePndf::evalSum(double sx, double sy) const {
   double sum = 0.0;
-  for (const Lobe& l : lobes_) sum += reference::lobeDensity(l.lobe, sx, sy);
+  for (const reference::FlakeLobe& l : lobes_) sum += reference::lobeDensity(l, sx, sy);
   return sum;
 }
 
@@ -55,9 +52,8 @@ RuntimeStatus ReferencePndf::eval(const runtime::Footprint&, const runtime::SPoi
 RuntimeStatus ReferencePndf::average(const runtime::Footprint&, const runtime::SRect& rect, double* value) const {
   if (!(rect.x1 > rect.x0) || !(rect.y1 > rect.y0)) return RuntimeStatus::kInvalidArgument;
   double sum = 0.0;
-  for (const Lobe& l : lobes_) {
-    sum += l.lobe.weight *
-           reference::gaussianRectangleIntegral(l.lobe.mean, l.lobe.cov, rect.x0, rect.x1, rect.y0, rect.y1);
+  for (const reference::FlakeLobe& l : lobes_) {
+    sum += l.weight * reference::gaussianRectangleIntegral(l.mean, l.cov, rect.x0, rect.x1, rect.y0, rect.y1);
   }
   *value = sum / ((rect.x1 - rect.x0) * (rect.y1 - rect.y0));
   return RuntimeStatus::kOk;
@@ -76,9 +72,13 @@ RuntimeStatus ReferencePndf::sample(const runtime::Footprint&, double u1, double
   const double r = std::sqrt(-2.0 * std::log1p(-v1));
   const double phi = 2.0 * 3.14159265358979323846 * u2;
   const double z0 = r * std::cos(phi), z1 = r * std::sin(phi);
-  const Lobe& l = lobes_[k];
-  out->s.x = l.lobe.mean[0] + l.chol[0] * z0;
-  out->s.y = l.lobe.mean[1] + l.chol[1] * z0 + l.chol[2] * z1;
+  // s = mean + L z with L the lower Cholesky factor of the lobe's covariance.
+  const reference::FlakeLobe& l = lobes_[k];
+  const double l00 = std::sqrt(l.cov[0]);
+  const double l10 = l.cov[1] / l00;
+  const double l11 = std::sqrt(std::max(0.0, l.cov[2] - l10 * l10));
+  out->s.x = l.mean[0] + l00 * z0;
+  out->s.y = l.mean[1] + l10 * z0 + l11 * z1;
   out->pdf = evalSum(out->s.x, out->s.y) / total_;
   return RuntimeStatus::kOk;
 }

@@ -8,7 +8,8 @@
 //    which pdf() returns;
 //  - average: the exact rectangle integral of every lobe over the rectangle's area;
 //  - mass: the total lobe weight; image: not offered (kInvalidArgument).
-// Not shared between threads (one per pixel); const queries do not allocate.
+// Not shared between threads; gather() re-aims one at another footprint, reusing its storage (a
+// renderer keeps one per tile). Const queries do not allocate.
 #pragma once
 
 #include <glintbake/reference/pndf.h>
@@ -21,7 +22,10 @@ namespace glintbake::bake::render {
 
 class ReferencePndf final : public runtime::NdfSource {
  public:
+  ReferencePndf() = default;
   ReferencePndf(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r);
+  // Gathers the lobes of another footprint (replacing the current ones).
+  void gather(const reference::FlakeSet& flakes, const runtime::Footprint& footprint, double sigma_r);
 
   // Not a container asset: kind kUnknown; every footprint is answered exactly.
   format::AssetKind kind() const override { return format::AssetKind::kUnknown; }
@@ -40,11 +44,7 @@ class ReferencePndf final : public runtime::NdfSource {
   }
 
  private:
-  struct Lobe {
-    reference::FlakeLobe lobe;
-    double chol[3];  // lower Cholesky factor of the covariance {l00, l10, l11}
-  };
-  std::vector<Lobe> lobes_;
+  std::vector<reference::FlakeLobe> lobes_;  // the footprint's lobes of positive weight
   std::vector<double> cdf_;  // running weight sums
   double total_ = 0.0;
   runtime::MapSize map_size_;

@@ -431,6 +431,7 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
   tbb::parallel_for(
       tbb::blocked_range2d<int>(0, cam.height, kTile, 0, cam.width, kTile), [&](const tbb::blocked_range2d<int>& tile) {
         if (failed.load() || (options.cancel != nullptr && options.cancel->load())) return;
+        ReferencePndf ref;  // --ndf reference: one lobe store per tile, re-aimed at each pixel
         for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
           for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
             const size_t index = size_t(y) * cam.width + x;
@@ -450,7 +451,7 @@ Result<RenderedImage> renderScene(const Scene& scene, const NdfInputs& inputs, c
                 ok = shader.shade(MicrofacetBrdf::glinty(inputs.asset, fp, model, mat.alpha, fresnel), hit, wo, index,
                                   &color);
               } else {
-                const ReferencePndf ref(*inputs.flakes, fp, mat.sigma_r);
+                ref.gather(*inputs.flakes, fp, mat.sigma_r);
                 ok = shader.shade(MicrofacetBrdf::glinty(&ref, fp, model, mat.alpha, fresnel), hit, wo, index, &color);
               }
               if (!ok) failed.store(true);

@@ -71,6 +71,7 @@ void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
     b->weight[b->count] = weight;
     b->index[b->count] = lv.index.data + first;
     b->mass[b->count] = lv.mass.data + first;
+    b->centre_mass[b->count] = nonneg ? lv.centre_mass.data[centre] : 0.0;
     ++b->count;
   });
 }
@@ -158,6 +159,33 @@ double TensorNdf::Impl::totalMass(const Blend& b, double* masses) const {
   return total;
 }
 
+double TensorNdf::Impl::mixtureMass(const Blend& b) const {
+  double total = 0.0;
+  for (int t = 0; t < b.count; ++t) total += b.weight[t] * b.centre_mass[t];
+  return total;
+}
+
+double TensorNdf::Impl::binValue(const Blend& b, uint64_t block, int bi, int bj) const {
+  // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
+  // first summing the terms' C rows: a point needs only R products per term); the terms' weighted
+  // lane sums share one final reduction.
+  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int t = 0; t < b.count; ++t) {
+    const TensorIndexEntry& e = b.index[t][block];
+    if (e.group == kTensorBlankGroup) continue;
+    const CpGroupView& v = groups.data[e.group].view;
+    const size_t rank = size_t(v.rank);
+    if (v.identity_a) {  // an exact block: one stored value
+      lanes[0] += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
+      continue;
+    }
+    laneAccumulateDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
+                       float(b.weight[t]), lanes);
+  }
+  const float sum = laneTotal(lanes);
+  return sum > 0.0f ? double(sum) : 0.0;
+}
+
 double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
   double masses[kMassBlocks];
   const double total = totalMass(b, masses);
@@ -187,25 +215,7 @@ RuntimeStatus TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s
   int bx, by, bi, bj;
   m.splitBin(i, &bx, &bi);
   m.splitBin(j, &by, &bj);
-  const uint64_t block = uint64_t(by) * uint64_t(m.nb) + uint64_t(bx);
-  // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
-  // first summing the terms' C rows: a point needs only R products per term); the terms' weighted
-  // lane sums share one final reduction.
-  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  for (int t = 0; t < b.count; ++t) {
-    const TensorIndexEntry& e = b.index[t][block];
-    if (e.group == kTensorBlankGroup) continue;
-    const CpGroupView& v = m.groups.data[e.group].view;
-    const size_t rank = size_t(v.rank);
-    if (v.identity_a) {  // an exact block: one stored value
-      lanes[0] += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
-      continue;
-    }
-    laneAccumulateDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
-                       float(b.weight[t]), lanes);
-  }
-  const float sum = laneTotal(lanes);
-  *value = sum > 0.0f ? double(sum) : 0.0;
+  *value = m.binValue(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), bi, bj);
   return RuntimeStatus::kOk;
 }
 
@@ -251,7 +261,7 @@ RuntimeStatus TensorNdf::averageChecked(const Footprint& footprint, const SRect&
 RuntimeStatus TensorNdf::massChecked(const Footprint& footprint, double* value) const {
   Impl::Blend b;
   impl_->blend(footprint, &b);
-  *value = impl_->totalMass(b);
+  *value = impl_->nonneg ? impl_->mixtureMass(b) : impl_->totalMass(b);
   return RuntimeStatus::kOk;
 }
 
@@ -264,58 +274,112 @@ RuntimeStatus TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s,
   }
   Impl::Blend b;
   m.blend(footprint, &b);
+  if (m.nonneg) {
+    // The mixture's density (sampleMixture): eval over mass.
+    const double total = m.mixtureMass(b);
+    int bx, by, bi, bj;
+    m.splitBin(bin % m.res, &bx, &bi);
+    m.splitBin(bin / m.res, &by, &bj);
+    *value = total > 0.0 ? m.binValue(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), bi, bj) / total : 0.0;
+    return RuntimeStatus::kOk;
+  }
   *value = m.binPdf(b, bin % m.res, bin / m.res);
   return RuntimeStatus::kOk;
+}
+
+namespace {
+
+// The walk of a discrete pick: the last entry with positive mass whose running sum passes target
+// (rounding may run past the last entry with mass: it is kept); `u` gets the position within the
+// chosen entry, rescaled to [0, 1).
+template <typename MassOf>
+uint64_t pickByMass(uint64_t count, double target, MassOf&& mass_of, double* chosen_mass, double* u) {
+  double before = 0.0;
+  uint64_t chosen = 0;
+  *chosen_mass = 0.0;
+  for (uint64_t k = 0; k < count; ++k) {
+    const double mk = mass_of(k);
+    if (!(mk > 0.0)) continue;
+    chosen = k;
+    *chosen_mass = mk;
+    if (target < before + mk) break;
+    before += mk;
+  }
+  const double v = (target - before) / *chosen_mass;
+  *u = v < kOneMinusEpsilon ? (v > 0.0 ? v : 0.0) : kOneMinusEpsilon;
+  return chosen;
+}
+
+}  // namespace
+
+void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi,
+                                   int* bj, double* p) const {
+  const int bx = int(block % uint64_t(nb)), by = int(block / uint64_t(nb));
+  double x, y;
+  CpBlockSample cs;
+  if (mix.blockMass() > 0.0f && mix.sample(u1, u2, &cs)) {
+    x = cs.x;
+    y = cs.y;
+    *bi = cs.i;
+    *bj = cs.j;
+    *p = cs.pdf;
+  } else {
+    x = u1 * bins;
+    y = u2 * bins;
+    *bi = std::min(bins - 1, int(x));
+    *bj = std::min(bins - 1, int(y));
+    *p = 1.0 / (double(bins) * bins);
+  }
+  const int col = bx * bins + *bi, row = by * bins + *bj;
+  *s = SPoint{-1.0 + (bx * bins + x) * bin, 1.0 - (by * bins + y) * bin};
+  // Rounding of the s-plane conversion must not move the point into a neighbouring bin (pdf()
+  // locates the bin from s): fall back to the bin centre in that rare case.
+  if (binOf(s->x, s->y) != row * res + col) *s = SPoint{-1.0 + (col + 0.5) * bin, 1.0 - (row + 0.5) * bin};
 }
 
 RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
   Impl::Blend b;
   m.blend(footprint, &b);
+  CpMix mix;
+  SPoint s;
+  int bi, bj;
+  double p;
+  if (m.nonneg) {
+    // Every term is non-negative, so the blend sum_t w_t NDF_t is a mixture: a centre by its
+    // weighted mass w_t M_t, a block of that centre by its mass, and a point of that one block.
+    // The density is then eval / mass wherever the point lands, whatever path drew it: no
+    // per-block blend of every centre's masses (nb^2 x centres) and a one-term CpMix.
+    const double total = m.mixtureMass(b);
+    if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
+    double term_mass, block_mass;
+    const uint64_t t = pickByMass(
+        uint64_t(b.count), u1 * total, [&](uint64_t k) { return b.weight[k] * b.centre_mass[k]; }, &term_mass, &u1);
+    const double* masses = b.mass[t];
+    const uint64_t block =
+        pickByMass(m.nb2, u1 * b.centre_mass[t], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
+    // A block with positive mass is never blank (blank blocks weigh 0).
+    const TensorIndexEntry& e = b.index[t][block];
+    const CpBlendTerm one{&m.groups.data[e.group].view, int32_t(e.row), 1.0f, float(block_mass * m.inv_bin_area)};
+    mix.init(&one, 1);
+    m.pointInBlock(mix, block, u1, u2, &s, &bi, &bj, &p);
+    out->s = s;
+    // pdf() forms the same quotient. A point whose blended value rounds to 0 (not seen on valid
+    // assets) reports density 0, as pdf() does there.
+    out->pdf = m.binValue(b, block, bi, bj) / total;
+    return RuntimeStatus::kOk;
+  }
   double masses[Impl::kMassBlocks];
   const double total = m.totalMass(b, masses);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
-
   // 1. Block by clamped blended mass; u1 is rescaled to [0, 1) within the chosen block.
-  const double target = u1 * total;
-  double before = 0.0, chosen_mass = 0.0;
-  uint64_t chosen = 0;
-  for (uint64_t k = 0; k < m.nb2; ++k) {
-    const double mk = m.keepsMasses() ? masses[k] : m.blockMass(b, k);
-    if (!(mk > 0.0)) continue;
-    chosen = k;
-    chosen_mass = mk;
-    if (target < before + mk) break;
-    before += mk;  // rounding may run past the last block with mass: it is kept
-  }
-  u1 = (target - before) / chosen_mass;
-  u1 = u1 < kOneMinusEpsilon ? (u1 > 0.0 ? u1 : 0.0) : kOneMinusEpsilon;
-
+  double chosen_mass;
+  const uint64_t chosen = pickByMass(
+      m.nb2, u1 * total, [&](uint64_t k) { return m.keepsMasses() ? masses[k] : m.blockMass(b, k); }, &chosen_mass,
+      &u1);
   // 2. Bin and point inside the block.
-  const int bx = int(chosen % uint64_t(m.nb)), by = int(chosen / uint64_t(m.nb));
-  CpMix mix;
   m.mixBlock(b, chosen, &mix);
-  double x, y, p;
-  int i, j;
-  CpBlockSample cs;
-  if (mix.blockMass() > 0.0f && mix.sample(u1, u2, &cs)) {
-    x = cs.x;
-    y = cs.y;
-    i = cs.i;
-    j = cs.j;
-    p = cs.pdf;
-  } else {
-    x = u1 * m.bins;
-    y = u2 * m.bins;
-    i = std::min(m.bins - 1, int(x));
-    j = std::min(m.bins - 1, int(y));
-    p = 1.0 / (double(m.bins) * m.bins);
-  }
-  const int col = bx * m.bins + i, row = by * m.bins + j;
-  SPoint s{-1.0 + (bx * m.bins + x) * m.bin, 1.0 - (by * m.bins + y) * m.bin};
-  // Rounding of the s-plane conversion must not move the point into a neighbouring bin (pdf()
-  // locates the bin from s): fall back to the bin centre in that rare case.
-  if (m.binOf(s.x, s.y) != row * m.res + col) s = SPoint{-1.0 + (col + 0.5) * m.bin, 1.0 - (row + 0.5) * m.bin};
+  m.pointInBlock(mix, chosen, u1, u2, &s, &bi, &bj, &p);
   out->s = s;
   out->pdf = combinePdf(chosen_mass, total, p, m.bin_area);
   return RuntimeStatus::kOk;

@@ -24,6 +24,7 @@ struct TensorNdf::Impl {
     NdfLevelRecord rec;
     Array<TensorIndexEntry> index;  // [centre * nb2 + block]
     Array<double> mass;             // raw block integral over its s-plane area (0 for blank blocks)
+    Array<double> centre_mass;      // non-negative assets: the sum of each centre's block masses
   };
   // The weighted centres of the footprint blend (format::NdfPyramidBlend), as NdfPyramid blends them.
   struct Blend {
@@ -31,6 +32,7 @@ struct TensorNdf::Impl {
     double weight[format::kMaxBlendCentres];
     const TensorIndexEntry* index[format::kMaxBlendCentres];  // the centre's nb2 entries
     const double* mass[format::kMaxBlendCentres];             // the centre's nb2 raw masses
+    double centre_mass[format::kMaxBlendCentres];             // non-negative assets: their sum
   };
 
   TensorInfoRecord info;
@@ -68,8 +70,16 @@ struct TensorNdf::Impl {
   bool keepsMasses() const { return nb2 <= kMassBlocks; }
   double blockMass(const Blend& b, uint64_t block) const;
   double totalMass(const Blend& b, double* masses = nullptr) const;
-  // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf().
+  // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf(). Signed models.
   double binPdf(const Blend& b, int i, int j) const;
+  // The clamped blended model value of bin (bi, bj) of block `block` (eval()).
+  double binValue(const Blend& b, uint64_t block, int bi, int bj) const;
+  // Non-negative models: the blend's mass as a mixture, sum_t w_t M_t (M_t the centre's mass).
+  double mixtureMass(const Blend& b) const;
+  // Draws a point of block `block` from `mix` (uniformly when its float mass is 0): the s-plane
+  // point, its bin (bi, bj) within the block and the within-block density p (per unit bin area).
+  void pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi, int* bj,
+                    double* p) const;
   // Image bin column (or row) n -> block column `block` and bin within it `local`.
   void splitBin(int n, int* block, int* local) const {
     if (bins_shift >= 0) {

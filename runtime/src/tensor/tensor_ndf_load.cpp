@@ -101,13 +101,16 @@ RuntimeStatus TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Ar
   const int idx = reader.find(format::kSectionTensorIndex, uint64_t(l));
   if (RuntimeStatus s = readExact(reader, idx, entries * sizeof(TensorIndexEntry), scratch); s != RuntimeStatus::kOk)
     return s;
-  if (!lv.index.allocate(size_t(entries)) || !lv.mass.allocate(size_t(entries))) return RuntimeStatus::kOutOfMemory;
+  if (!lv.index.allocate(size_t(entries)) || !lv.mass.allocate(size_t(entries)) ||
+      (nonneg && !lv.centre_mass.allocate(size_t(centres))))
+    return RuntimeStatus::kOutOfMemory;
   std::memcpy(lv.index.data, scratch->data, size_t(entries) * sizeof(TensorIndexEntry));
-  memory_bytes += entries * (sizeof(TensorIndexEntry) + sizeof(double));
+  memory_bytes += entries * (sizeof(TensorIndexEntry) + sizeof(double)) + (nonneg ? centres * sizeof(double) : 0);
   const uint32_t b = info.block;
   for (uint64_t c = 0; c < centres; ++c) {
     const uint32_t cx = uint32_t(c % rec.grid_width), cy = uint32_t(c / rec.grid_width);
     const uint32_t region = (cy / rec.region_size) * rec.regions_x + cx / rec.region_size;
+    double centre_mass = 0.0;
     for (uint64_t blk = 0; blk < nb2; ++blk) {
       const uint64_t e_index = c * nb2 + blk;
       const TensorIndexEntry& e = lv.index.data[e_index];
@@ -128,9 +131,13 @@ RuntimeStatus TensorNdf::Impl::loadIndex(const format::Reader& reader, int l, Ar
       const float* crow = g.view.c + size_t(e.row) * rank;
       double m = 0.0;
       for (int32_t r = 0; r < rank; ++r) m += (double(pa1[r]) - pa0[r]) * (double(pb1[r]) - pb0[r]) * double(crow[r]);
+      // Non-negative factors and monotone prefix sums give m >= 0: anything else is corrupt.
+      if (nonneg && !(m >= 0.0)) return RuntimeStatus::kInvalidAsset;
       lv.mass.data[e_index] = m * bin_area;
+      centre_mass += m * bin_area;
       ++blocks_kept;
     }
+    if (nonneg) lv.centre_mass.data[c] = centre_mass;
   }
   return RuntimeStatus::kOk;
 }

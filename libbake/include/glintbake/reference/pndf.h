@@ -59,6 +59,9 @@ double lobeDensity(const FlakeLobe& lobe, double sx, double sy);
 // wrap=clamp there are no flakes outside the map.
 // Cost: about pi (6 sqrt(sigma_h^2 + sigma^2) rate)^2 lobes of 64 bytes. Thread-safe.
 std::vector<FlakeLobe> footprintLobes(const FlakeSet& set, const Footprint& fp, double sigma_r);
+// The same into *lobes (cleared first), reusing its capacity: callers that gather one footprint
+// after another (a renderer's pixels) allocate once.
+void footprintLobes(const FlakeSet& set, const Footprint& fp, double sigma_r, std::vector<FlakeLobe>* lobes);
 
 // Sum of the lobe weights: the integral of D over the whole s-plane (about 1 away from clamped
 // edges and for sigma >~ 1 texel; smaller footprints see the flake lattice). Thread-safe.

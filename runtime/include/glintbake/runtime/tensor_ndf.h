@@ -21,18 +21,23 @@
 //    cumulative sums (prefix sum of the whole bins plus the covered fraction of each end bin) and
 //    is clamped at 0. Cost is independent of the rectangle size except for the number of blocks it
 //    spans (at most nb^2).
-//  - sample: picks a block with probability proportional to its blended clamped mass
-//    max(0, sum_t w_t m_t) (raw masses m_t of every (centre, block) are precomputed by open(), so
-//    this costs 8 x nb^2 loads), then descends the block's quadtree (CpMix::sample) and jitters in
-//    the bin. pdf() returns exactly (bit for bit) the density sample() reported for a point, and
-//    mass() is the sum of the clamped block masses that both normalise by.
-// For assets with non-negative factors (TensorInfoRecord flag bit 0) the clamps never bite and
-// eval, average, pdf * mass agree up to float rounding; for signed models they differ where the
-// model dips below 0 (then pdf * mass is not eval, but pdf still matches sample).
+//  - sample, non-negative assets (TensorInfoRecord flag bit 0, factors checked >= 0 by open()):
+//    every blended term is non-negative, so the blend is the mixture sum_t w_t NDF_t. sample picks
+//    a centre with probability w_t M_t / sum (M_t the centre's mass), a block of it by its mass,
+//    then descends that one block's quadtree (CpMix::sample) and jitters in the bin; the density
+//    reported is eval / mass, and pdf() forms the same quotient (bit for bit). Cost: eval plus a
+//    walk over the centres and one centre's nb^2 masses (precomputed by open()).
+//  - sample, signed models: picks a block with probability proportional to its blended clamped
+//    mass max(0, sum_t w_t m_t) (8 x nb^2 x centres loads), then descends the block's blended
+//    quadtree. pdf() returns exactly the density sample() reported for a point, and mass() is the
+//    sum of the clamped block masses that both normalise by.
+// For non-negative assets the clamps never bite and eval, average and pdf * mass agree up to float
+// rounding; for signed models they differ where the model dips below 0 (then pdf * mass is not
+// eval, but pdf still matches sample).
 //
 // Memory: every group's factors are loaded by open() (float16 factors are widened to float32),
-// plus 8 bytes of index and 8 bytes of raw mass per (centre, block). Queries never allocate, never
-// throw, are const and thread-safe. open() is safe on untrusted input: every record, index entry,
+// plus 8 bytes of index and 8 bytes of raw mass per (centre, block) and, for non-negative assets, 8
+// bytes of mass per centre. Queries never allocate, never throw, are const and thread-safe. open() is safe on untrusted input: every record, index entry,
 // group header and section size is checked (SPEC 10.4 "Readers MUST ...") and every stored value
 // must be finite and of bounded magnitude, so that no query can overflow; anything else is
 // kInvalidAsset.
