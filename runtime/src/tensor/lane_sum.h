@@ -40,25 +40,70 @@ inline void laneAccumulate(int32_t n, Term term, T w, T lanes[4]) {
 // lanes[k] += w * sum_{r % 4 == k} a[r] b[r] c[r] in float: laneAccumulate of the triple product,
 // with one SSE2 register as the four lanes when n is a multiple of 4 (every lane sees the same
 // additions in the same order, so both paths give the same bits).
+#if GLINTBAKE_RUNTIME_SSE2
+// The four lane sums of a[r] b[r] c[r] for n a multiple of 4, in one register.
+inline __m128 laneDot3Sse(const float* a, const float* b, const float* c, int32_t n) {
+  auto term = [=](int32_t r) {
+    return _mm_mul_ps(_mm_mul_ps(_mm_loadu_ps(a + r), _mm_loadu_ps(b + r)), _mm_loadu_ps(c + r));
+  };
+  __m128 s = _mm_setzero_ps();
+  if (n == 16) {  // the default rank, unrolled (same additions, same order)
+    s = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(s, term(0)), term(4)), term(8)), term(12));
+  } else {
+    for (int32_t r = 0; r < n; r += 4) s = _mm_add_ps(s, term(r));
+  }
+  return s;
+}
+#endif
+
 inline void laneAccumulateDot3(const float* a, const float* b, const float* c, int32_t n, float w, float lanes[4]) {
 #if GLINTBAKE_RUNTIME_SSE2
   if ((n & 3) == 0) {
-    auto term = [=](int32_t r) {
-      return _mm_mul_ps(_mm_mul_ps(_mm_loadu_ps(a + r), _mm_loadu_ps(b + r)), _mm_loadu_ps(c + r));
-    };
-    __m128 s = _mm_setzero_ps();
-    if (n == 16) {  // the default rank, unrolled (same additions, same order)
-      s = _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(s, term(0)), term(4)), term(8)), term(12));
-    } else {
-      for (int32_t r = 0; r < n; r += 4) s = _mm_add_ps(s, term(r));
-    }
-    _mm_storeu_ps(lanes, _mm_add_ps(_mm_loadu_ps(lanes), _mm_mul_ps(_mm_set1_ps(w), s)));
+    _mm_storeu_ps(lanes, _mm_add_ps(_mm_loadu_ps(lanes), _mm_mul_ps(_mm_set1_ps(w), laneDot3Sse(a, b, c, n))));
     return;
   }
 #endif
   laneAccumulate<float>(
       n, [=](int32_t r) { return a[r] * b[r] * c[r]; }, w, lanes);
 }
+
+// Running lanes of laneAccumulateDot3 kept in a register between terms (the same additions, so
+// the same bits as a float[4]): a sum over hundreds of terms does not store and reload its lanes
+// for every term.
+class Dot3Lanes {
+ public:
+  void add(const float* a, const float* b, const float* c, int32_t n, float w) {
+#if GLINTBAKE_RUNTIME_SSE2
+    if ((n & 3) == 0) {
+      v_ = _mm_add_ps(v_, _mm_mul_ps(_mm_set1_ps(w), laneDot3Sse(a, b, c, n)));
+      return;
+    }
+    float lanes[4];
+    _mm_storeu_ps(lanes, v_);
+    laneAccumulateDot3(a, b, c, n, w, lanes);
+    v_ = _mm_loadu_ps(lanes);
+#else
+    laneAccumulateDot3(a, b, c, n, w, v_);
+#endif
+  }
+  // (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]), as laneTotal.
+  float total() const {
+#if GLINTBAKE_RUNTIME_SSE2
+    float lanes[4];
+    _mm_storeu_ps(lanes, v_);
+    return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+#else
+    return (v_[0] + v_[1]) + (v_[2] + v_[3]);
+#endif
+  }
+
+ private:
+#if GLINTBAKE_RUNTIME_SSE2
+  __m128 v_ = _mm_setzero_ps();
+#else
+  float v_[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+#endif
+};
 
 template <typename T>
 inline T laneTotal(const T lanes[4]) {

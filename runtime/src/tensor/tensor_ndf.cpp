@@ -100,7 +100,8 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
   const Span sx(x0, x1, bins), sy(y0, y1, bins);
   const CpGroupView* current = nullptr;
   float ex[kCpMaxRank], ey[kCpMaxRank];
-  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  Dot3Lanes lanes;
+  float exact = 0.0f;  // the exact blocks' terms (as binValue)
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup || b.weight[t] == 0.0) continue;
@@ -116,7 +117,7 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
         if (!(wx > 0.0f)) continue;
         sum += wx * crow[r] * sy.column(v->b, v->b_prefix, rank, r);
       }
-      lanes[0] += float(b.weight[t]) * sum;
+      exact += float(b.weight[t]) * sum;
       continue;
     }
     if (v != current) {
@@ -124,9 +125,9 @@ double TensorNdf::Impl::blockRangeIntegral(const Blend& b, uint64_t block, doubl
       sy.extents(v->b, v->b_prefix, rank, ey);
       current = v;
     }
-    laneAccumulateDot3(ex, ey, v->c + size_t(e.row) * size_t(rank), rank, float(b.weight[t]), lanes);
+    lanes.add(ex, ey, v->c + size_t(e.row) * size_t(rank), rank, float(b.weight[t]));
   }
-  return double(laneTotal(lanes));
+  return double(lanes.total() + exact);
 }
 
 double TensorNdf::Impl::blockMass(const Blend& b, uint64_t block) const {
@@ -168,21 +169,23 @@ double TensorNdf::Impl::mixtureMass(const Blend& b) const {
 double TensorNdf::Impl::binValue(const Blend& b, uint64_t block, int bi, int bj) const {
   // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
   // first summing the terms' C rows: a point needs only R products per term); the terms' weighted
-  // lane sums share one final reduction.
-  float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  // lane sums share one final reduction. Exact blocks (one stored value per term; the top levels
+  // blend up to hundreds of them) add into a sum of their own, kept in a register.
+  Dot3Lanes lanes;
+  float exact = 0.0f;
   for (int t = 0; t < b.count; ++t) {
     const TensorIndexEntry& e = b.index[t][block];
     if (e.group == kTensorBlankGroup) continue;
     const CpGroupView& v = groups.data[e.group].view;
     const size_t rank = size_t(v.rank);
     if (v.identity_a) {  // an exact block: one stored value
-      lanes[0] += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
+      exact += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
       continue;
     }
-    laneAccumulateDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
-                       float(b.weight[t]), lanes);
+    lanes.add(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
+              float(b.weight[t]));
   }
-  const float sum = laneTotal(lanes);
+  const float sum = lanes.total() + exact;
   return sum > 0.0f ? double(sum) : 0.0;
 }
 
