@@ -191,9 +191,11 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   cli::resolvePyramidOptions(o.pyramid);
   const int ndf_res = o.pyramid.options.splat.ndf_res;
   // The automatic level count may stop only once the pyramid has reached the levels stored exactly
-  // (side^2 R^2 4 bytes within the budget), so that the top level is not a lossy one.
+  // (side^2 R^2 4 bytes within the budget), so that the top level is not a lossy one, and never
+  // before its top grid fits the runtime's whole-grid blend (the builder's default).
   const double exact_side = std::sqrt(double(o.pack.exact_level_bytes) / (4.0 * double(ndf_res) * double(ndf_res)));
-  o.pyramid.options.converge_from_grid = int(std::min(exact_side, 16.0));  // kMaxExactCentres = 16 x 16
+  const int exact_grid = int(std::min(exact_side, 16.0));  // kMaxExactCentres = 16 x 16
+  if (exact_grid >= 1) o.pyramid.options.converge_from_grid = std::min(exact_grid, o.pyramid.options.converge_from_grid);
   o.pyramid.options.converge_from_level = o.pack.exact_level_bytes > 0 ? 1 : 0;
   if (ndf_res % o.pack.block != 0) {
     throw Error(cli::kExitBadArguments,
