@@ -21,8 +21,9 @@ void ReferencePndf::gather(const reference::FlakeSet& flakes, const runtime::Foo
   fp.y = footprint.y;
   fp.sigma = footprint.sigma;
   reference::footprintLobes(flakes, fp, sigma_r, &lobes_);
-  lobes_.erase(std::remove_if(lobes_.begin(), lobes_.end(), [](const reference::FlakeLobe& l) { return !(l.weight > 0.0); }),
-               lobes_.end());
+  lobes_.erase(
+      std::remove_if(lobes_.begin(), lobes_.end(), [](const reference::FlakeLobe& l) { return !(l.weight > 0.0); }),
+      lobes_.end());
   cdf_.resize(lobes_.size());
   total_ = 0.0;
   for (size_t k = 0; k < lobes_.size(); ++k) {

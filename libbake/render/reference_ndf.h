@@ -45,7 +45,7 @@ class ReferencePndf final : public runtime::NdfSource {
 
  private:
   std::vector<reference::FlakeLobe> lobes_;  // the footprint's lobes of positive weight
-  std::vector<double> cdf_;  // running weight sums
+  std::vector<double> cdf_;                  // running weight sums
   double total_ = 0.0;
   runtime::MapSize map_size_;
   runtime::MapWrap wrap_ = runtime::MapWrap::kRepeat;

@@ -195,7 +195,8 @@ void readInput(cli::Tool& t, Options& o, Input& in, Json& params) {
   // before its top grid fits the runtime's whole-grid blend (the builder's default).
   const double exact_side = std::sqrt(double(o.pack.exact_level_bytes) / (4.0 * double(ndf_res) * double(ndf_res)));
   const int exact_grid = int(std::min(exact_side, 16.0));  // kMaxExactCentres = 16 x 16
-  if (exact_grid >= 1) o.pyramid.options.converge_from_grid = std::min(exact_grid, o.pyramid.options.converge_from_grid);
+  if (exact_grid >= 1)
+    o.pyramid.options.converge_from_grid = std::min(exact_grid, o.pyramid.options.converge_from_grid);
   o.pyramid.options.converge_from_level = o.pack.exact_level_bytes > 0 ? 1 : 0;
   if (ndf_res % o.pack.block != 0) {
     throw Error(cli::kExitBadArguments,

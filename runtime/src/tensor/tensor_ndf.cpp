@@ -182,8 +182,7 @@ double TensorNdf::Impl::binValue(const Blend& b, uint64_t block, int bi, int bj)
       exact += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
       continue;
     }
-    lanes.add(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank,
-              float(b.weight[t]));
+    lanes.add(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank, float(b.weight[t]));
   }
   const float sum = lanes.total() + exact;
   return sum > 0.0f ? double(sum) : 0.0;
@@ -315,8 +314,8 @@ uint64_t pickByMass(uint64_t count, double target, MassOf&& mass_of, double* cho
 
 }  // namespace
 
-void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi,
-                                   int* bj, double* p) const {
+void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi, int* bj,
+                                   double* p) const {
   const int bx = int(block % uint64_t(nb)), by = int(block / uint64_t(nb));
   double x, y;
   CpBlockSample cs;
@@ -359,8 +358,8 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
     const uint64_t t = pickByMass(
         uint64_t(b.count), u1 * total, [&](uint64_t k) { return b.weight[k] * b.centre_mass[k]; }, &term_mass, &u1);
     const double* masses = b.mass[t];
-    const uint64_t block =
-        pickByMass(m.nb2, u1 * b.centre_mass[t], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
+    const uint64_t block = pickByMass(
+        m.nb2, u1 * b.centre_mass[t], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
     // A block with positive mass is never blank (blank blocks weigh 0).
     const TensorIndexEntry& e = b.index[t][block];
     const CpBlendTerm one{&m.groups.data[e.group].view, int32_t(e.row), 1.0f, float(block_mass * m.inv_bin_area)};

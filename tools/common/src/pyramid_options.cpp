@@ -21,7 +21,9 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& r
       app.add_option("--stride", o.stride0, "Level-0 spacing of footprint centres, texels (> 0)")
           ->capture_default_str(),
       app.add_option("--sigma0", o.sigma0, "Level-0 footprint std, texels (> 0)")->capture_default_str(),
-      app.add_option("--levels", p.levels_text, "Number of levels, or auto (stop on convergence or a 1x1 grid)")
+      app.add_option("--levels", p.levels_text,
+                     "Number of levels, or auto (stop on convergence once the grid is at most 16 x 16, or at a 1x1 "
+                     "grid)")
           ->capture_default_str(),
       app.add_option("--converge-mse", o.converge_mse,
                      "auto levels: stop when the relative MSE between neighbouring levels is below this")

@@ -37,10 +37,10 @@
 //
 // Memory: every group's factors are loaded by open() (float16 factors are widened to float32),
 // plus 8 bytes of index and 8 bytes of raw mass per (centre, block) and, for non-negative assets, 8
-// bytes of mass per centre. Queries never allocate, never throw, are const and thread-safe. open() is safe on untrusted input: every record, index entry,
-// group header and section size is checked (SPEC 10.4 "Readers MUST ...") and every stored value
-// must be finite and of bounded magnitude, so that no query can overflow; anything else is
-// kInvalidAsset.
+// bytes of mass per centre. Queries never allocate, never throw, are const and thread-safe. open()
+// is safe on untrusted input: every record, index entry, group header and section size is checked
+// (SPEC 10.4 "Readers MUST ...") and every stored value must be finite and of bounded magnitude, so
+// that no query can overflow; anything else is kInvalidAsset.
 #pragma once
 
 #include <glintbake/runtime/cp_block.h>
