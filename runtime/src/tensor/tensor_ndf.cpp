@@ -188,6 +188,13 @@ double TensorNdf::Impl::binValue(const Blend& b, uint64_t block, int bi, int bj)
   return sum > 0.0f ? double(sum) : 0.0;
 }
 
+double TensorNdf::Impl::imageBinValue(const Blend& b, int i, int j) const {
+  int bx, by, bi, bj;
+  splitBin(i, &bx, &bi);
+  splitBin(j, &by, &bj);
+  return binValue(b, uint64_t(by) * uint64_t(nb) + uint64_t(bx), bi, bj);
+}
+
 double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
   double masses[kMassBlocks];
   const double total = totalMass(b, masses);
@@ -214,10 +221,7 @@ RuntimeStatus TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s
   }
   Impl::Blend b;
   m.blend(footprint, &b);
-  int bx, by, bi, bj;
-  m.splitBin(i, &bx, &bi);
-  m.splitBin(j, &by, &bj);
-  *value = m.binValue(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), bi, bj);
+  *value = m.imageBinValue(b, i, j);
   return RuntimeStatus::kOk;
 }
 
@@ -277,12 +281,9 @@ RuntimeStatus TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s,
   Impl::Blend b;
   m.blend(footprint, &b);
   if (m.nonneg) {
-    // The mixture's density (sampleMixture): eval over mass.
+    // The density sample() reports for the mixture: eval over mass.
     const double total = m.mixtureMass(b);
-    int bx, by, bi, bj;
-    m.splitBin(bin % m.res, &bx, &bi);
-    m.splitBin(bin / m.res, &by, &bj);
-    *value = total > 0.0 ? m.binValue(b, uint64_t(by) * uint64_t(m.nb) + uint64_t(bx), bi, bj) / total : 0.0;
+    *value = total > 0.0 ? m.imageBinValue(b, bin % m.res, bin / m.res) / total : 0.0;
     return RuntimeStatus::kOk;
   }
   *value = m.binPdf(b, bin % m.res, bin / m.res);

@@ -74,6 +74,8 @@ struct TensorNdf::Impl {
   double binPdf(const Blend& b, int i, int j) const;
   // The clamped blended model value of bin (bi, bj) of block `block` (eval()).
   double binValue(const Blend& b, uint64_t block, int bi, int bj) const;
+  // The same for bin (i, j) of the whole R x R image.
+  double imageBinValue(const Blend& b, int i, int j) const;
   // Non-negative models: the blend's mass as a mixture, sum_t w_t M_t (M_t the centre's mass).
   double mixtureMass(const Blend& b) const;
   // Draws a point of block `block` from `mix` (uniformly when its float mass is 0): the s-plane
