@@ -402,21 +402,23 @@ def main():
                 inputs.append(info[mode]["path"])
             else:
                 args += ["--ndf", mode]
-            doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
+            outputs = [exr, png]
+            if mode != "reference":  # MODES[0]: every other render is compared with it in its own run
+                heat = os.path.join(img_dir, f"{name}_{view}_{mode}_error.png")
+                args += ["--compare", renders["reference"]["exr"], "--heatmap", heat]
+                inputs.append(renders["reference"]["exr"])
+                outputs.append(heat)
+            doc, _ = runner.run(args, inputs=inputs, outputs=outputs, capture_json=True)
             renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
                              "sigma_mean": doc["footprint_sigma_texels"]["mean"],
                              "pixels_hit": doc["pixels_hit"],
                              "preview": os.path.relpath(png, out), "exr": exr}
-        ref_seconds = renders["reference"]["render_seconds"]
-        for mode in MODES[1:]:
-            heat = os.path.join(img_dir, f"{name}_{view}_{mode}_error.png")
-            r = renders[mode]
-            doc, _ = runner.run([tool("glintref"), "compare", r["exr"], renders["reference"]["exr"],
-                                 "--heatmap", heat, "--json"], inputs=[r["exr"], renders["reference"]["exr"]],
-                                outputs=[heat], capture_json=True)
-            r.update({"rmse": doc["rmse"], "relative_mse": doc["relative_mse"], "psnr": doc["psnr"],
-                      "heatmap": os.path.relpath(heat, out),
-                      "speedup": ref_seconds / r["render_seconds"] if r["render_seconds"] > 0 else None})
+            if mode != "reference":
+                c, r = doc["compare"], renders[mode]
+                ref_seconds = renders["reference"]["render_seconds"]
+                r.update({"rmse": c["rmse"], "relative_mse": c["relative_mse"], "psnr": c["psnr"],
+                          "heatmap": os.path.relpath(heat, out),
+                          "speedup": ref_seconds / r["render_seconds"] if r["render_seconds"] > 0 else None})
         for r in renders.values():
             del r["exr"]
         return renders
@@ -427,39 +429,35 @@ def main():
         x, y = round(0.37 * side, 1) + 0.5, round(0.61 * side, 1) + 0.5
         stem = os.path.join(work, f"{name}_ndf_{sigma_name(sigma)}")
         ref_exr = stem + "_reference.exr"
-        ref_doc, ref_seconds = runner.run(
-            [tool("glintref"), "image", info["map_path"], "--at", f"{x},{y}", "--sigma", sigma, "--res", 128,
-             "-o", ref_exr, "--json", "--quiet"] + threads, inputs=[info["map_path"]], outputs=[ref_exr],
-            capture_json=True)
+        show = sigma in show_sigmas
+        # Shown footprints also get PNGs, written by the run that evaluates the image; the assets' and
+        # the whole map's at the reference's scale (1 / its maximum), so that the four compare.
+        pngs = {m: os.path.join(img_dir, f"{name}_ndf_{sigma_name(sigma)}_{m}.png")
+                for m in ("reference", "pyramid", "tensor16", "whole")}
+        args = [tool("glintref"), "image", info["map_path"], "--at", f"{x},{y}", "--sigma", sigma, "--res", 128,
+                "-o", ref_exr, "--json", "--quiet"] + threads
+        if show:
+            args += ["--preview", pngs["reference"]]
+        ref_doc, ref_seconds = runner.run(args, inputs=[info["map_path"]],
+                                          outputs=[ref_exr] + ([pngs["reference"]] if show else []), capture_json=True)
         ref = read_exr(ref_exr)
         result = {"sigma": sigma, "at": [x, y], "reference_seconds": ref_seconds, "lobes": ref_doc["lobes"]}
-        show = sigma in show_sigmas
         scale = 1.0 / ref_doc["max"] if ref_doc["max"] > 0 else 1.0
         if show:
-            png = os.path.join(img_dir, f"{name}_ndf_{sigma_name(sigma)}_reference.png")
-            runner.run(["oiiotool", ref_exr, "--mulc", repr(scale), "-d", "uint8", "-o", png], inputs=[ref_exr],
-                       outputs=[png])
-            result["reference_png"] = os.path.relpath(png, out)
-        for mode in ("pyramid", "tensor16"):
-            asset = info[mode]["path"]
-            pfm = f"{stem}_{mode}.exr"
-            runner.run([tool("glintquery"), "image", asset, "--at", f"{x},{y}", "--sigma", sigma, "-o", pfm,
-                        "--quiet"] + threads, inputs=[asset], outputs=[pfm])
-            result[mode] = relative_l1(read_exr(pfm), ref)
-            if show:
-                png = os.path.join(img_dir, f"{name}_ndf_{sigma_name(sigma)}_{mode}.png")
-                runner.run([tool("glintquery"), "image", asset, "--at", f"{x},{y}", "--sigma", sigma, "-o", png,
-                            "--scale", repr(scale), "--quiet"] + threads, inputs=[asset], outputs=[png])
-                result[mode + "_png"] = os.path.relpath(png, out)
+            result["reference_png"] = os.path.relpath(pngs["reference"], out)
         whole_pfm = os.path.join(work, f"{name}_whole.exr")
-        runner.run([tool("glintquery"), "image", info["whole"], "--at", f"{x},{y}", "--sigma", side / 2, "-o",
-                    whole_pfm, "--quiet"] + threads, inputs=[info["whole"]], outputs=[whole_pfm])
-        result["whole_map"] = relative_l1(read_exr(whole_pfm), ref)
-        if show:
-            png = os.path.join(img_dir, f"{name}_ndf_{sigma_name(sigma)}_whole.png")
-            runner.run([tool("glintquery"), "image", info["whole"], "--at", f"{x},{y}", "--sigma", side / 2, "-o",
-                        png, "--scale", repr(scale), "--quiet"] + threads, inputs=[info["whole"]], outputs=[png])
-            result["whole_png"] = os.path.relpath(png, out)
+        for mode, asset, at_sigma, exr in (("pyramid", info["pyramid"]["path"], sigma, f"{stem}_pyramid.exr"),
+                                           ("tensor16", info["tensor16"]["path"], sigma, f"{stem}_tensor16.exr"),
+                                           ("whole", info["whole"], side / 2, whole_pfm)):
+            args = [tool("glintquery"), "image", asset, "--at", f"{x},{y}", "--sigma", at_sigma, "-o", exr,
+                    "--quiet"] + threads
+            if show:
+                args += ["--preview", pngs[mode], "--preview-scale", repr(scale)]
+            runner.run(args, inputs=[asset], outputs=[exr] + ([pngs[mode]] if show else []))
+            key = "whole_map" if mode == "whole" else mode
+            result[key] = relative_l1(read_exr(exr), ref)
+            if show:
+                result[mode + "_png"] = os.path.relpath(pngs[mode], out)
         return result
 
     def glitter_asset():
@@ -478,23 +476,26 @@ def main():
         if not os.path.exists(scene):
             fail(f"{scene} not found")
         renders = {}
-        for mode in ("glitter", "smooth"):
+        for mode in ("smooth", "glitter"):  # the glitter render is compared with the smooth one in its run
             stem = f"glitter_{view}_{mode}"
             exr = os.path.join(work, stem + ".exr")
             png = os.path.join(img_dir, stem + ".png")
             args = [tool("glintref"), "render", scene, "-o", exr, "--preview", png, "--exposure", EXPOSURE,
                     "--asset", asset, "--ndf", "asset" if mode == "glitter" else "smooth", "--json",
                     "--quiet"] + threads
+            inputs = [scene, asset]
+            if mode == "glitter":
+                args += ["--compare", renders["smooth"]["exr"]]
+                inputs.append(renders["smooth"]["exr"])
             if opts.image_size:
                 args += ["--image-size", opts.image_size]
-            doc, _ = runner.run(args, inputs=[scene, asset], outputs=[exr, png], capture_json=True)
+            doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
             renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
                              "sigma_mean": doc["footprint_sigma_texels"]["mean"],
                              "pixels_hit": doc["pixels_hit"], "mean_radiance": doc["mean_radiance"],
                              "preview": os.path.relpath(png, out), "exr": exr}
-        doc, _ = runner.run([tool("glintref"), "compare", renders["glitter"]["exr"], renders["smooth"]["exr"],
-                             "--json"], inputs=[renders["glitter"]["exr"], renders["smooth"]["exr"]],
-                            capture_json=True)
+            if mode == "glitter":
+                vs_smooth = doc["compare"]
         glitter, smooth = read_exr(renders["glitter"]["exr"]), read_exr(renders["smooth"]["exr"])
         floor = 0.05 * max(smooth) if smooth else 0.0
         ratios = [g / s for g, s in zip(glitter, smooth) if s > floor]
@@ -502,7 +503,7 @@ def main():
         contrast = (math.sqrt(sum((r - mean) ** 2 for r in ratios) / len(ratios)) / mean) if mean else None
         result = {"view": view, "sigma_mean": renders["glitter"]["sigma_mean"],
                   "pixels_hit": renders["glitter"]["pixels_hit"],
-                  "relative_mse_vs_smooth": doc["relative_mse"], "psnr_vs_smooth": doc["psnr"],
+                  "relative_mse_vs_smooth": vs_smooth["relative_mse"], "psnr_vs_smooth": vs_smooth["psnr"],
                   "mean_ratio": mean, "sparkle_contrast": contrast,
                   "facets_per_pixel": GLITTER_FACETS_PER_TEXEL * 4 * math.pi * renders["glitter"]["sigma_mean"] ** 2}
         for mode, r in renders.items():
@@ -538,7 +539,7 @@ def main():
         """The tile set, the repeated example and the reference on the materialised region; each against
         the reference, and how strongly each render repeats at the example's period."""
         renders = {}
-        for mode in ("tiled", "repeated", "reference"):
+        for mode in ("reference", "tiled", "repeated"):  # each asset render is compared with the reference in its run
             scene = os.path.join(opts.scenes, f"wang_{mode}.json")
             if not os.path.exists(scene):
                 fail(f"{scene} not found")
@@ -556,17 +557,17 @@ def main():
             else:
                 args += ["--ndf", "reference", "--normal-map", paths["region"]]
                 inputs.append(paths["region"])
+            if mode != "reference":
+                args += ["--compare", renders["reference"]["exr"]]
+                inputs.append(renders["reference"]["exr"])
             if opts.image_size:
                 args += ["--image-size", opts.image_size]
             doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
             renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
                              "sigma_mean": doc["footprint_sigma_texels"]["mean"], "width": doc["width"],
                              "height": doc["height"], "preview": os.path.relpath(png, out), "exr": exr}
-        for mode in ("tiled", "repeated"):
-            doc, _ = runner.run([tool("glintref"), "compare", renders[mode]["exr"], renders["reference"]["exr"],
-                                 "--json"], inputs=[renders[mode]["exr"], renders["reference"]["exr"]],
-                                capture_json=True)
-            renders[mode]["relative_mse_vs_reference"] = doc["relative_mse"]
+            if mode != "reference":
+                renders[mode]["relative_mse_vs_reference"] = doc["compare"]["relative_mse"]
         period = max(1, renders["tiled"]["width"] // WANG_REPEATS)
         for r in renders.values():
             r["repetition"] = period_correlation(read_exr(r["exr"]), r["width"], r["height"], period)
@@ -600,7 +601,8 @@ def main():
         """One asset at one distance: the runtime's render and the reference's on the materialised
         region, their relative MSE and the fraction of the region's texels some example covers."""
         renders = {}
-        for mode in ("asset", "reference"):
+        heat = os.path.join(img_dir, f"tiny_{kind}_{view}_error.png")
+        for mode in ("reference", "asset"):  # the asset's render is compared with the reference in its run
             scene = os.path.join(opts.scenes, f"tiny_{view}.json" if mode == "asset" else f"tiny_{view}_reference.json")
             if not os.path.exists(scene):
                 fail(f"{scene} not found")
@@ -610,23 +612,23 @@ def main():
             args = [tool("glintref"), "render", scene, "-o", exr, "--preview", png, "--exposure", EXPOSURE, "--json",
                     "--quiet"] + threads
             inputs = [scene]
+            outputs = [exr, png]
             if mode == "asset":
-                args += ["--ndf", "asset", "--asset", asset["path"]]
-                inputs.append(asset["path"])
+                args += ["--ndf", "asset", "--asset", asset["path"], "--compare", renders["reference"]["exr"],
+                         "--heatmap", heat]
+                inputs += [asset["path"], renders["reference"]["exr"]]
+                outputs.append(heat)
             else:
                 args += ["--ndf", "reference", "--normal-map", asset["regions"][view]["path"]]
                 inputs.append(asset["regions"][view]["path"])
             if opts.image_size:
                 args += ["--image-size", opts.image_size]
-            doc, _ = runner.run(args, inputs=inputs, outputs=[exr, png], capture_json=True)
+            doc, _ = runner.run(args, inputs=inputs, outputs=outputs, capture_json=True)
             renders[mode] = {"render_seconds": doc["time_seconds"]["render"],
                              "sigma_mean": doc["footprint_sigma_texels"]["mean"],
                              "preview": os.path.relpath(png, out), "exr": exr}
-        heat = os.path.join(img_dir, f"tiny_{kind}_{view}_error.png")
-        doc, _ = runner.run([tool("glintref"), "compare", renders["asset"]["exr"], renders["reference"]["exr"],
-                             "--heatmap", heat, "--json"],
-                            inputs=[renders["asset"]["exr"], renders["reference"]["exr"]], outputs=[heat],
-                            capture_json=True)
+            if mode == "asset":
+                vs_reference = doc["compare"]
         # The NDF images at the region's centre and the view's footprint: the asset's bin averages
         # against the reference evaluator's on the materialised map.
         centre = TINY_VIEWS[view] * 16 + 0.5
@@ -641,8 +643,8 @@ def main():
                     "--quiet"] + threads, inputs=[asset["path"]], outputs=[asset_exr])
         result = {"type": kind, "view": view, "examples_across": TINY_VIEWS[view],
                   "ndf_relative_l1": relative_l1(read_exr(asset_exr), read_exr(ref_exr)), "ndf_at": at,
-                  "sigma_mean": renders["asset"]["sigma_mean"], "relative_mse": doc["relative_mse"],
-                  "psnr": doc["psnr"], "heatmap": os.path.relpath(heat, out),
+                  "sigma_mean": renders["asset"]["sigma_mean"], "relative_mse": vs_reference["relative_mse"],
+                  "psnr": vs_reference["psnr"], "heatmap": os.path.relpath(heat, out),
                   "covered_texels": asset["regions"][view]["covered_fraction"],
                   "speedup": (renders["reference"]["render_seconds"] / renders["asset"]["render_seconds"]
                               if renders["asset"]["render_seconds"] > 0 else None)}

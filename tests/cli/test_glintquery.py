@@ -49,6 +49,24 @@ class GlintQuery(ToolTestCase):
             self.assertEqual(doc["resolution"], 32)
             self.assertAlmostEqual(doc["mass"], 1.0, delta=2e-3)
 
+    def test_image_preview(self):
+        # --preview writes the PNG a second run with -o .png --scale writes, from one evaluation.
+        exr, png, alone = self.path("p.exr"), self.path("p.png"), self.path("alone.png")
+        at = ["--at", "16,16", "--sigma", "8"]
+        doc = self.run_json("glintquery", "image", self.asset, *at, "-o", exr, "--preview", png, "--preview-scale",
+                            "0.25", schema="glintquery-image.schema.json")
+        self.assertEqual(doc["scale"], 1.0)
+        self.assertEqual(doc["preview"], {"name": "p.png", "scale": 0.25})
+        self.run_ok("glintquery", "image", self.asset, *at, "-o", alone, "--scale", "0.25", "--quiet")
+        with open(png, "rb") as f, open(alone, "rb") as g:
+            self.assertEqual(f.read(), g.read())
+        doc = self.run_json("glintquery", "image", self.asset, *at, "-o", exr, "--preview", png)
+        self.assertAlmostEqual(doc["preview"]["scale"] * doc["max"], 1.0, places=12)
+        for bad in (["--preview", self.path("p.jpg")], ["--preview-scale", "2"], ["--preview", png, "--preview-scale",
+                                                                                  "-1"]):
+            self.assert_fails(clitest.BAD_ARGS, "glintquery", "image", self.asset, *at, "-o", self.path("n.exr"), *bad,
+                              outputs=[self.path("n.exr")])
+
     def test_batch(self):
         queries = [
             {"op": "point", "x": 3.0, "y": 4.0, "sigma": 6.0, "s": [0.0, 0.0], "id": 1},

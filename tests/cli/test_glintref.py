@@ -92,6 +92,15 @@ class GlintRef(ToolTestCase):
         self.assertEqual(doc["output"]["format"], "png")
         self.assertAlmostEqual(doc["output"]["scale"] * doc["max"], 1.0, places=12)
         self.assertTrue(os.path.exists(png))
+        # --preview: the same PNG beside the EXR, from one evaluation.
+        both = self.path("both.png")
+        doc = self.run_json("glintref", "image", self.map, *AT, "--res", "16", "-o", self.path("both.exr"),
+                            "--preview", both, schema="glintref-image.schema.json")
+        self.assertEqual(doc["preview"]["name"], "both.png")
+        with open(png, "rb") as f, open(both, "rb") as g:
+            self.assertEqual(f.read(), g.read())
+        self.assert_fails(clitest.BAD_ARGS, "glintref", "image", self.map, *AT, "-o", self.path("n.exr"), "--preview",
+                          self.path("n.jpg"), outputs=[self.path("n.exr")])
 
     def test_image_identical_bytes_for_any_thread_count(self):
         a, b, c = self.path("a.exr"), self.path("b.exr"), self.path("c.exr")

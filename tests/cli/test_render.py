@@ -150,14 +150,18 @@ class RenderTest(clitest.ToolTestCase):
         self.assert_fails(BAD_ARGS, "glintref", "render", scene, "-o", self.path("x.exr"), "--ltc", table, "--ndf",
                           "reference", outputs=[self.path("x.exr")])
 
-    def test_compare(self):
+    # A 16 x 12 view of a plane with a 32^2 Beckmann-like map under a point light.
+    def small_scene(self):
         nmap = self.mapgen("beckmann", "c.exr", "--size", "32")
-        scene = write_scene(self.path("c.json"), {
+        return write_scene(self.path("c.json"), {
             "camera": {"position": [0, 2, 2], "width": 16, "height": 12},
             "object": {"type": "plane"},
             "material": {"normal_map": nmap, "alpha": 0.3},
             "lights": [{"type": "point", "position": [0, 2, -1], "intensity": [5, 5, 5]}],
         })
+
+    def test_compare(self):
+        scene = self.small_scene()
         a, b = self.path("a.exr"), self.path("b.exr")
         self.run_ok("glintref", "render", scene, "-o", a, "--ndf", "smooth", "--quiet")
         self.run_ok("glintref", "render", scene, "-o", b, "--ndf", "reference", "--quiet")
@@ -174,6 +178,31 @@ class RenderTest(clitest.ToolTestCase):
         self.run_ok("glintref", "render", scene, "-o", self.path("small.exr"), "--image-size", "8,8", "--quiet")
         self.assert_fails(INVALID, "glintref", "compare", a, self.path("small.exr"))
         self.assert_fails(IO, "glintref", "compare", a, self.path("missing.exr"))
+
+    def test_render_compare_matches_compare(self):
+        # render --compare gives glintref compare's figures for the file it wrote, in one run.
+        scene = self.small_scene()
+        ref, img, heat = self.path("ref.exr"), self.path("img.exr"), self.path("heat.png")
+        self.run_ok("glintref", "render", scene, "-o", ref, "--ndf", "reference", "--quiet")
+        doc = self.render(scene, img, "--ndf", "smooth", "--compare", ref, "--heatmap", heat)
+        alone = self.compare(img, ref, "--heatmap", self.path("heat2.png"))
+        for key in ("rmse", "relative_mse", "psnr", "peak", "max_abs_error", "differing_values"):
+            self.assertEqual(doc["compare"][key], alone[key], key)
+        self.assertGreater(doc["compare"]["relative_mse"], 0.0)
+        self.assertEqual(doc["compare"]["reference"], "ref.exr")
+        with open(heat, "rb") as f, open(self.path("heat2.png"), "rb") as g:
+            self.assertEqual(f.read(), g.read())
+        # A missing or mis-sized reference fails before anything is written; --heatmap needs --compare.
+        out = self.path("out.exr")
+        self.assert_fails(IO, "glintref", "render", scene, "-o", out, "--compare", self.path("none.exr"),
+                          outputs=[out])
+        self.run_ok("glintref", "render", scene, "-o", self.path("small.exr"), "--image-size", "8,8", "--quiet")
+        self.assert_fails(INVALID, "glintref", "render", scene, "-o", out, "--compare", self.path("small.exr"),
+                          "--heatmap", self.path("h.png"), outputs=[out, self.path("h.png")])
+        self.assert_fails(BAD_ARGS, "glintref", "render", scene, "-o", out, "--heatmap", self.path("h.png"),
+                          outputs=[out])
+        self.assert_fails(BAD_ARGS, "glintref", "render", scene, "-o", out, "--compare", ref, "--heatmap",
+                          self.path("h.jpg"), outputs=[out])
 
     def test_errors(self):
         nmap = self.mapgen("flat", "e.exr", "--size", "16")

@@ -4,6 +4,7 @@
 
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/image_output.h>
 
 #include <algorithm>
 #include <cctype>
@@ -37,6 +38,9 @@ CLI::App* addImageCommand(CLI::App& app, ImageOptions& options) {
   image->add_option("--scale", options.png_scale,
                     "Multiply densities by this before writing (default: 1 for float "
                     "formats, 1/max for integer formats)");
+  image->add_option("--preview", options.preview,
+                    "Also write the image as an 8-bit PNG, densities times --preview-scale (one evaluation for both)");
+  image->add_option("--preview-scale", options.preview_scale, "Scale of the --preview PNG (default: 1/max)");
   return image;
 }
 
@@ -46,6 +50,12 @@ int runImage(cli::Tool& tool, const ImageOptions& options) {
   const rt::Footprint fp = parseFootprint(options.footprint);
   if (!(options.png_scale >= 0.0) || !std::isfinite(options.png_scale))
     throw Error(cli::kExitBadArguments, "--scale must be >= 0");
+  if (!(options.preview_scale >= 0.0) || !std::isfinite(options.preview_scale))
+    throw Error(cli::kExitBadArguments, "--preview-scale must be >= 0");
+  if (!options.preview.empty() && bake::imageExtension(options.preview) != "png")
+    throw Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
+  if (options.preview.empty() && options.preview_scale != 0.0)
+    throw Error(cli::kExitBadArguments, "--preview-scale needs --preview");
   const Asset ndf = openAsset(tool, options.footprint.asset);
   const int res = ndf.source->resolution();
   std::vector<float> pixels(size_t(res) * size_t(res));
@@ -57,10 +67,14 @@ int runImage(cli::Tool& tool, const ImageOptions& options) {
   }
   mass *= 4.0 / (double(res) * res);
   const double scale = imageScale(options.output, options.png_scale, peak);
+  const double preview_scale = options.preview_scale > 0.0 ? options.preview_scale : (peak > 0.0 ? 1.0 / peak : 1.0);
+  std::vector<float> preview(options.preview.empty() ? 0 : pixels.size(), 0.0f);
+  for (size_t k = 0; k < preview.size(); ++k) preview[k] = float(pixels[k] * preview_scale);
   if (scale != 1.0)
     for (float& v : pixels) v = float(v * scale);
   cli::check(bake::writeImage(options.output, res, res, 1, pixels.data()));
   tool.addOutput(options.output);
+  if (!options.preview.empty()) cli::writePreviewBeside(tool, options.preview, options.output, res, res, preview.data());
   if (tool.common().json) {
     Json doc;
     doc["tool"] = "glintquery";
@@ -74,6 +88,7 @@ int runImage(cli::Tool& tool, const ImageOptions& options) {
     doc["mass"] = mass;
     doc["max"] = peak;
     doc["scale"] = scale;
+    if (!options.preview.empty()) doc["preview"] = {{"name", cli::baseName(options.preview)}, {"scale", preview_scale}};
     tool.printJson(doc);
   } else {
     tool.info("wrote " + options.output + " (" + std::to_string(res) + "x" + std::to_string(res) + ", mass " +

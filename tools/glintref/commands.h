@@ -26,6 +26,7 @@ struct ImageOptions {
   QueryOptions query;
   int res = 128;
   std::string output;
+  std::string preview;  // an 8-bit PNG scaled by the maximum, beside the output
 };
 
 struct SampleOptions {
@@ -48,6 +49,9 @@ struct RenderOptions {
   std::string image_size;  // --image-size W,H; empty: the scene's
   std::string preview;     // tone-mapped PNG
   double exposure = 1.0;
+  std::string compare;     // --compare REFERENCE: the metrics of glintref compare against it
+  std::string heatmap;     // with --compare: its heat map PNG
+  double heatmap_scale = 0.0;
   bake::IngestOptions ingest;
 };
 
@@ -87,5 +91,13 @@ int runImage(cli::Tool& tool, ImageOptions& options);
 int runSample(cli::Tool& tool, SampleOptions& options);
 int runRender(cli::Tool& tool, RenderOptions& options);
 int runCompare(cli::Tool& tool, CompareOptions& options);
+
+// What compare and render --compare share. checkHeatmap: the heat map's scale, and its path (a .png
+// in an existing folder; empty for none). compareFiles: the metrics of the image file `image`
+// against `reference` (files as written, so that both commands give the same figures), the heat map
+// written when `heatmap` is not empty, as compare's JSON fields (metrics, width, height, heatmap).
+void checkHeatmap(const std::string& heatmap, double heatmap_scale, const char* option);
+cli::Json compareFiles(cli::Tool& tool, const std::string& image, const std::string& reference,
+                       const std::string& heatmap, double heatmap_scale, double* relative_mse);
 
 }  // namespace glintbake::glintref

@@ -32,62 +32,74 @@ CLI::App* addCompareCommand(CLI::App& app, CompareOptions& options) {
   return cmd;
 }
 
-int runCompare(cli::Tool& tool, CompareOptions& options) {
-  if (!(options.heatmap_scale >= 0.0) || !std::isfinite(options.heatmap_scale)) {
+void checkHeatmap(const std::string& heatmap, double heatmap_scale, const char* option) {
+  if (!(heatmap_scale >= 0.0) || !std::isfinite(heatmap_scale)) {
     throw cli::Error(cli::kExitBadArguments, "--heatmap-scale must be >= 0");
   }
-  if (!(options.max_rel_mse >= 0.0)) throw cli::Error(cli::kExitBadArguments, "--max-rel-mse must be >= 0");
-  if (!options.heatmap.empty()) {
-    if (bake::imageExtension(options.heatmap) != "png") {
-      throw cli::Error(cli::kExitBadArguments, "--heatmap " + options.heatmap + ": the heat map must be .png");
-    }
-    const std::filesystem::path parent = std::filesystem::path(options.heatmap).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-      throw cli::Error(cli::kExitIo, "cannot write " + options.heatmap + ": no such directory");
-    }
+  if (heatmap.empty()) return;
+  if (bake::imageExtension(heatmap) != "png") {
+    throw cli::Error(cli::kExitBadArguments, std::string(option) + " " + heatmap + ": the heat map must be .png");
   }
-  tool.addInput(options.image);
-  tool.addInput(options.reference);
-  auto a = bake::render::loadRgbImage(options.image);
+  const std::filesystem::path parent = std::filesystem::path(heatmap).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw cli::Error(cli::kExitIo, "cannot write " + heatmap + ": no such directory");
+  }
+}
+
+cli::Json compareFiles(cli::Tool& tool, const std::string& image, const std::string& reference,
+                       const std::string& heatmap, double heatmap_scale, double* relative_mse) {
+  tool.addInput(image);
+  tool.addInput(reference);
+  auto a = bake::render::loadRgbImage(image);
   if (!a) throw cli::Error(int(a.error().code), a.error().message);
-  auto b = bake::render::loadRgbImage(options.reference);
+  auto b = bake::render::loadRgbImage(reference);
   if (!b) throw cli::Error(int(b.error().code), b.error().message);
   auto metrics = bake::render::compareImages(a.value(), b.value());
   if (!metrics) throw cli::Error(cli::kExitInvalidInput, metrics.error().message);
   const bake::render::CompareMetrics& m = metrics.value();
-
-  if (!options.heatmap.empty()) {
-    const std::vector<float> heat = bake::render::errorHeatMap(a.value(), b.value(), options.heatmap_scale);
+  if (!heatmap.empty()) {
+    const std::vector<float> heat = bake::render::errorHeatMap(a.value(), b.value(), heatmap_scale);
     bake::ImageWriteOptions wo;
     wo.png_bits = 8;
-    const bake::BakeStatus st =
-        bake::writeImage(options.heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
+    const bake::BakeStatus st = bake::writeImage(heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
     if (!st) throw cli::Error(int(st.error().code), st.error().message);
-    tool.addOutput(options.heatmap);
+    tool.addOutput(heatmap);
   }
+  *relative_mse = m.relative_mse;
+  cli::Json doc;
+  doc["width"] = b.value().width;
+  doc["height"] = b.value().height;
+  doc["rmse"] = m.rmse;
+  doc["relative_mse"] = finiteOrNull(m.relative_mse);
+  doc["psnr"] = finiteOrNull(m.psnr);
+  doc["peak"] = m.peak;
+  doc["max_abs_error"] = m.max_abs_error;
+  doc["differing_values"] = m.differing_values;
+  if (!heatmap.empty()) doc["heatmap"] = cli::baseName(heatmap);
+  return doc;
+}
 
+int runCompare(cli::Tool& tool, CompareOptions& options) {
+  checkHeatmap(options.heatmap, options.heatmap_scale, "--heatmap");
+  if (!(options.max_rel_mse >= 0.0)) throw cli::Error(cli::kExitBadArguments, "--max-rel-mse must be >= 0");
+  double relative_mse = 0.0;
+  const cli::Json fields =
+      compareFiles(tool, options.image, options.reference, options.heatmap, options.heatmap_scale, &relative_mse);
   const bool differs =
-      options.max_rel_mse < std::numeric_limits<double>::infinity() && m.relative_mse > options.max_rel_mse;
+      options.max_rel_mse < std::numeric_limits<double>::infinity() && relative_mse > options.max_rel_mse;
   if (tool.common().json) {
     cli::Json doc;
     doc["tool"] = "glintref";
     doc["command"] = "compare";
     doc["image"] = cli::baseName(options.image);
     doc["reference"] = cli::baseName(options.reference);
-    doc["width"] = b.value().width;
-    doc["height"] = b.value().height;
-    doc["rmse"] = m.rmse;
-    doc["relative_mse"] = finiteOrNull(m.relative_mse);
-    doc["psnr"] = finiteOrNull(m.psnr);
-    doc["peak"] = m.peak;
-    doc["max_abs_error"] = m.max_abs_error;
-    doc["differing_values"] = m.differing_values;
-    if (!options.heatmap.empty()) doc["heatmap"] = cli::baseName(options.heatmap);
+    for (const auto& [key, value] : fields.items()) doc[key] = value;
     doc["within_threshold"] = !differs;
     tool.printJson(doc);
   } else {
     std::ostringstream s;
-    s << "rmse " << m.rmse << "  relative_mse " << m.relative_mse << "  psnr " << m.psnr << " dB";
+    s << "rmse " << fields["rmse"].get<double>() << "  relative_mse " << relative_mse << "  psnr "
+      << (fields["psnr"].is_null() ? std::numeric_limits<double>::infinity() : fields["psnr"].get<double>()) << " dB";
     std::printf("%s\n", s.str().c_str());
   }
   return differs ? cli::kExitDifferences : cli::kExitOk;

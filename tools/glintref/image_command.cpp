@@ -2,6 +2,7 @@
 // glintref image: the bin-averaged NDF image of a footprint (each bin the exact average of D over
 // the bin), written as a 1-channel float EXR or, for viewing, a PNG normalised by its maximum.
 #include <glintbake/cli/exit_codes.h>
+#include <glintbake/cli/image_output.h>
 #include "commands.h"
 
 #include <glintbake/bake/io/image_io.h>
@@ -30,6 +31,8 @@ CLI::App* addImageCommand(CLI::App& app, ImageOptions& options) {
   cmd->add_option("--res", options.res, "Bins per side of the image over s in [-1,1]^2 (1..4096)");
   cmd->add_option("-o,--output", options.output, "Output image: .exr (float densities) or .png (scaled by the maximum)")
       ->required();
+  cmd->add_option("--preview", options.preview,
+                  "Also write the image as a .png scaled by its maximum (one evaluation for both)");
   return cmd;
 }
 
@@ -41,9 +44,14 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
   if (ext != ".exr" && ext != ".png") {
     throw cli::Error(cli::kExitBadArguments, "-o " + options.output + ": the image must be .exr or .png");
   }
-  const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw cli::Error(cli::kExitIo, "cannot write " + options.output + ": no such directory");
+  if (!options.preview.empty() && lowerExtension(options.preview) != ".png") {
+    throw cli::Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
+  }
+  for (const std::string& out : {options.output, options.preview}) {
+    const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+      throw cli::Error(cli::kExitIo, "cannot write " + out + ": no such directory");
+    }
   }
   const Query query = loadQuery(tool, options.query);
 
@@ -65,6 +73,11 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
   const bake::BakeStatus written = bake::writeImage(options.output, res, res, 1, pixels.data());
   cli::check(written);
   tool.addOutput(options.output);
+  const double preview_scale = max_value > 0.0 ? 1.0 / max_value : 1.0;
+  if (!options.preview.empty()) {
+    for (size_t k = 0; k < image.size(); ++k) pixels[k] = float(image[k] * preview_scale);
+    cli::writePreviewBeside(tool, options.preview, options.output, res, res, pixels.data());
+  }
 
   if (tool.common().json) {
     cli::Json doc;
@@ -73,6 +86,7 @@ int runImage(cli::Tool& tool, ImageOptions& options) {
     doc.update(queryJson(options.query, query, lobes));
     doc["res"] = res;
     doc["output"] = {{"name", cli::baseName(options.output)}, {"format", png ? "png" : "exr"}, {"scale", scale}};
+    if (!options.preview.empty()) doc["preview"] = {{"name", cli::baseName(options.preview)}, {"scale", preview_scale}};
     doc["integral"] = sum * bin_area;
     doc["max"] = max_value;
     tool.printJson(doc);

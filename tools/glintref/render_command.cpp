@@ -57,6 +57,13 @@ bake::render::NdfMode checkRenderOptions(const RenderOptions& options, int* widt
   if (!options.preview.empty() && bake::imageExtension(options.preview) != "png") {
     throw cli::Error(cli::kExitBadArguments, "--preview " + options.preview + ": the preview must be .png");
   }
+  if (options.compare.empty() && (!options.heatmap.empty() || options.heatmap_scale != 0.0)) {
+    throw cli::Error(cli::kExitBadArguments, "--heatmap and --heatmap-scale need --compare");
+  }
+  checkHeatmap(options.heatmap, options.heatmap_scale, "--heatmap");
+  if (!options.compare.empty() && !std::filesystem::is_regular_file(options.compare)) {
+    throw cli::Error(cli::kExitIo, "cannot read " + options.compare + ": no such file");
+  }
   for (const std::string& out : {options.output, options.preview}) {
     if (out.empty()) continue;
     const std::filesystem::path parent = std::filesystem::path(out).parent_path();
@@ -167,7 +174,7 @@ void writeRenderOutputs(cli::Tool& tool, const RenderOptions& options, const bak
 
 void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::render::NdfMode mode,
                         const bake::render::NdfInputs& inputs, const bake::render::RenderedImage& image,
-                        double load_seconds, double render_seconds) {
+                        double load_seconds, double render_seconds, const cli::Json* comparison) {
   if (tool.common().json) {
     cli::Json doc;
     doc["tool"] = "glintref";
@@ -188,10 +195,24 @@ void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::ren
     doc["time_seconds"] = {{"load", load_seconds}, {"render", render_seconds}};
     doc["output"] = cli::baseName(options.output);
     if (!options.preview.empty()) doc["preview"] = cli::baseName(options.preview);
+    if (comparison) {
+      cli::Json c = *comparison;
+      c["reference"] = cli::baseName(options.compare);
+      c.erase("width");
+      c.erase("height");
+      doc["compare"] = c;
+    }
     tool.printJson(doc);
   } else {
     tool.info("wrote " + options.output + " (" + std::to_string(image.width) + "x" + std::to_string(image.height) +
               ", --ndf " + options.ndf + ", " + std::to_string(render_seconds) + " s)");
+    if (comparison) {
+      std::ostringstream s;
+      s << "against " << options.compare << ": rmse " << (*comparison)["rmse"].get<double>() << "  relative_mse "
+        << ((*comparison)["relative_mse"].is_null() ? std::numeric_limits<double>::infinity()
+                                                    : (*comparison)["relative_mse"].get<double>());
+      tool.info(s.str());
+    }
   }
 }
 
@@ -220,6 +241,12 @@ CLI::App* addRenderCommand(CLI::App& app, RenderOptions& options) {
   cmd->add_option("--image-size", options.image_size, "Override the camera's image size: W,H in pixels (1..8192)");
   cmd->add_option("--preview", options.preview, "Also write a tone-mapped sRGB PNG preview");
   cmd->add_option("--exposure", options.exposure, "Exposure multiplier of the preview (> 0)");
+  cmd->add_option("--compare", options.compare,
+                  "Also compare the written render with this reference image (the metrics of glintref compare, "
+                  "under 'compare' in --json)");
+  cmd->add_option("--heatmap", options.heatmap, "With --compare: write its per-pixel RMS error as a colour-ramp PNG");
+  cmd->add_option("--heatmap-scale", options.heatmap_scale,
+                  "With --heatmap: error mapped to the top of the ramp (0: 4 x the image RMSE)");
   cli::addIngestOptions(*cmd, options.ingest);
   return cmd;
 }
@@ -229,6 +256,17 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   int width = 0, height = 0;
   const bake::render::NdfMode mode = checkRenderOptions(options, &width, &height);
   const bake::render::Scene scene = loadRenderScene(tool, options, width, height);
+  if (!options.compare.empty()) {
+    // The reference is read and its size checked before the render, so that a bad one fails fast.
+    auto reference = bake::render::loadRgbImage(options.compare);
+    if (!reference) throw cli::Error(int(reference.error().code), reference.error().message);
+    if (reference.value().width != scene.camera.width || reference.value().height != scene.camera.height) {
+      throw cli::Error(cli::kExitInvalidInput,
+                       "--compare " + options.compare + " is " + std::to_string(reference.value().width) + "x" +
+                           std::to_string(reference.value().height) + ", the render " +
+                           std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height));
+    }
+  }
   RenderSources sources;
   loadRenderSources(tool, options, mode, scene, &sources);
   const double load_seconds = secondsSince(t_start);
@@ -249,7 +287,25 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   progress->finish();
   const bake::render::RenderedImage image = cli::unwrap(std::move(rendered));
   writeRenderOutputs(tool, options, image);
-  printRenderSummary(tool, options, mode, sources.inputs, image, load_seconds, render_seconds);
+  // The comparison reads the render back as written, so that its figures are glintref compare's.
+  cli::Json comparison;
+  double relative_mse = 0.0;
+  if (!options.compare.empty()) {
+    try {
+      comparison = compareFiles(tool, options.output, options.compare, options.heatmap, options.heatmap_scale,
+                                &relative_mse);
+    } catch (...) {
+      // No partial output: the render and its preview go with a comparison that failed.
+      for (const std::string& out : {options.output, options.preview, options.heatmap})
+        if (!out.empty()) {
+          std::error_code ignored;
+          std::filesystem::remove(out, ignored);
+        }
+      throw;
+    }
+  }
+  printRenderSummary(tool, options, mode, sources.inputs, image, load_seconds, render_seconds,
+                     options.compare.empty() ? nullptr : &comparison);
   return cli::kExitOk;
 }
 
