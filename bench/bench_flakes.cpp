@@ -6,7 +6,8 @@
 // is not negligible (sampled from it), so that caches and branch predictors see varied queries.
 // GLINTBAKE_BENCH_ASSETS=a.gbk,b.gbk adds `asset_eval` and `asset_sample`: the same queries through
 // baked NDF assets (openNdfAsset: flakes, lobes, pyramid and the blends between them) at footprints
-// from 1 texel to past the pyramid's hand-over, so that every path and band of an asset is timed.
+// from 1 texel to past the pyramid's hand-over, so that every path and band of an asset is timed;
+// `asset_eval_raster` the same evals over a block of neighbouring pixels' footprints.
 // `lobe_build` times the lobe hierarchy a reader builds at load (16 lobes per tile).
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
@@ -17,6 +18,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -89,12 +91,19 @@ struct Query {
   double u1, u2;
 };
 
-std::vector<Query> queries(const rt::NdfSource& source, int width, int height, double sigma) {
+// raster: the footprints of a 32 x 32 block of pixels instead (centres 2 sigma apart, at least a
+// texel: a pixel's footprint std is about half its spacing), in scanline order, as a renderer's
+// neighbouring pixels query the same surface; random footprints over the whole map are the cold
+// worst case.
+std::vector<Query> queries(const rt::NdfSource& source, int width, int height, double sigma, bool raster = false) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Query> q(1024);
-  for (Query& x : q) {
-    x.fp = {u(rng) * width, u(rng) * height, sigma};
+  const double x0 = u(rng) * width, y0 = u(rng) * height, spacing = std::max(2.0 * sigma, 1.0);
+  for (size_t k = 0; k < q.size(); ++k) {
+    Query& x = q[k];
+    x.fp = raster ? rt::Footprint{x0 + double(k % 32) * spacing, y0 + double(k / 32) * spacing, sigma}
+                  : rt::Footprint{u(rng) * width, u(rng) * height, sigma};
     rt::NdfSample smp;
     // A point where the NDF is not negligible: a sample of it (retry the rare rejected tail).
     int tries = 0;
@@ -138,10 +147,10 @@ std::vector<AssetSubject>& assets() {
   return all;
 }
 
-void assetBench(benchmark::State& state, size_t index, double sigma, bool sample) {
+void assetBench(benchmark::State& state, size_t index, double sigma, bool sample, bool raster) {
   const rt::NdfSource& src = *assets()[index].source;
   const rt::MapSize size = src.mapSize();
-  const std::vector<Query> q = queries(src, int(size.width), int(size.height), sigma);
+  const std::vector<Query> q = queries(src, int(size.width), int(size.height), sigma, raster);
   size_t i = 0;
   for (auto _ : state) {
     if (sample) {
@@ -248,9 +257,11 @@ const int registered = [] {
   for (size_t k = 0; k < assets().size(); ++k) {
     for (double sigma : {1.0, 4.0, 5.0, 8.0, 12.0, 16.0, 20.0, 22.0, 24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 128.0}) {
       const std::string tag = assets()[k].name + "/sigma:" + std::to_string(int(sigma));
-      benchmark::RegisterBenchmark(("asset_eval/" + tag).c_str(), assetBench, k, sigma, false)
+      benchmark::RegisterBenchmark(("asset_eval/" + tag).c_str(), assetBench, k, sigma, false, false)
           ->Unit(benchmark::kMicrosecond);
-      benchmark::RegisterBenchmark(("asset_sample/" + tag).c_str(), assetBench, k, sigma, true)
+      benchmark::RegisterBenchmark(("asset_sample/" + tag).c_str(), assetBench, k, sigma, true, false)
+          ->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("asset_eval_raster/" + tag).c_str(), assetBench, k, sigma, false, true)
           ->Unit(benchmark::kMicrosecond);
     }
   }
