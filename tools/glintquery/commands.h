@@ -26,8 +26,8 @@ struct PointOptions {
 struct ImageOptions {
   FootprintOptions footprint;
   std::string output;
-  double png_scale = 0.0;  // 0: 1 for float formats, 1/max for integer formats
-  std::string preview;      // a PNG beside the output
+  double png_scale = 0.0;      // 0: 1 for float formats, 1/max for integer formats
+  std::string preview;         // a PNG beside the output
   double preview_scale = 0.0;  // 0: 1/max
 };
 

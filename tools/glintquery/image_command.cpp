@@ -74,7 +74,8 @@ int runImage(cli::Tool& tool, const ImageOptions& options) {
     for (float& v : pixels) v = float(v * scale);
   cli::check(bake::writeImage(options.output, res, res, 1, pixels.data()));
   tool.addOutput(options.output);
-  if (!options.preview.empty()) cli::writePreviewBeside(tool, options.preview, options.output, res, res, preview.data());
+  if (!options.preview.empty())
+    cli::writePreviewBeside(tool, options.preview, options.output, res, res, preview.data());
   if (tool.common().json) {
     Json doc;
     doc["tool"] = "glintquery";

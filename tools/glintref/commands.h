@@ -49,8 +49,8 @@ struct RenderOptions {
   std::string image_size;  // --image-size W,H; empty: the scene's
   std::string preview;     // tone-mapped PNG
   double exposure = 1.0;
-  std::string compare;     // --compare REFERENCE: the metrics of glintref compare against it
-  std::string heatmap;     // with --compare: its heat map PNG
+  std::string compare;  // --compare REFERENCE: the metrics of glintref compare against it
+  std::string heatmap;  // with --compare: its heat map PNG
   double heatmap_scale = 0.0;
   bake::IngestOptions ingest;
 };

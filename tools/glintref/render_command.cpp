@@ -292,8 +292,8 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   double relative_mse = 0.0;
   if (!options.compare.empty()) {
     try {
-      comparison = compareFiles(tool, options.output, options.compare, options.heatmap, options.heatmap_scale,
-                                &relative_mse);
+      comparison =
+          compareFiles(tool, options.output, options.compare, options.heatmap, options.heatmap_scale, &relative_mse);
     } catch (...) {
       // No partial output: the render and its preview go with a comparison that failed.
       for (const std::string& out : {options.output, options.preview, options.heatmap})
