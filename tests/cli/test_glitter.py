@@ -63,7 +63,8 @@ class Glitter(ToolTestCase):
         self.assertEqual(doc["kind"], "ndf-pyramid")
         self.assertGreaterEqual(len(doc["levels"]), 1)
         self.run_ok("glintinfo", "validate", out)
-        q = self.run_json("glintquery", "point", out, "--at", "20,30", "--sigma", "8", "--s", "0.1,0.1")
+        q = self.run_json("glintquery", "point", out, "--at", "20,30", "--sigma", "8", "--s", "0.1,0.1",
+                          schema="glintquery-point.schema.json")
         self.assertGreaterEqual(q["value"], 0.0)
         # Deterministic for every thread count.
         out1 = self.path("g1.gbk")
@@ -76,7 +77,9 @@ class Glitter(ToolTestCase):
                             schema="ndfgen-procedural.schema.json")
         self.assertEqual(doc["kind"], "glitter")
         self.run_ok("glintinfo", "validate", asset)
-        q = self.run_json("glintquery", "point", asset, "--at", "20,30", "--sigma", "2", "--s", "0.1,0.1")
+        q = self.run_json("glintquery", "point", asset, "--at", "20,30", "--sigma", "2", "--s", "0.1,0.1",
+                          schema="glintquery-point.schema.json")
+        self.assertEqual(q["kind"], "glitter")
         self.assertGreaterEqual(q["value"], 0.0)
 
     def test_validate_checks_the_glitter_layout(self):

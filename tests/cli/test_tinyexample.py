@@ -57,8 +57,11 @@ class TinyExample(ToolTestCase):
         self.run_ok("glintinfo", "validate", out)
         info = self.run_json("glintinfo", "info", out)
         self.assertEqual(info["asset_kind"], "tiny-example")
-        q = self.run_json("glintquery", "point", out, "--at", "1000,-70", "--sigma", "40", "--s", "0.05,0.0")
+        q = self.run_json("glintquery", "point", out, "--at", "1000,-70", "--sigma", "40", "--s", "0.05,0.0",
+                          schema="glintquery-point.schema.json")
         self.assertGreaterEqual(q["value"], 0.0)
+        self.run_json("glintquery", "image", out, "--at", "1000,-70", "--sigma", "40", "-o", self.path("t.exr"),
+                      schema="glintquery-image.schema.json")
         # float16 tile images by default; --precision float32 keeps them whole, in a larger file.
         self.assertEqual(doc["precision"], "float16")
         out32, doc32 = self.bake("t32.gbk", "--precision", "float32", json=True)

@@ -31,8 +31,11 @@ class WangTile(ToolTestCase):
         self.assertEqual(info["asset_kind"], "wang-tiles")
         for at in ("8,8", "-1000.5,123456.25", "16,16"):
             for sigma in ("0.5", "3"):
-                q = self.run_json("glintquery", "point", out, "--at", at, "--sigma", sigma, "--s", "0.05,0.02")
+                q = self.run_json("glintquery", "point", out, "--at", at, "--sigma", sigma, "--s", "0.05,0.02",
+                                  schema="glintquery-point.schema.json")
                 self.assertGreaterEqual(q["value"], 0.0)
+        self.run_json("glintquery", "image", out, "--at", "8,8", "--sigma", "3", "-o", self.path("w.exr"),
+                      schema="glintquery-image.schema.json")
         out1 = self.path("w1.gbk")
         self.run_ok("wangtile", ex, "-o", out1, *SMALL, "-j1")
         self.assertEqual(clitest.file_hash(out), clitest.file_hash(out1))
