@@ -203,6 +203,10 @@ class RenderTest(clitest.ToolTestCase):
                           outputs=[out])
         self.assert_fails(BAD_ARGS, "glintref", "render", scene, "-o", out, "--compare", ref, "--heatmap",
                           self.path("h.jpg"), outputs=[out])
+        # The reference is not the render's own output (it would be overwritten before the comparison).
+        before = clitest.file_hash(ref)
+        self.assert_fails(BAD_ARGS, "glintref", "render", scene, "-o", ref, "--compare", ref)
+        self.assertEqual(clitest.file_hash(ref), before)
 
     def test_errors(self):
         nmap = self.mapgen("flat", "e.exr", "--size", "16")

@@ -64,6 +64,12 @@ bake::render::NdfMode checkRenderOptions(const RenderOptions& options, int* widt
   if (!options.compare.empty() && !std::filesystem::is_regular_file(options.compare)) {
     throw cli::Error(cli::kExitIo, "cannot read " + options.compare + ": no such file");
   }
+  if (!options.compare.empty()) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(options.compare, options.output, ec) && !ec) {
+      throw cli::Error(cli::kExitBadArguments, "--compare " + options.compare + " is the render's own output (-o)");
+    }
+  }
   for (const std::string& out : {options.output, options.preview}) {
     if (out.empty()) continue;
     const std::filesystem::path parent = std::filesystem::path(out).parent_path();
