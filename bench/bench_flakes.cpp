@@ -99,7 +99,9 @@ std::vector<Query> queries(const rt::NdfSource& source, int width, int height, d
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<Query> q(1024);
-  const double x0 = u(rng) * width, y0 = u(rng) * height, spacing = std::max(2.0 * sigma, 1.0);
+  // The raster's corner is drawn only for a raster, so that the random footprints stay the same.
+  const double x0 = raster ? u(rng) * width : 0.0, y0 = raster ? u(rng) * height : 0.0;
+  const double spacing = std::max(2.0 * sigma, 1.0);
   for (size_t k = 0; k < q.size(); ++k) {
     Query& x = q[k];
     x.fp = raster ? rt::Footprint{x0 + double(k % 32) * spacing, y0 + double(k / 32) * spacing, sigma}

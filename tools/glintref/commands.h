@@ -10,6 +10,7 @@
 #include <glintbake/cli/tool.h>
 
 #include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/render/image_compare.h>
 
 #include <cstdint>
 #include <limits>
@@ -93,11 +94,14 @@ int runRender(cli::Tool& tool, RenderOptions& options);
 int runCompare(cli::Tool& tool, CompareOptions& options);
 
 // What compare and render --compare share. checkHeatmap: the heat map's scale, and its path (a .png
-// in an existing folder; empty for none). compareFiles: the metrics of the image file `image`
-// against `reference` (files as written, so that both commands give the same figures), the heat map
-// written when `heatmap` is not empty, as compare's JSON fields (metrics, width, height, heatmap).
+// in an existing folder; empty for none). loadCompareImage: an image read for comparison (its read
+// error thrown). compareLoaded: the metrics of `image` against `reference`, the heat map written
+// when `heatmap` is not empty. comparisonJson: compare's JSON fields of them.
 void checkHeatmap(const std::string& heatmap, double heatmap_scale, const char* option);
-cli::Json compareFiles(cli::Tool& tool, const std::string& image, const std::string& reference,
-                       const std::string& heatmap, double heatmap_scale, double* relative_mse);
+bake::render::RgbImage loadCompareImage(const std::string& path);
+bake::render::CompareMetrics compareLoaded(cli::Tool& tool, const bake::render::RgbImage& image,
+                                           const bake::render::RgbImage& reference, const std::string& heatmap,
+                                           double heatmap_scale);
+cli::Json comparisonJson(const bake::render::CompareMetrics& m, const std::string& heatmap);
 
 }  // namespace glintbake::glintref

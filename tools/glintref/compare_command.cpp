@@ -4,6 +4,7 @@
 
 #include <glintbake/bake/io/image_io.h>
 #include <glintbake/bake/render/image_compare.h>
+#include <glintbake/cli/exit_codes.h>
 
 #include <cmath>
 #include <cstdio>
@@ -46,29 +47,29 @@ void checkHeatmap(const std::string& heatmap, double heatmap_scale, const char* 
   }
 }
 
-cli::Json compareFiles(cli::Tool& tool, const std::string& image, const std::string& reference,
-                       const std::string& heatmap, double heatmap_scale, double* relative_mse) {
-  tool.addInput(image);
-  tool.addInput(reference);
-  auto a = bake::render::loadRgbImage(image);
-  if (!a) throw cli::Error(int(a.error().code), a.error().message);
-  auto b = bake::render::loadRgbImage(reference);
-  if (!b) throw cli::Error(int(b.error().code), b.error().message);
-  auto metrics = bake::render::compareImages(a.value(), b.value());
+bake::render::RgbImage loadCompareImage(const std::string& path) {
+  auto image = bake::render::loadRgbImage(path);
+  if (!image) throw cli::Error(int(image.error().code), image.error().message);
+  return std::move(image.value());
+}
+
+bake::render::CompareMetrics compareLoaded(cli::Tool& tool, const bake::render::RgbImage& image,
+                                           const bake::render::RgbImage& reference, const std::string& heatmap,
+                                           double heatmap_scale) {
+  auto metrics = bake::render::compareImages(image, reference);
   if (!metrics) throw cli::Error(cli::kExitInvalidInput, metrics.error().message);
-  const bake::render::CompareMetrics& m = metrics.value();
   if (!heatmap.empty()) {
-    const std::vector<float> heat = bake::render::errorHeatMap(a.value(), b.value(), heatmap_scale);
+    const std::vector<float> heat = bake::render::errorHeatMap(image, reference, heatmap_scale);
     bake::ImageWriteOptions wo;
     wo.png_bits = 8;
-    const bake::BakeStatus st = bake::writeImage(heatmap, a.value().width, a.value().height, 3, heat.data(), wo);
-    if (!st) throw cli::Error(int(st.error().code), st.error().message);
+    cli::check(bake::writeImage(heatmap, image.width, image.height, 3, heat.data(), wo));
     tool.addOutput(heatmap);
   }
-  *relative_mse = m.relative_mse;
+  return metrics.value();
+}
+
+cli::Json comparisonJson(const bake::render::CompareMetrics& m, const std::string& heatmap) {
   cli::Json doc;
-  doc["width"] = b.value().width;
-  doc["height"] = b.value().height;
   doc["rmse"] = m.rmse;
   doc["relative_mse"] = finiteOrNull(m.relative_mse);
   doc["psnr"] = finiteOrNull(m.psnr);
@@ -82,24 +83,27 @@ cli::Json compareFiles(cli::Tool& tool, const std::string& image, const std::str
 int runCompare(cli::Tool& tool, CompareOptions& options) {
   checkHeatmap(options.heatmap, options.heatmap_scale, "--heatmap");
   if (!(options.max_rel_mse >= 0.0)) throw cli::Error(cli::kExitBadArguments, "--max-rel-mse must be >= 0");
-  double relative_mse = 0.0;
-  const cli::Json fields =
-      compareFiles(tool, options.image, options.reference, options.heatmap, options.heatmap_scale, &relative_mse);
+  tool.addInput(options.image);
+  tool.addInput(options.reference);
+  const bake::render::RgbImage a = loadCompareImage(options.image), b = loadCompareImage(options.reference);
+  const bake::render::CompareMetrics m = compareLoaded(tool, a, b, options.heatmap, options.heatmap_scale);
   const bool differs =
-      options.max_rel_mse < std::numeric_limits<double>::infinity() && relative_mse > options.max_rel_mse;
+      options.max_rel_mse < std::numeric_limits<double>::infinity() && m.relative_mse > options.max_rel_mse;
   if (tool.common().json) {
     cli::Json doc;
     doc["tool"] = "glintref";
     doc["command"] = "compare";
     doc["image"] = cli::baseName(options.image);
     doc["reference"] = cli::baseName(options.reference);
+    doc["width"] = b.width;
+    doc["height"] = b.height;
+    const cli::Json fields = comparisonJson(m, options.heatmap);
     for (const auto& [key, value] : fields.items()) doc[key] = value;
     doc["within_threshold"] = !differs;
     tool.printJson(doc);
   } else {
     std::ostringstream s;
-    s << "rmse " << fields["rmse"].get<double>() << "  relative_mse " << relative_mse << "  psnr "
-      << (fields["psnr"].is_null() ? std::numeric_limits<double>::infinity() : fields["psnr"].get<double>()) << " dB";
+    s << "rmse " << m.rmse << "  relative_mse " << m.relative_mse << "  psnr " << m.psnr << " dB";
     std::printf("%s\n", s.str().c_str());
   }
   return differs ? cli::kExitDifferences : cli::kExitOk;

@@ -9,8 +9,10 @@ int main(int argc, char** argv) {
   cli::Tool tool("glintref",
                  "Reference P-NDF of a normal map: point values, bin-averaged images, samples, renders, comparisons; "
                  "procedural glitter");
-  tool.addExample("glintref ndf map.png --at 64,64 --sigma 4 --s 0.1,0", "The reference P-NDF of a normal map at one point.");
-  tool.addExample("glintref render scene.json -o render.exr --asset brushed.gbk", "Render a scene with a baked asset on its material.");
+  tool.addExample("glintref ndf map.png --at 64,64 --sigma 4 --s 0.1,0",
+                  "The reference P-NDF of a normal map at one point.");
+  tool.addExample("glintref render scene.json -o render.exr --asset brushed.gbk",
+                  "Render a scene with a baked asset on its material.");
   CLI::App& app = tool.app();
   // Common options (--json, --quiet, ...) may follow the subcommand.
   app.fallthrough();

@@ -43,8 +43,7 @@ void addQueryOptions(CLI::App& command, QueryOptions& options) {
 
 void parsePair(const std::string& option, const std::string& text, double* a, double* b) {
   const size_t comma = text.find(',');
-  if (comma == std::string::npos || !parseNumber(text.substr(0, comma), a) ||
-      !parseNumber(text.substr(comma + 1), b)) {
+  if (comma == std::string::npos || !parseNumber(text.substr(0, comma), a) || !parseNumber(text.substr(comma + 1), b)) {
     throw cli::Error(cli::kExitBadArguments, option + " expects two finite numbers A,B; got '" + text + "'");
   }
 }
@@ -58,15 +57,15 @@ Query loadQuery(cli::Tool& tool, const QueryOptions& options) {
                                                  formatNumber(kMaxCentreTexels) + " texels from the origin");
   }
   if (!(options.sigma > 0.0) || !std::isfinite(options.sigma)) {
-    throw cli::Error(cli::kExitBadArguments, "--sigma must be a positive number of texels, got " +
-                                                 formatNumber(options.sigma));
+    throw cli::Error(cli::kExitBadArguments,
+                     "--sigma must be a positive number of texels, got " + formatNumber(options.sigma));
   }
   if (!(options.sigma_r > 0.0 && options.sigma_r < 1.0)) {
     throw cli::Error(cli::kExitBadArguments, "--sigma-r must be in (0, 1), got " + formatNumber(options.sigma_r));
   }
   if (options.rate < 1 || options.rate > reference::kMaxRate) {
-    throw cli::Error(cli::kExitBadArguments, "--rate must be in 1.." + std::to_string(reference::kMaxRate) +
-                                                 ", got " + std::to_string(options.rate));
+    throw cli::Error(cli::kExitBadArguments, "--rate must be in 1.." + std::to_string(reference::kMaxRate) + ", got " +
+                                                 std::to_string(options.rate));
   }
   // Flakes within the truncation disk (with their periodic images), before loading anything.
   const double step = 1.0 / options.rate;
@@ -74,10 +73,10 @@ Query loadQuery(cli::Tool& tool, const QueryOptions& options) {
   const double radius = reference::kTruncationSigmas * std::sqrt(sigma_h * sigma_h + options.sigma * options.sigma);
   const double lobes = kPi * (radius * options.rate) * (radius * options.rate);
   if (lobes > kMaxLobes) {
-    throw cli::Error(cli::kExitBadArguments,
-                     "--sigma " + formatNumber(options.sigma) + " at --rate " + std::to_string(options.rate) +
-                         " sums about " + formatNumber(lobes) + " flakes; the reference evaluator accepts at most " +
-                         formatNumber(kMaxLobes) + " (reduce --sigma or --rate)");
+    throw cli::Error(cli::kExitBadArguments, "--sigma " + formatNumber(options.sigma) + " at --rate " +
+                                                 std::to_string(options.rate) + " sums about " + formatNumber(lobes) +
+                                                 " flakes; the reference evaluator accepts at most " +
+                                                 formatNumber(kMaxLobes) + " (reduce --sigma or --rate)");
   }
 
   Query query;

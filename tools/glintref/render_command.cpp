@@ -61,14 +61,9 @@ bake::render::NdfMode checkRenderOptions(const RenderOptions& options, int* widt
     throw cli::Error(cli::kExitBadArguments, "--heatmap and --heatmap-scale need --compare");
   }
   checkHeatmap(options.heatmap, options.heatmap_scale, "--heatmap");
-  if (!options.compare.empty() && !std::filesystem::is_regular_file(options.compare)) {
-    throw cli::Error(cli::kExitIo, "cannot read " + options.compare + ": no such file");
-  }
-  if (!options.compare.empty()) {
-    std::error_code ec;
-    if (std::filesystem::equivalent(options.compare, options.output, ec) && !ec) {
-      throw cli::Error(cli::kExitBadArguments, "--compare " + options.compare + " is the render's own output (-o)");
-    }
+  std::error_code ec;
+  if (!options.compare.empty() && std::filesystem::equivalent(options.compare, options.output, ec) && !ec) {
+    throw cli::Error(cli::kExitBadArguments, "--compare " + options.compare + " is the render's own output (-o)");
   }
   for (const std::string& out : {options.output, options.preview}) {
     if (out.empty()) continue;
@@ -180,7 +175,7 @@ void writeRenderOutputs(cli::Tool& tool, const RenderOptions& options, const bak
 
 void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::render::NdfMode mode,
                         const bake::render::NdfInputs& inputs, const bake::render::RenderedImage& image,
-                        double load_seconds, double render_seconds, const cli::Json* comparison) {
+                        double load_seconds, double render_seconds, const bake::render::CompareMetrics* comparison) {
   if (tool.common().json) {
     cli::Json doc;
     doc["tool"] = "glintref";
@@ -202,11 +197,8 @@ void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::ren
     doc["output"] = cli::baseName(options.output);
     if (!options.preview.empty()) doc["preview"] = cli::baseName(options.preview);
     if (comparison) {
-      cli::Json c = *comparison;
-      c["reference"] = cli::baseName(options.compare);
-      c.erase("width");
-      c.erase("height");
-      doc["compare"] = c;
+      doc["compare"] = comparisonJson(*comparison, options.heatmap);
+      doc["compare"]["reference"] = cli::baseName(options.compare);
     }
     tool.printJson(doc);
   } else {
@@ -214,9 +206,8 @@ void printRenderSummary(cli::Tool& tool, const RenderOptions& options, bake::ren
               ", --ndf " + options.ndf + ", " + std::to_string(render_seconds) + " s)");
     if (comparison) {
       std::ostringstream s;
-      s << "against " << options.compare << ": rmse " << (*comparison)["rmse"].get<double>() << "  relative_mse "
-        << ((*comparison)["relative_mse"].is_null() ? std::numeric_limits<double>::infinity()
-                                                    : (*comparison)["relative_mse"].get<double>());
+      s << "against " << options.compare << ": rmse " << comparison->rmse << "  relative_mse "
+        << comparison->relative_mse;
       tool.info(s.str());
     }
   }
@@ -262,15 +253,16 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   int width = 0, height = 0;
   const bake::render::NdfMode mode = checkRenderOptions(options, &width, &height);
   const bake::render::Scene scene = loadRenderScene(tool, options, width, height);
+  // The reference is read and its size checked before the render, so that a bad one fails fast.
+  bake::render::RgbImage reference;
   if (!options.compare.empty()) {
-    // The reference is read and its size checked before the render, so that a bad one fails fast.
-    auto reference = bake::render::loadRgbImage(options.compare);
-    if (!reference) throw cli::Error(int(reference.error().code), reference.error().message);
-    if (reference.value().width != scene.camera.width || reference.value().height != scene.camera.height) {
+    tool.addInput(options.compare);
+    reference = loadCompareImage(options.compare);
+    if (reference.width != scene.camera.width || reference.height != scene.camera.height) {
       throw cli::Error(cli::kExitInvalidInput,
-                       "--compare " + options.compare + " is " + std::to_string(reference.value().width) + "x" +
-                           std::to_string(reference.value().height) + ", the render " +
-                           std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height));
+                       "--compare " + options.compare + " is " + std::to_string(reference.width) + "x" +
+                           std::to_string(reference.height) + ", the render " + std::to_string(scene.camera.width) +
+                           "x" + std::to_string(scene.camera.height));
     }
   }
   RenderSources sources;
@@ -293,13 +285,13 @@ int runRender(cli::Tool& tool, RenderOptions& options) {
   progress->finish();
   const bake::render::RenderedImage image = cli::unwrap(std::move(rendered));
   writeRenderOutputs(tool, options, image);
-  // The comparison reads the render back as written, so that its figures are glintref compare's.
-  cli::Json comparison;
-  double relative_mse = 0.0;
+  // The comparison reads the render back as written (the file's precision), so that its figures
+  // are glintref compare's.
+  bake::render::CompareMetrics comparison;
   if (!options.compare.empty()) {
     try {
       comparison =
-          compareFiles(tool, options.output, options.compare, options.heatmap, options.heatmap_scale, &relative_mse);
+          compareLoaded(tool, loadCompareImage(options.output), reference, options.heatmap, options.heatmap_scale);
     } catch (...) {
       // No partial output: the render and its preview go with a comparison that failed.
       for (const std::string& out : {options.output, options.preview, options.heatmap})
