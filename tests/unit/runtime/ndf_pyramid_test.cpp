@@ -390,9 +390,9 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
     const double p = pos(rng), sigma_l = 2.0, sigma = std::sqrt(sigma_l * sigma_l + 4.0 * 4.0 / 6.0 + extra(rng));
     int idx[format::kMaxBlendAxis];
     double w[format::kMaxBlendAxis];
-    const int n = axis.gaussianWeights(p, sigma, sigma_l, 1.5, idx, w);
+    const int n = axis.gaussianWeights(p, sigma, sigma_l, format::NdfPyramidBlend::kMaxSpread, idx, w);
     // The same weights from the closed form: tau * second differences of F, wrapped and normalised.
-    const double tau = std::min(axis.spread(sigma, sigma_l), 1.5), g = (p - 2.0) / 4.0;
+    const double tau = std::min(axis.spread(sigma, sigma_l), format::NdfPyramidBlend::kMaxSpread), g = (p - 2.0) / 4.0;
     double ref[16] = {}, total = 0.0;
     for (int i = int(std::floor(g - 3.5 * tau - 1.0)); i <= int(std::floor(g + 3.5 * tau + 1.0)) + 1; ++i) {
       const double d = (g - i) / tau;

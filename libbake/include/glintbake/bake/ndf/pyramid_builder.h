@@ -61,13 +61,13 @@ struct PyramidOptions {
   int region_size = 16;        // centres per region side, [1, 256]
   // Automatic level count: the convergence test runs only above a level of at most this many
   // centres per side (0: above every level). The default is the runtime's whole-grid blend
-  // (format::kMaxBlendAxis): a repeating map's top level of at most 16 x 16 centres answers every
+  // (format::kWholeGridAxis): a repeating map's top level of at most 16 x 16 centres answers every
   // wider footprint with the mean of its centres over the footprint, where a larger top grid is
-  // spread by at most 1.5 strides, a clamp that footprints far above it see as the wrong NDF (on
+  // spread by at most 2 strides, a clamp that footprints far above it see as the wrong NDF (on
   // a brushed 1024^2 map, a pyramid that stopped at its level 0 scored 0.09-0.10 relative L1 at
   // 48-128 texels, worse than the whole map's NDF). tensorpack also makes the pyramid reach the
   // small levels it stores exactly.
-  int converge_from_grid = format::kMaxBlendAxis;
+  int converge_from_grid = format::kWholeGridAxis;
   int converge_from_level = 0;  // ... and only above this level
   // Sharded bakes (bake/shard/shard.h): when set, only the regions it accepts are computed and
   // handed to the sink (addChunk); the others are announced with skipChunk, and of their centres
