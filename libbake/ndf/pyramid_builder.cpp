@@ -217,6 +217,7 @@ class PyramidBuild {
     LevelGeometry geo;
     format::NdfLevelRecord rec;
     bool split = false;                      // footprints split over kSplitParts row sets
+    FootprintPartition partition;            // the level's partition-of-unity factors (splat.h)
     std::vector<Sample> samples;             // of this level, predicted from the level below
     std::vector<Sample> next;                // of the next level, predicted from this one
     std::vector<std::vector<float>> probed;  // images of `samples`, computed by the probe
@@ -299,6 +300,10 @@ PyramidBuild::Level PyramidBuild::planLevel(int level, std::vector<Sample> sampl
   // Footprints with very many flakes (the top levels: few images, each costing up to several
   // map's worth of flakes) are split; the split depends only on the level.
   lv.split = !source_ && splatters_->local().flakesPerImage(lv.geo.sigma) > kSplitFlakes;
+  if (!source_ && flakes_) {
+    lv.partition = footprintPartition(*flakes_, lv.geo.sigma, lv.geo.grid_width, lv.geo.stride_x, lv.geo.grid_height,
+                                      lv.geo.stride_y);
+  }
   return lv;
 }
 
@@ -311,13 +316,13 @@ void PyramidBuild::computeImage(const Level& lv, int i, int j, float* out) {
     return;
   }
   if (!lv.split) {
-    splatters_->local().image(x, y, lv.geo.sigma, out);
+    splatters_->local().image(x, y, lv.geo.sigma, out, &lv.partition);
     return;
   }
   tbb::parallel_for(0, kSplitParts, [&](int part) {
     std::vector<double>& acc = part_acc_[size_t(part)];
     std::fill(acc.begin(), acc.end(), 0.0);
-    splatters_->local().accumulate(x, y, lv.geo.sigma, part, kSplitParts, acc.data());
+    splatters_->local().accumulate(x, y, lv.geo.sigma, part, kSplitParts, acc.data(), &lv.partition);
   });
   for (int part = 1; part < kSplitParts; ++part) {
     for (size_t b = 0; b < image_floats_; ++b) part_acc_[0][b] += part_acc_[size_t(part)][b];

@@ -241,9 +241,47 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
   flush();
 }
 
-int64_t Splatter::image(double x, double y, double sigma, float* out) {
+namespace {
+
+// 1 / R along one axis of `flakes` flakes `step` apart (see footprintPartition); empty when the
+// axis is left alone.
+std::vector<double> partitionAxis(int flakes, double step, int centres, double stride, double variance) {
+  const double sd = std::sqrt(variance);
+  if (centres < 2 || !(stride <= kPartitionMaxStride * sd)) return {};
+  std::vector<double> inv(size_t(std::max(flakes, 0)));
+  const double reach = 10.0 * sd;  // the density below e^-50 beyond
+  const double scale = stride / (std::sqrt(2.0 * kPi) * sd);
+  for (int g = 0; g < flakes; ++g) {
+    const double u = (double(g) + 0.5) * step;
+    // Centres (k + 0.5) stride for every integer k: the level's centres and their periodic images
+    // (stride * centres is the map's size).
+    const int64_t k0 = int64_t(std::floor((u - reach) / stride - 0.5));
+    const int64_t k1 = int64_t(std::ceil((u + reach) / stride - 0.5));
+    double r = 0.0;
+    for (int64_t k = k0; k <= k1; ++k) {
+      const double d = u - (double(k) + 0.5) * stride;
+      r += std::exp(-0.5 * d * d / variance);
+    }
+    inv[size_t(g)] = 1.0 / (scale * r);
+  }
+  return inv;
+}
+
+}  // namespace
+
+FootprintPartition footprintPartition(const FlakeSet& flakes, double sigma, int centres_x, double stride_x,
+                                      int centres_y, double stride_y) {
+  FootprintPartition p;
+  if (flakes.wrap != Wrap::kRepeat) return p;
+  const double variance = flakes.sigma_h * flakes.sigma_h + sigma * sigma;
+  p.x = partitionAxis(flakes.grid_width, flakes.step, centres_x, stride_x, variance);
+  p.y = partitionAxis(flakes.grid_height, flakes.step, centres_y, stride_y, variance);
+  return p;
+}
+
+int64_t Splatter::image(double x, double y, double sigma, float* out, const FootprintPartition* partition) {
   std::fill(acc_.begin(), acc_.end(), 0.0);
-  const int64_t used = accumulate(x, y, sigma, 0, 1, acc_.data());
+  const int64_t used = accumulate(x, y, sigma, 0, 1, acc_.data(), partition);
   finish(acc_.data(), out);
   return used;
 }
@@ -260,7 +298,8 @@ void Splatter::finish(const double* acc, float* out) const {
   for (size_t i = 0; i < n; ++i) out[i] = inside_disk_[i] ? float(acc[i] * inv_bin_area) : 0.0f;
 }
 
-int64_t Splatter::accumulate(double x, double y, double sigma, int part, int parts, double* acc) const {
+int64_t Splatter::accumulate(double x, double y, double sigma, int part, int parts, double* acc,
+                             const FootprintPartition* partition) const {
   const int res = params_.ndf_res;
   const FlakeSet& f = flakes_;
   const double sh2 = f.sigma_h * f.sigma_h;
@@ -288,6 +327,9 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
   const int64_t gy0 = int64_t(std::floor((y - radius) / f.step - 0.5));
   const int64_t gy1 = int64_t(std::ceil((y + radius) / f.step - 0.5));
   const bool repeat = f.wrap == Wrap::kRepeat;
+  // Partition factors apply to repeating maps only (footprintPartition leaves clamped ones alone).
+  const double* part_x = partition && repeat && !partition->x.empty() ? partition->x.data() : nullptr;
+  const double* part_y = partition && repeat && !partition->y.empty() ? partition->y.data() : nullptr;
   int64_t used = 0;
   for (int64_t gy = gy0 + part; gy <= gy1; gy += parts) {
     int64_t wy = gy;
@@ -300,6 +342,7 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
     const double dy = f.positionY(gy) - y;
     const double dy2 = dy * dy;
     if (dy2 > radius2) continue;
+    const double row_factor = part_y ? part_y[wy] : 1.0;
     for (int64_t gx = gx0; gx <= gx1; ++gx) {
       const double dx = f.positionX(gx) - x;
       const double d2 = dx * dx + dy2;
@@ -320,7 +363,8 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
       const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
       const double cxy = kc * (j00 * j10 + j01 * j11);
       const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
-      const double mass = spatial_norm * std::exp(-d2 * inv_2s2);
+      double mass = spatial_norm * std::exp(-d2 * inv_2s2);
+      if (part_x || part_y) mass *= row_factor * (part_x ? part_x[wx] : 1.0);
       splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
       ++used;
     }

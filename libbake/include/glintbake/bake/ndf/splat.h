@@ -46,6 +46,26 @@ struct SplatParams {
   double lobe_truncation = 4.0;       // lobe extent in conditional stds, [2, 10]
 };
 
+// Per-flake factors on the footprint weights of one pyramid level (footprintPartition): the flake
+// at wrapped grid position (gx, gy) weighs x[gx] * y[gy] times its Gaussian weight. An empty axis
+// has factor 1.
+struct FootprintPartition {
+  std::vector<double> x, y;
+  bool empty() const { return x.empty() && y.empty(); }
+};
+
+// The factors that make a level's footprints a partition of unity on a repeating map, axis by axis
+// (formats/SPEC.md 10.1): 1 / R(u) with R(u) = stride * sum_k g(u - c_k), g the normal density of
+// the splat's variance sigma_h^2 + sigma^2 and c_k = (k + 0.5) stride the level's centres and their
+// periodic images (R has mean 1). The level's Gaussian footprints then sum to the same weight at
+// every texel, so a flat mix of its images is exactly the whole map's NDF instead of one whose
+// texels weigh 1 +- 2 exp(-2 pi^2 (sigma / stride)^2) (1.4% at stride 2 sigma). An axis is left
+// alone (no entries) on clamped maps, with fewer than two centres, or with a stride above
+// kPartitionMaxStride times the footprint's std, where R would dip towards 0 between centres.
+constexpr double kPartitionMaxStride = 2.5;
+FootprintPartition footprintPartition(const FlakeSet& flakes, double sigma, int centres_x, double stride_x,
+                                      int centres_y, double stride_y);
+
 // Computes NDF images of one FlakeSet. Holds scratch buffers: one splatter per thread (not
 // thread-safe); the FlakeSet is shared read-only and must outlive the splatter. Deterministic: the
 // result depends only on the flakes, the parameters and the footprint (fixed flake order, double
@@ -57,14 +77,16 @@ class Splatter {
   // Bin-averaged P-NDF image of the footprint centred at (x, y) texels with std sigma texels
   // (sigma >= 0) into out[R * R] (row-major, row 0 at s_y = +1). Returns the number of flakes
   // that contributed.
-  int64_t image(double x, double y, double sigma, float* out);
+  // With `partition`, each flake's footprint weight is multiplied by its factors.
+  int64_t image(double x, double y, double sigma, float* out, const FootprintPartition* partition = nullptr);
 
   // The same image split into `parts` interleaved sets of flake rows, for footprints too large for
   // one thread: accumulate() adds the bin MASSES of rows part, part + parts, ... into acc[R * R]
   // (thread-safe: const, caller-owned buffer); finish() turns summed masses into the stored image.
   // Summing the parts in a fixed order gives bytes independent of the thread count (they may differ
   // from image() in the last bits, since the summation order differs).
-  int64_t accumulate(double x, double y, double sigma, int part, int parts, double* acc) const;
+  int64_t accumulate(double x, double y, double sigma, int part, int parts, double* acc,
+                     const FootprintPartition* partition = nullptr) const;
   void finish(const double* acc, float* out) const;
   // Flakes within the truncation radius of a footprint of std sigma (estimate, for scheduling).
   double flakesPerImage(double sigma) const;
