@@ -157,7 +157,7 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
     std::printf("                pyramid of %d levels, sigma %g to %g texels; above: %s\n", f["levels"].get<int>(),
                 f["pyramid_min_sigma"].get<double>(), f["pyramid_max_sigma"].get<double>(),
                 f["unbounded_above_top"].get<bool>() ? "the top level spread to any width"
-                                                     : "the top level spread up to 2 strides (a clamp)");
+                                                     : "the top level spread up to 2.5 strides (a clamp)");
   }
   std::printf("\n");
   std::printf("%5s  %-12s  %-24s  %-5s  %12s  %12s  %7s\n", "index", "type", "key", "codec", "stored", "raw", "ratio");

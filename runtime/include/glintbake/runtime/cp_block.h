@@ -54,7 +54,7 @@ constexpr int32_t kCpMaxRank = 64;
 constexpr int32_t kCpMaxBins = 256;
 // Most terms of a blend (the footprint blend's centres, format::kMaxBlendCentres) and most
 // distinct groups among them (the blend's centres lie in a few spatial regions of two levels).
-constexpr int32_t kCpMaxBlend = 648;
+constexpr int32_t kCpMaxBlend = 968;
 constexpr int32_t kCpMaxGroups = 128;
 
 // A non-owning view of one compressed group (float32, row-major, rank entries per row):

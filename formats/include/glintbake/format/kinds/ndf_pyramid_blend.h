@@ -30,9 +30,9 @@ namespace glintbake::format {
 // Most centres per axis of a top level that the blend spreads to any width (a repeating map's whole
 // grid, see gaussianLevel); the baker's automatic level count stops only at a grid this small.
 constexpr int kWholeGridAxis = 16;
-// Most centres blend() emits per axis of one level (the 2 (3.5 q + 1) + 2 a spread of kMaxSpread
-// can reach) and for one footprint (two levels).
-constexpr int kMaxBlendAxis = 18;
+// Most centres blend() emits per axis of one level (the 2 (3.5 q + 1) + 2 a spread of
+// NdfPyramidBlend::kMaxSpread can reach, rounded up) and for one footprint (two levels).
+constexpr int kMaxBlendAxis = 22;
 constexpr int kMaxBlendCentres = 2 * kMaxBlendAxis * kMaxBlendAxis;
 
 // F(z) = z Phi(z) + phi(z) (the Gaussian's CDF integrated once), whose second differences are the
@@ -202,13 +202,15 @@ class NdfPyramidBlend {
  public:
   // Spread (tau' in strides) up to which a level answers, and from which the next level is blended
   // in. A level of stride 2 sigma_l samples its footprints' NDF field below its Nyquist rate, and
-  // the tau'-Gaussian over its centres only hides the aliasing once q is near 1 or above (a 777 x
-  // 513 tufted-leather map at 96 texels: 0.049 relative L1 answered mostly by a level at q = 0.37,
-  // 0.007 by the level below at q = 1.35). With levels of stride 2 sigma_l, sigma_l doubling, the
-  // next level's q where it takes over (q = 2 here) is 0.83, where its alias is small; a clamp at
-  // 1.5 handed over at 0.5. The price is more centres per query: up to kMaxBlendAxis per axis.
-  static constexpr double kMaxSpread = 2.0;
-  static constexpr double kBlendSpread = 1.6;
+  // the tau'-Gaussian over its centres only hides the aliasing once q is about 1 or above. With
+  // levels of stride 2 sigma_l, sigma_l doubling, the next level's q where it starts to take over
+  // (q = 2 here) is 0.83 and where it answers alone (2.5) 1.12. On a 777 x 513 tufted-leather map
+  // (relative L1 against the reference): at 96 texels 0.049 when the switch was at 1.0-1.5 (a
+  // level at q = 0.37 answered most of it), 0.007 at 1.6-2; at 128 texels 0.019 at 1.6-2 (a level
+  // at q = 0.75 had three quarters of it), 0.001 at 2-2.5. The price is more centres per query: up
+  // to kMaxBlendAxis per axis.
+  static constexpr double kMaxSpread = 2.5;
+  static constexpr double kBlendSpread = 2.0;
 
   // records: `count` level records that passed checkNdfLevelRecord (strides and sigmas finite and
   // positive, sigmas increasing); 1 <= count <= kMaxNdfLevels.

@@ -63,7 +63,7 @@ struct PyramidOptions {
   // centres per side (0: above every level). The default is the runtime's whole-grid blend
   // (format::kWholeGridAxis): a repeating map's top level of at most 16 x 16 centres answers every
   // wider footprint with the mean of its centres over the footprint, where a larger top grid is
-  // spread by at most 2 strides, a clamp that footprints far above it see as the wrong NDF (on
+  // spread by at most 2.5 strides, a clamp that footprints far above it see as the wrong NDF (on
   // a brushed 1024^2 map, a pyramid that stopped at its level 0 scored 0.09-0.10 relative L1 at
   // 48-128 texels, worse than the whole map's NDF). tensorpack also makes the pyramid reach the
   // small levels it stores exactly.
