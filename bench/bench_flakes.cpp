@@ -257,7 +257,8 @@ const int registered = [] {
         ->Unit(benchmark::kMicrosecond);
   }
   for (size_t k = 0; k < assets().size(); ++k) {
-    for (double sigma : {1.0, 4.0, 5.0, 8.0, 12.0, 16.0, 20.0, 22.0, 24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 96.0, 128.0, 160.0, 256.0}) {
+    for (double sigma :
+         {1.0, 4.0, 5.0, 8.0, 12.0, 16.0, 20.0, 22.0, 24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 96.0, 128.0, 160.0, 256.0}) {
       const std::string tag = assets()[k].name + "/sigma:" + std::to_string(int(sigma));
       benchmark::RegisterBenchmark(("asset_eval/" + tag).c_str(), assetBench, k, sigma, false, false)
           ->Unit(benchmark::kMicrosecond);

@@ -71,8 +71,8 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
   const double a = std::exp(-2.0 * 3.14159265358979 * 3.14159265358979 * (centre.sigma * centre.sigma) /
                             (l0->stride_x * l0->stride_x));
   const double centre_err = relL1(reference::binAveragedImage(flakes, rf, o.splat.sigma_r, res));
-  std::printf("[ measured ] level-0 centre against the Gaussian footprint: relative L1 %.4f (bound %.4f)\n",
-              centre_err, 4.0 * a);
+  std::printf("[ measured ] level-0 centre against the Gaussian footprint: relative L1 %.4f (bound %.4f)\n", centre_err,
+              4.0 * a);
   EXPECT_LT(centre_err, 4.0 * a);
 
   // The plain trilinear blend (4 centres of each bracketing level), for comparison.
