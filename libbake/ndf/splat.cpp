@@ -363,8 +363,8 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
       const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
       const double cxy = kc * (j00 * j10 + j01 * j11);
       const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
-      double mass = spatial_norm * std::exp(-d2 * inv_2s2);
-      if (part_x || part_y) mass *= row_factor * (part_x ? part_x[wx] : 1.0);
+      // Factors of 1 leave the mass's bits as they are.
+      const double mass = spatial_norm * std::exp(-d2 * inv_2s2) * (row_factor * (part_x ? part_x[wx] : 1.0));
       splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
       ++used;
     }
