@@ -32,6 +32,12 @@ constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
 constexpr int kFinestTile = 4;       // flakes per side of a level-0 tile
 constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
+// Where the footprint weight is low the clustered levels take coarser tiles: a tile k levels above
+// the footprint's own is taken where its nearest point lies at least sqrt(2 k kCoarsenStep)
+// standard deviations from the centre (1.4, 2 and 2.4 for k = 1..kMaxCoarser), that is where the
+// weight has fallen below e^-k of its peak.
+constexpr double kCoarsenStep = 1.0;
+constexpr int kMaxCoarser = 3;
 // Spatial truncation, in standard deviations of a lobe's footprint weight: the lobes beyond hold
 // about 1% of the mass (a disk of 3 standard deviations); eval, mass and sample truncate alike.
 constexpr double kWindowSigmas = 3.0;
@@ -341,8 +347,10 @@ void laneWeightKernel(bool wide, const Block& b, int count, float sp2, float bx,
 // the answering level and the window.
 struct Terms {
   double sigma, ux, uy, sp2;
-  const Level* level;
-  double tile_texels;
+  const Level* level;    // the finest level of the cut (levelFor)
+  int finest, coarsest;  // its index and that of the coarsest level the cut may take tiles from
+  bool exact_mode;       // answered by the exact flakes' window (level 0 with every flake a lobe)
+  double tile_texels;    // tile side of the finest level
   double reach;
 };
 
@@ -375,10 +383,18 @@ struct LobeNdf::Impl {
   void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
   bool terms(const Footprint& fp, Terms* t) const;
-  // Calls visit(block, bound, base_x, base_y) for every tile of the window within the spatial
-  // truncation, base = u_Q - the origin of the tile's periodic image.
+  // Calls visit(block, bound, base_x, base_y, spatial_min, inv_a) for every tile of the footprint's
+  // cut within the spatial truncation (tiles of the answering level near the centre, of up to
+  // kMaxCoarser levels above it farther out; the same tiles in the same order for every query of
+  // a footprint), base = u_Q - the origin of the tile's periodic image.
   template <typename Visit>
   void forEachTile(const Terms& t, Visit&& visit) const;
+  // The same for the tiles that pass test(bound, base_x, base_y, spatial_min, tile side, inv_a),
+  // which sees only the tile's bounds (their blocks are fetched only for the tiles that pass).
+  template <typename Test, typename Visit>
+  void forEachTile(const Terms& t, Test&& test, Visit&& visit) const;
+  template <typename Accept>
+  void visitNode(const Terms& t, int li, int tx, int ty, double ux, double uy, Accept& accept) const;
   // Calls visit(lobe, weight) for every lane of the block within the spatial truncation, with the
   // footprint-conditioned s-plane lobe and its footprint weight.
   template <typename Visit>
@@ -581,7 +597,15 @@ int LobeNdf::Impl::levelFor(double sigma) const {
 bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
   t->sigma = fp.sigma;
   t->sp2 = fp.sigma * fp.sigma;
-  t->level = &levelBuilt(levelFor(fp.sigma));
+  t->finest = levelFor(fp.sigma);
+  t->exact_mode = t->finest == 0 && exact;
+  // Coarser levels up to kMaxCoarser above the answering one, when its tiles are within
+  // kTileRatio sigma (not when the finest level is answering a footprint narrower than that).
+  t->coarsest = t->finest;
+  if (!t->exact_mode && double(levels[t->finest].tile) <= kTileRatio * fp.sigma * rate)
+    t->coarsest = std::min(level_count - 1, t->finest + kMaxCoarser);
+  levelBuilt(t->coarsest);
+  t->level = &levels[t->finest];
   t->tile_texels = t->level->tile * step;
   t->ux = fp.x;
   t->uy = fp.y;
@@ -592,13 +616,60 @@ bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
     return false;
   }
   t->reach = kWindowSigmas * std::sqrt(t->sp2 + sigma_h2) + t->tile_texels;
-  return 2.0 * t->reach / t->tile_texels + 2.0 <= double(kMaxWindowTiles);
+  return 2.0 * t->reach / (levels[t->coarsest].tile * step) + 2.0 <= double(kMaxWindowTiles);
 }
 
 template <typename Visit>
 void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
-  const Level& l = *t.level;
-  const double side = t.tile_texels;
+  forEachTile(
+      t, [](const Bound&, double, double, double, double, double) { return true; }, visit);
+}
+
+template <typename Test, typename Visit>
+void LobeNdf::Impl::forEachTile(const Terms& t, Test&& test, Visit&& visit) const {
+  // The tiles of the cut are gathered in batches from their geometry alone; then the bounds of a
+  // batch are prefetched and tested, and the blocks of the tiles that pass (about a kilobyte each)
+  // prefetched a few tiles ahead of the one visited, so that their cache misses overlap.
+  struct TileRef {
+    size_t index;
+    double bx, by, d2, side;
+  };
+  constexpr int kBatch = 64, kAhead = 4;
+  TileRef batch[kBatch];
+  int n = 0;
+  const double inv_a = 1.0 / (t.sp2 + sigma_h2);
+  auto fetch = [&](const void* p, size_t size) {
+    const char* bytes = static_cast<const char*>(p);
+    for (size_t o = 0; o < size; o += 64) flakes::prefetch(bytes + o);
+    flakes::prefetch(bytes + size - 1);
+  };
+  auto flush = [&] {
+    for (int i = 0; i < n; ++i) fetch(bounds.data + batch[i].index, sizeof(Bound));
+    int kept = 0;
+    for (int i = 0; i < n; ++i) {
+      const TileRef& r = batch[i];
+      const Bound& bound = bounds.data[r.index];
+      if (bound.count == 0) continue;
+      // Smallest spatial exponent of the tile: A <= (sigma_p^2 + tr S_uu) I.
+      const double spatial_min = 0.5 * r.d2 / (t.sp2 + double(bound.uu));
+      if (spatial_min > kMaxSpatial || !test(bound, r.bx, r.by, spatial_min, r.side, inv_a)) continue;
+      if (kept < kAhead) fetch(blocks.data + r.index, sizeof(Block));
+      batch[kept] = r;
+      batch[kept++].d2 = spatial_min;
+    }
+    for (int i = 0; i < kept; ++i) {
+      if (i + kAhead < kept) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
+      const TileRef& r = batch[i];
+      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by, r.d2, inv_a);
+    }
+    n = 0;
+  };
+  auto accept = [&](size_t index, double bx, double by, double d2, double side) {
+    batch[n++] = {index, bx, by, d2, side};
+    if (n == kBatch) flush();
+  };
+  const Level& top = levels[t.coarsest];
+  const double side = top.tile * step;
   auto periods = [&](double u, double size, int64_t* p0, int64_t* p1) {
     if (!repeat) {
       *p0 = *p1 = 0;
@@ -610,33 +681,44 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   int64_t py0, py1, px0, px1;
   periods(t.uy, double(height), &py0, &py1);
   periods(t.ux, double(width), &px0, &px1);
-  const double inv_a = 1.0 / (t.sp2 + sigma_h2);
   for (int64_t py = py0; py <= py1; ++py) {
     const double oy = double(py) * height;
     const double ly0 = t.uy - t.reach - oy, ly1 = t.uy + t.reach - oy;
     const int ty0 = int(std::max(0.0, std::floor(ly0 / side))),
-              ty1 = int(std::min(double(l.tiles_y - 1), std::floor(ly1 / side)));
+              ty1 = int(std::min(double(top.tiles_y - 1), std::floor(ly1 / side)));
     for (int64_t px = px0; px <= px1; ++px) {
       const double ox = double(px) * width;
       const double lx0 = t.ux - t.reach - ox, lx1 = t.ux + t.reach - ox;
       const int tx0 = int(std::max(0.0, std::floor(lx0 / side))),
-                tx1 = int(std::min(double(l.tiles_x - 1), std::floor(lx1 / side)));
+                tx1 = int(std::min(double(top.tiles_x - 1), std::floor(lx1 / side)));
       for (int ty = ty0; ty <= ty1; ++ty) {
-        const double by = t.uy - oy - ty * side;
-        const double dy = by < 0.0 ? -by : (by > side ? by - side : 0.0);
-        for (int tx = tx0; tx <= tx1; ++tx) {
-          const double bx = t.ux - ox - tx * side;
-          const double dx = bx < 0.0 ? -bx : (bx > side ? bx - side : 0.0);
-          const size_t index = l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx);
-          const Bound& bound = bounds.data[index];
-          if (bound.count == 0) continue;
-          // Smallest spatial exponent of the tile: A <= (sigma_p^2 + tr S_uu) I.
-          const double spatial_min = 0.5 * (dx * dx + dy * dy) / (t.sp2 + double(bound.uu));
-          if (spatial_min > kMaxSpatial) continue;
-          visit(blocks.data[index], bound, bx, by, spatial_min, inv_a);
-        }
+        for (int tx = tx0; tx <= tx1; ++tx) visitNode(t, t.coarsest, tx, ty, t.ux - ox, t.uy - oy, accept);
       }
     }
+  }
+  flush();
+}
+
+// Tile (tx, ty) of level li, or its children when the cut takes this region from a finer level:
+// a tile li - finest levels coarser than the footprint's is taken where its nearest point is at
+// least sqrt(2 kCoarsenStep (li - finest)) footprint stds from the centre.
+template <typename Accept>
+void LobeNdf::Impl::visitNode(const Terms& t, int li, int tx, int ty, double ux, double uy, Accept& accept) const {
+  const Level& l = levels[li];
+  const double side = l.tile * step;
+  const double by = uy - ty * side, bx = ux - tx * side;
+  const double dy = by < 0.0 ? -by : (by > side ? by - side : 0.0);
+  const double dx = bx < 0.0 ? -bx : (bx > side ? bx - side : 0.0);
+  if (dx > t.reach || dy > t.reach) return;
+  const size_t index = l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx);
+  const double d2 = dx * dx + dy * dy;
+  if (li == t.finest || d2 >= 2.0 * kCoarsenStep * double(li - t.finest) * t.sp2) {
+    accept(index, bx, by, d2, side);
+    return;
+  }
+  const Level& c = levels[li - 1];
+  for (int cy = 2 * ty; cy < std::min(c.tiles_y, 2 * ty + 2); ++cy) {
+    for (int cx = 2 * tx; cx < std::min(c.tiles_x, 2 * tx + 2); ++cx) visitNode(t, li - 1, cx, cy, ux, uy, accept);
   }
 }
 
@@ -683,7 +765,7 @@ double LobeNdf::Impl::laneWeights(const Block& b, const Bound& bound, double bx,
 }
 
 double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
-  if (t.level == &levels[0] && exact) {
+  if (t.exact_mode) {
     double v = 0.0;
     FlakeNdfAccess::windowedEval(*exact, {t.ux, t.uy, t.sigma}, {sx, sy}, kWindowSigmas, &v);
     return v * kWindowNorm;
@@ -718,14 +800,16 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
     }
     n = 0;
   };
-  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double spatial_min, double inv_a) {
-    // The lobes' means lie within the box widened by |S_su A^-1 (u_Q - c)| and their covariance
-    // below tr S_ss: skip the tile when none can reach s.
-    const double ddx = std::fabs(bx) + t.tile_texels, ddy = std::fabs(by) + t.tile_texels;
+  // The lobes' means lie within the box widened by |S_su A^-1 (u_Q - c)| and their covariance
+  // below tr S_ss: skip the tiles whose lobes cannot reach s.
+  auto reaches = [&](const Bound& bound, double bx, double by, double spatial_min, double side, double inv_a) {
+    const double ddx = std::fabs(bx) + side, ddy = std::fabs(by) + side;
     const double shift = double(bound.su) * inv_a * std::sqrt(ddx * ddx + ddy * ddy);
     const double ex = std::max(std::max(double(bound.lo[0]) - shift - sx, sx - double(bound.hi[0]) - shift), 0.0);
     const double ey = std::max(std::max(double(bound.lo[1]) - shift - sy, sy - double(bound.hi[1]) - shift), 0.0);
-    if ((ex * ex + ey * ey) > 2.0 * (kMaxExponent - spatial_min) * double(bound.ss)) return;
+    return (ex * ex + ey * ey) <= 2.0 * (kMaxExponent - spatial_min) * double(bound.ss);
+  };
+  forEachTile(t, reaches, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
     n = keepLanes(wide, b, int(bound.count), c, float(bx), float(by), &list, n);
     if (n > kLaneList - kLanes) drain();
   });
@@ -734,7 +818,7 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
-  if (t.level == &levels[0] && exact) {
+  if (t.exact_mode) {
     double m = 0.0;
     FlakeNdfAccess::windowedMass(*exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, &m);
     return m * kWindowNorm;
@@ -874,7 +958,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   const LobeNdf::Impl& m = *lobes.impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  const bool exact_level = t.level == &m.levels[0] && m.exact;
+  const bool exact_level = t.exact_mode;
   // The clustered levels' mass tile by tile (massOf's sum, in its order), kept for the pick.
   double tile_mass[kMaxSampleTiles];
   int tiles = 0;

@@ -95,8 +95,14 @@ TEST(LobeNdf, ClusteredLevelsStayCloseToTheExactFlakes) {
     Pair p(mapOf(kind, 128, 8), 16);
     for (double sigma : {24.0}) {
       EXPECT_GT(p.lobes.tileFor(sigma), 4);
-      const double e = p.imageError({70.2, 33.9, sigma});
+      const Footprint fp{70.2, 33.9, sigma};
+      const double e = p.imageError(fp);
       EXPECT_LT(e, 0.05) << "kind " << int(kind) << " sigma " << sigma;
+      // Coarser tiles far from the centre (the cut) keep the footprint's mass.
+      double ml = 0.0, mf = 0.0;
+      ASSERT_EQ(p.lobes.mass(fp, &ml), RuntimeStatus::kOk);
+      ASSERT_EQ(p.flakes.mass(fp, &mf), RuntimeStatus::kOk);
+      EXPECT_NEAR(ml / mf, 1.0, 0.01) << "kind " << int(kind);
       std::printf("kind %d sigma %g: relative L1 %.3f\n", int(kind), sigma, e);
     }
   }
@@ -158,8 +164,9 @@ TEST(LobeNdf, RotatedMapRotatesTheNdf) {
 }
 
 TEST(LobeNdf, SamplesFollowTheirPdf) {
+  // 6 and 14: the exact flakes of level 0; 30: a clustered level with coarser tiles far out.
   Pair p(mapOf(bake::MapKind::kBeckmann, 128, 21), 16, 32);
-  for (double sigma : {6.0, 14.0}) {
+  for (double sigma : {6.0, 14.0, 30.0}) {
     const Footprint fp{40.5, 22.25, sigma};
     double mass = 0.0;
     ASSERT_EQ(p.lobes.mass(fp, &mass), RuntimeStatus::kOk);

@@ -22,20 +22,32 @@
 // keeps lobes_per_tile (lobes of different orientation stay apart, as the arms of two crossing
 // scratches, which k-means on the normal means merged; image relative L1 at 24 texels against
 // every flake as its own lobe, k-means -> this: curved scratches 0.159 -> 0.057, sharp flakes
-// 0.144 -> 0.034, leather 0.087 -> 0.066, on the 1024^2 and 512^2 maps of the README). A
-// footprint is answered on the level whose tiles are at most 0.35 times its std (so the footprint
-// weight varies little across a tile and 19-36 tiles span the window per side), from every lobe within
-// 3 standard deviations of the footprint centre; tiles whose lobes cannot reach s are skipped.
-// The cost is then about constant in the footprint size: a few thousand lobes per query, through
-// a two-pass kernel (a division-free test, then exp and sqrt on the kept lobes only; AVX2 where
-// the processor has it, with the same bits as the SSE2 kernel). With lobes_per_tile = 16, level 0
-// keeps every flake as its own lobe, and its eval, mass and sampling are those of the exact flakes
-// (flake_ndf.h, which prunes by normal within tiles) with the 3-sigma window. On 1024^2 maps
-// (bench/bench_flakes.cpp) eval costs about 6-9 us at sigma_p = 6 texels, 17-28 us at 12 and
-// 15-40 us on the clustered levels (24, 48). Sample: on level 0 the disk rows' weights come from
-// running sums of the column weights (linear in the window's side), so it costs about one eval;
-// on the clustered levels one weighing of the window's tiles (AVX2 where the processor has it),
-// whose tile masses the pick reuses, plus the eval of its density: about 1.7-2 evals.
+// 0.144 -> 0.034, leather 0.087 -> 0.066, on the 1024^2 and 512^2 maps of the README).
+//
+// A footprint is answered from a cut through the hierarchy: near its centre the tiles of the
+// level whose tiles are at most 0.35 times its std (so the footprint weight varies little across
+// a tile), farther out coarser ones, a tile k levels up (k <= 3) where its nearest point lies at
+// least sqrt(2 k) standard deviations from the centre, where the weight has fallen below e^-k of
+// its peak; every lobe within 3 standard deviations of the centre counts, and tiles whose lobes
+// cannot reach s are skipped. The cut depends on the footprint only, so eval, mass, sample and
+// the images see the same lobes. It visits about 140-370 tiles where the answering level alone
+// spans 300-1200 (a disk of 3 sigma on tiles of 0.175-0.35 sigma), at a cost in image relative
+// L1 against the reference of at most 0.024 on the README's maps (sharp flakes at 24 texels,
+// 0.032 -> 0.056; leather at 32, 0.070 -> 0.077; the smooth maps unchanged); coarser tiles from
+// 1 standard deviation on doubled that error. Each query gathers the tiles of its cut by their
+// geometry, tests their bounds, and prefetches the blocks of those that pass a few tiles ahead
+// of the kernel (the blocks, about a kilobyte each, are scattered over the levels): 0.6-0.7
+// times the time of the cut without it. The kernel has two passes (a division-free test, then exp and sqrt
+// on the kept lobes only; AVX2 where the processor has it, with the same bits as the SSE2
+// kernel). With lobes_per_tile = 16, level 0 keeps every flake as its own lobe, and its eval,
+// mass and sampling are those of the exact flakes (flake_ndf.h, which prunes by normal within
+// tiles) with the 3-sigma window, without a cut. On 1024^2 maps (bench/bench_flakes.cpp) eval
+// costs about 4 us at sigma_p = 6 texels, 12-15 us at 12 (level 0, up to 23 texels, is the
+// costliest band: 30-44 us at 20-22) and 8.4-9.7 us on the clustered levels at 24 and 48 (21-25
+// and 16-17 before the cut). Sample: on level 0 the disk rows' weights come from running sums of
+// the column weights (linear in the window's side), so it costs about one eval; on the
+// clustered levels one weighing of the cut's tiles (AVX2 where the processor has it), whose tile
+// masses the pick reuses, plus the eval of its density: about 2 evals.
 //
 // What it gives up against the exact path: the shape of each group beyond its covariance. It is
 // close where a tile's flakes form a few tight groups (sharp flakes, scratches) or vary smoothly,
