@@ -14,11 +14,19 @@ struct FlakeNdfAccess {
   // exponent cutoff and kernels.
   static RuntimeStatus windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s, double window_sigmas,
                                     double* value);
-  // FlakeNdf::eval (value) and windowedEval with inner_window_sigmas (<= 6; inner) from one
-  // traversal: the inner window's flakes are a subset of the full one's with the same lane values,
-  // so inner equals windowedEval up to the order of the summation.
+  // windowedEval with outer_window_sigmas (<= 6, the exact path's window; value) and with
+  // inner_window_sigmas (<= outer; inner) from one traversal: the inner window's flakes are a
+  // subset of the outer one's with the same lane values, so both equal windowedEval up to the
+  // order of the summation.
   static RuntimeStatus evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
-                                           double inner_window_sigmas, double* value, double* inner);
+                                           double inner_window_sigmas, double outer_window_sigmas, double* value,
+                                           double* inner);
+  // FlakeNdf::average and FlakeNdf::addImage with the footprint weights truncated at
+  // window_sigmas (<= 6), as windowedEval (FlakeNdf's own are these at 6).
+  static RuntimeStatus windowedAverage(const FlakeNdf& f, const Footprint& fp, const SRect& rect, double window_sigmas,
+                                       double* value);
+  static RuntimeStatus windowedAddImage(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double weight,
+                                        float* out, size_t out_count);
   // FlakeNdf::sample; without with_pdf the density is not evaluated (out->pdf = 0), for callers
   // that evaluate their own.
   static RuntimeStatus sample(const FlakeNdf& f, const Footprint& fp, double u1, double u2, NdfSample* out,

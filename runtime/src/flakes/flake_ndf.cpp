@@ -534,7 +534,7 @@ void FlakeNdf::Impl::forEachFlakeOf(const LeafVisit& leaf, const FootprintTerms&
     if (k.nx[i] == kPaddingNormal) continue;
     const double dx = leaf.base_x - double(localPosition(k.lx[i])), dy = leaf.base_y - double(localPosition(k.ly[i]));
     const double spatial = (dx * dx + dy * dy) * t.inv2v;
-    if (spatial <= kMaxExponent) visit(k, i, dx, dy, spatial);
+    if (spatial <= t.spatial_cut) visit(k, i, dx, dy, spatial);
   }
 }
 
@@ -707,12 +707,14 @@ RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& f
 }
 
 RuntimeStatus FlakeNdfAccess::evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
-                                                  double inner_window_sigmas, double* value, double* inner) {
+                                                  double inner_window_sigmas, double outer_window_sigmas, double* value,
+                                                  double* inner) {
   if (!f.impl_ || !value || !inner || !validFootprint(fp) || !flakes::validPoint(s) ||
-      !(inner_window_sigmas > 0.0 && inner_window_sigmas <= kWindowSigmas))
+      !(inner_window_sigmas > 0.0 && inner_window_sigmas <= outer_window_sigmas &&
+        outer_window_sigmas <= kWindowSigmas))
     return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!f.impl_->terms(fp, &t)) return RuntimeStatus::kInvalidArgument;
+  if (!f.impl_->terms(fp, &t, outer_window_sigmas)) return RuntimeStatus::kInvalidArgument;
   *value = *inner = 0.0;
   // The lanes a window of inner_window_sigmas keeps: spatial exponent below its cut, as in
   // windowedEval's kernel (float comparison).
@@ -849,10 +851,17 @@ RuntimeStatus FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double*
 }
 
 RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validRect(rect)) return RuntimeStatus::kInvalidArgument;
-  const Impl& m = *impl_;
+  return FlakeNdfAccess::windowedAverage(*this, footprint, rect, kWindowSigmas, value);
+}
+
+RuntimeStatus FlakeNdfAccess::windowedAverage(const FlakeNdf& f, const Footprint& footprint, const SRect& rect,
+                                              double window_sigmas, double* value) {
+  if (!f.impl_ || !value || !validFootprint(footprint) || !validRect(rect) ||
+      !(window_sigmas > 0.0 && window_sigmas <= kWindowSigmas))
+    return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
   FootprintTerms t;
-  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
+  if (!m.terms(footprint, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
@@ -892,14 +901,19 @@ RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, d
 }
 
 RuntimeStatus FlakeNdf::addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const {
-  if (!impl_) return RuntimeStatus::kInvalidArgument;
-  const Impl& m = *impl_;
+  return FlakeNdfAccess::windowedAddImage(*this, footprint, kWindowSigmas, weight, out, out_count);
+}
+
+RuntimeStatus FlakeNdfAccess::windowedAddImage(const FlakeNdf& f, const Footprint& footprint, double window_sigmas,
+                                               double weight, float* out, size_t out_count) {
+  if (!f.impl_ || !(window_sigmas > 0.0 && window_sigmas <= kWindowSigmas)) return RuntimeStatus::kInvalidArgument;
+  const FlakeNdf::Impl& m = *f.impl_;
   const int res = m.res;
   const size_t n = size_t(res) * size_t(res);
   if (!out || out_count < n || !validFootprint(footprint) || !std::isfinite(weight))
     return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
-  if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
+  if (!m.terms(footprint, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   const double bin = 2.0 / res;
   // Each lobe adds its probability over the bins, scaled to a density (divided by the bin area),
   // in the fixed order of the traversal.
@@ -954,12 +968,7 @@ RuntimeStatus FlakeNdfAccess::sample(const FlakeNdf& ndf, const Footprint& footp
   flakes::Lobe g;
   m.lobeOf(m.blocks.data[where / kLeafFlakes], int(where % kLeafFlakes), t.ux - m.flakePosition(fx),
            t.uy - m.flakePosition(fy), t, &g);
-  // Box-Muller, then the Cholesky factor of the lobe covariance.
-  const double radius = std::sqrt(-2.0 * std::log1p(-v1));
-  const double z0 = radius * std::cos(kTwoPi * v2), z1 = radius * std::sin(kTwoPi * v2);
-  const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11, l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
-  out->s.x = g.mx + l11 * z0;
-  out->s.y = g.my + l21 * z0 + l22 * z1;
+  flakes::lobePoint(g, v1, v2, &out->s.x, &out->s.y);
   out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
   return RuntimeStatus::kOk;
 }

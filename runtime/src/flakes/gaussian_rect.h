@@ -16,6 +16,18 @@ struct Lobe {
   double cxx, cxy, cyy;
 };
 
+// The point of the lobe for uniforms v1, v2 in [0, 1): Box-Muller, then the Cholesky factor of
+// the covariance (how every flake and lobe path samples a lobe it has picked).
+inline void lobePoint(const Lobe& g, double v1, double v2, double* x, double* y) {
+  const double radius = std::sqrt(-2.0 * std::log1p(-v1));
+  const double z0 = radius * std::cos(6.283185307179586476925286766559 * v2);
+  const double z1 = radius * std::sin(6.283185307179586476925286766559 * v2);
+  const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11;
+  const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
+  *x = g.mx + l11 * z0;
+  *y = g.my + l21 * z0 + l22 * z1;
+}
+
 // How precisely the integrals are taken. kExact: mass beyond 8.5 standard deviations skipped
 // (below 2e-17) and 8-point Gauss-Legendre panels, error below about 1e-10 of the lobe's mass (the
 // exact flake path, which is checked against the reference evaluator). kImage: beyond 5.5

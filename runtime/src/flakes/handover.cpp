@@ -6,6 +6,7 @@
 #include "../heap_array.h"
 #include "../pyramid_blend.h"
 #include "flake_access.h"
+#include "flake_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -53,8 +54,75 @@ RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resoluti
   return RuntimeStatus::kOk;
 }
 
+double BandFlakes::norm() {
+  static const double scale = 1.0 / (1.0 - std::exp(-kBandFlakeWindow * kBandFlakeWindow / 2.0));
+  return scale;
+}
+
+RuntimeStatus BandFlakes::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  double v = 0.0;
+  if (RuntimeStatus st = FlakeNdfAccess::windowedEval(*flakes_, fp, s, kBandFlakeWindow, &v); st != RuntimeStatus::kOk)
+    return st;
+  *value = v * norm();
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus BandFlakes::average(const Footprint& fp, const SRect& rect, double* value) const {
+  double v = 0.0;
+  if (RuntimeStatus st = FlakeNdfAccess::windowedAverage(*flakes_, fp, rect, kBandFlakeWindow, &v);
+      st != RuntimeStatus::kOk)
+    return st;
+  *value = v * norm();
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus BandFlakes::mass(const Footprint& fp, double* value) const {
+  double v = 0.0;
+  if (!value) return RuntimeStatus::kInvalidArgument;
+  if (RuntimeStatus st = FlakeNdfAccess::windowedMass(*flakes_, fp, kBandFlakeWindow, &v); st != RuntimeStatus::kOk)
+    return st;
+  *value = v * norm();
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus BandFlakes::pdf(const Footprint& fp, const SPoint& s, double* value) const {
+  if (!value) return RuntimeStatus::kInvalidArgument;
+  double e = 0.0, m = 0.0;
+  if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
+  if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
+  *value = m > 0.0 ? e / m : 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus BandFlakes::addImage(const Footprint& fp, double weight, float* out, size_t out_count) const {
+  if (!std::isfinite(weight)) return RuntimeStatus::kInvalidArgument;
+  return FlakeNdfAccess::windowedAddImage(*flakes_, fp, kBandFlakeWindow, weight * norm(), out, out_count);
+}
+
+RuntimeStatus BandFlakes::draw(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (!out || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0)) return RuntimeStatus::kInvalidArgument;
+  double m = 0.0;
+  if (RuntimeStatus st = FlakeNdfAccess::windowedMass(*flakes_, fp, kBandFlakeWindow, &m); st != RuntimeStatus::kOk)
+    return st;
+  if (!(m > 0.0)) return RuntimeStatus::kInvalidArgument;
+  flakes::Lobe g;
+  double v1 = 0.5, v2 = 0.5;
+  if (RuntimeStatus st = FlakeNdfAccess::windowedPick(*flakes_, fp, kBandFlakeWindow, u1, u2, m, &g, &v1, &v2);
+      st != RuntimeStatus::kOk)
+    return st;
+  flakes::lobePoint(g, v1, v2, &out->s.x, &out->s.y);
+  out->pdf = 0.0;
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus BandFlakes::sample(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+  if (RuntimeStatus st = draw(fp, u1, u2, out); st != RuntimeStatus::kOk) return st;
+  if (!flakes::inSquare(out->s)) return RuntimeStatus::kOk;  // pdf 0: a failed sample, as FlakeNdf's
+  return pdf(fp, out->s, &out->pdf);
+}
+
 HandoverNdf::HandoverNdf(FlakePaths paths, std::unique_ptr<NdfSource> pyramid)
-    : paths_(std::move(paths)), pyramid_(std::move(pyramid)) {
+    : paths_(std::move(paths)), band_flakes_(paths_.flakes.get()), pyramid_(std::move(pyramid)) {
   const format::FlakesRecord& r = paths_.record;
   flakes_up_to_ = r.flakes_up_to;
   pyramid_from_ = r.pyramid_from;
@@ -85,9 +153,9 @@ HandoverNdf::Mix HandoverNdf::mixFor(double sigma) const {
   const AccumulatingNdfSource* flakes = paths_.flakes.get();
   if (sigma <= flakes_up_to_) return {flakes, nullptr, 0.0};
   if (sigma >= pyramid_from_) return {flakes, pyramid_.get(), 1.0};
-  if (!paths_.lobes) return {flakes, pyramid_.get(), band(sigma, flakes_up_to_, pyramid_from_)};
+  if (!paths_.lobes) return {&band_flakes_, pyramid_.get(), band(sigma, flakes_up_to_, pyramid_from_)};
   const AccumulatingNdfSource* lobes = paths_.lobes.get();
-  if (sigma < lobes_from_) return {flakes, lobes, band(sigma, flakes_up_to_, lobes_from_)};
+  if (sigma < lobes_from_) return {&band_flakes_, lobes, band(sigma, flakes_up_to_, lobes_from_)};
   if (sigma <= lobes_up_to_) return {lobes, nullptr, 0.0};
   return {lobes, pyramid_.get(), band(sigma, lobes_up_to_, pyramid_from_)};
 }
@@ -114,13 +182,14 @@ RuntimeStatus HandoverNdf::eval(const Footprint& fp, const SPoint& s, double* va
     // sums come from one traversal of the flakes.
     const Mix mix = mixFor(fp.sigma);
     double window = 0.0, norm = 0.0;
-    if (mix.t > 0.0 && mix.t < 1.0 && mix.lower == paths_.flakes.get() && paths_.lobes &&
-        mix.upper == paths_.lobes.get() && LobeNdfAccess::exactWindow(*paths_.lobes, fp.sigma, &window, &norm)) {
-      double full = 0.0, inner = 0.0;
-      if (RuntimeStatus st = FlakeNdfAccess::evalWithInnerWindow(*paths_.flakes, fp, s, window, &full, &inner);
+    if (mix.t > 0.0 && mix.t < 1.0 && mix.lower == &band_flakes_ && paths_.lobes && mix.upper == paths_.lobes.get() &&
+        LobeNdfAccess::exactWindow(*paths_.lobes, fp.sigma, &window, &norm) && window <= kBandFlakeWindow) {
+      double outer = 0.0, inner = 0.0;
+      if (RuntimeStatus st =
+              FlakeNdfAccess::evalWithInnerWindow(*paths_.flakes, fp, s, window, kBandFlakeWindow, &outer, &inner);
           st != RuntimeStatus::kOk)
         return st;
-      *value = (1.0 - mix.t) * full + mix.t * (norm * inner);
+      *value = (1.0 - mix.t) * (BandFlakes::norm() * outer) + mix.t * (norm * inner);
       return RuntimeStatus::kOk;
     }
   }
@@ -174,8 +243,8 @@ RuntimeStatus HandoverNdf::sample(const Footprint& fp, double u1, double u2, Ndf
   // The flakes and lobes draw the point without their own density (the blend's is needed).
   NdfSample picked;
   RuntimeStatus drawn;
-  if (&src == paths_.flakes.get())
-    drawn = FlakeNdfAccess::sample(*paths_.flakes, fp, u, u2, &picked, false);
+  if (&src == &band_flakes_)
+    drawn = band_flakes_.draw(fp, u, u2, &picked);
   else if (paths_.lobes && &src == paths_.lobes.get())
     drawn = LobeNdfAccess::sample(*paths_.lobes, fp, u, u2, &picked, false, first ? &ma : &mb);
   else

@@ -979,12 +979,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   }
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   auto finish = [&](const flakes::Lobe& g, double v1, double v2) {
-    const double radius = std::sqrt(-2.0 * std::log1p(-v1));
-    const double z0 = radius * std::cos(kTwoPi * v2), z1 = radius * std::sin(kTwoPi * v2);
-    const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11;
-    const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
-    out->s.x = g.mx + l11 * z0;
-    out->s.y = g.my + l21 * z0 + l22 * z1;
+    flakes::lobePoint(g, v1, v2, &out->s.x, &out->s.y);
     out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
     return RuntimeStatus::kOk;
   };

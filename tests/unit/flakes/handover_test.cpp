@@ -12,6 +12,7 @@
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
 
+#include "../../stats/chi_square.h"
 #include "../temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -148,18 +149,32 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
   }
 }
 
+// The reference P-NDF with the footprint weights truncated at `window` standard deviations and
+// scaled by the inverse of that disk's share of a Gaussian: the flakes' share of a hand-over band
+// (runtime kBandFlakeWindow = 4).
+double bandReference(const reference::FlakeSet& set, const Footprint& fp, SPoint s, double window = 4.0) {
+  const reference::Footprint rfp{fp.x, fp.y, fp.sigma};
+  const double v = set.sigma_h * set.sigma_h + fp.sigma * fp.sigma;
+  const double peak = set.area / (2.0 * M_PI * v), cut = window * window / 2.0;
+  double sum = 0.0;
+  for (const reference::FlakeLobe& lobe : reference::footprintLobes(set, rfp, reference::kDefaultSigmaR)) {
+    if (std::log(peak / lobe.weight) <= cut) sum += reference::lobeDensity(lobe, s.x, s.y);
+  }
+  return sum / (1.0 - std::exp(-cut));
+}
+
 // Between the flakes and the lobes that answer from the exact flakes in their narrower window, the
-// asset evaluates both from one traversal: the blend of the two paths evaluated apart, at points
-// where the NDF matters and anywhere, near the map's edges too (periodic windows).
+// asset evaluates both from one traversal: the blend of the flakes in a 4-sigma window and of the
+// lobes evaluated apart, at points where the NDF matters and anywhere, near the map's edges too
+// (periodic windows).
 TEST(Handover, FlakesToLobesBandIsTheBlendOfBothPaths) {
   const bake::NormalMap map = beckmann(32, 9);
   std::unique_ptr<runtime::NdfSource> asset;
   ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "band.gbk", true, 16).c_str(), &asset), RuntimeStatus::kOk);
   const runtime::InterleavedTexels texels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(),
                                           3);
-  runtime::FlakeNdf flakes;
+  const reference::FlakeSet set = reference::buildFlakes(map, 1);
   runtime::LobeNdf lobes;
-  ASSERT_EQ(flakes.build(texels, 1, 0.005, 32), RuntimeStatus::kOk);
   ASSERT_EQ(lobes.build(texels, 1, 0.005, 16, 32), RuntimeStatus::kOk);
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -174,17 +189,54 @@ TEST(Handover, FlakesToLobesBandIsTheBlendOfBothPaths) {
         ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
         s = smp.s;
       }
-      double v = -1.0, f = -1.0, l = -1.0;
+      double v = -1.0, l = -1.0;
       ASSERT_EQ(asset->eval(fp, s, &v), RuntimeStatus::kOk);
-      ASSERT_EQ(flakes.eval(fp, s, &f), RuntimeStatus::kOk);
       ASSERT_EQ(lobes.eval(fp, s, &l), RuntimeStatus::kOk);
-      const double expected = (1.0 - t) * f + t * l;
-      EXPECT_NEAR(v, expected, 1e-12 * expected + 1e-300)
+      const double expected = (1.0 - t) * bandReference(set, fp, s) + t * l;
+      EXPECT_NEAR(v, expected, 2e-5 * expected + 1e-6)  // the flake path against the reference
           << "sigma " << sigma << " at (" << fp.x << ", " << fp.y << ")";
       compared += expected > 1e-3;
     }
   }
   EXPECT_GT(compared, 150);  // most of them where the NDF is not negligible
+}
+
+// Inside the flakes-to-lobes band (the flakes in their 4-sigma window): samples follow the pdf
+// (chi-square against the image) and averages are the image's bins.
+TEST(Handover, BandSamplesFollowThePdfAndAveragesTheImage) {
+  const bake::NormalMap map = beckmann(32, 9);
+  std::unique_ptr<runtime::NdfSource> asset;
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "bandimg.gbk", true, 16).c_str(), &asset), RuntimeStatus::kOk);
+  const int res = asset->resolution();
+  const Footprint fp{20.3, 11.6, 4.7};
+  std::vector<float> img(size_t(res) * res);
+  ASSERT_EQ(asset->image(fp, img.data(), img.size()), RuntimeStatus::kOk);
+  double mass = 0.0;
+  ASSERT_EQ(asset->mass(fp, &mass), RuntimeStatus::kOk);
+  EXPECT_NEAR(mass, 1.0, 0.01);
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  struct S {
+    double sx, sy;
+  };
+  std::vector<S> samples;
+  for (int i = 0; i < 20000; ++i) {
+    runtime::NdfSample smp;
+    ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
+    samples.push_back({smp.s.x, smp.s.y});
+  }
+  const std::vector<double> image(img.begin(), img.end());
+  const stats::ChiSquareResult r = stats::chiSquareNdfTest(samples, image, res, mass);
+  EXPECT_GT(r.p_value, 0.01) << r.message;
+  const double bin = 2.0 / res;
+  for (int j = 6; j < res - 6; j += 5) {
+    for (int i = 6; i < res - 6; i += 5) {
+      const runtime::SRect rect{-1.0 + i * bin, 1.0 - (j + 1) * bin, -1.0 + (i + 1) * bin, 1.0 - j * bin};
+      double avg = 0.0;
+      ASSERT_EQ(asset->average(fp, rect, &avg), RuntimeStatus::kOk);
+      EXPECT_NEAR(avg, img[size_t(j) * res + i], 1e-4 * avg + 1e-6);
+    }
+  }
 }
 
 // Where a compressed pyramid takes over from the lobes: above its first level from which every
