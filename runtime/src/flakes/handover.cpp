@@ -59,30 +59,31 @@ double BandFlakes::norm() {
   return scale;
 }
 
-RuntimeStatus BandFlakes::eval(const Footprint& fp, const SPoint& s, double* value) const {
+namespace {
+// *value = norm() x what `query` writes to its argument (a windowed FlakeNdfAccess sum).
+template <typename Query>
+RuntimeStatus scaledByNorm(double* value, Query&& query) {
+  if (!value) return RuntimeStatus::kInvalidArgument;
   double v = 0.0;
-  if (RuntimeStatus st = FlakeNdfAccess::windowedEval(*flakes_, fp, s, kBandFlakeWindow, &v); st != RuntimeStatus::kOk)
-    return st;
-  *value = v * norm();
+  if (RuntimeStatus st = query(&v); st != RuntimeStatus::kOk) return st;
+  *value = v * BandFlakes::norm();
   return RuntimeStatus::kOk;
+}
+}  // namespace
+
+RuntimeStatus BandFlakes::eval(const Footprint& fp, const SPoint& s, double* value) const {
+  return scaledByNorm(value,
+                      [&](double* v) { return FlakeNdfAccess::windowedEval(*flakes_, fp, s, kBandFlakeWindow, v); });
 }
 
 RuntimeStatus BandFlakes::average(const Footprint& fp, const SRect& rect, double* value) const {
-  double v = 0.0;
-  if (RuntimeStatus st = FlakeNdfAccess::windowedAverage(*flakes_, fp, rect, kBandFlakeWindow, &v);
-      st != RuntimeStatus::kOk)
-    return st;
-  *value = v * norm();
-  return RuntimeStatus::kOk;
+  return scaledByNorm(
+      value, [&](double* v) { return FlakeNdfAccess::windowedAverage(*flakes_, fp, rect, kBandFlakeWindow, v); });
 }
 
 RuntimeStatus BandFlakes::mass(const Footprint& fp, double* value) const {
-  double v = 0.0;
-  if (!value) return RuntimeStatus::kInvalidArgument;
-  if (RuntimeStatus st = FlakeNdfAccess::windowedMass(*flakes_, fp, kBandFlakeWindow, &v); st != RuntimeStatus::kOk)
-    return st;
-  *value = v * norm();
-  return RuntimeStatus::kOk;
+  return scaledByNorm(value,
+                      [&](double* v) { return FlakeNdfAccess::windowedMass(*flakes_, fp, kBandFlakeWindow, v); });
 }
 
 RuntimeStatus BandFlakes::pdf(const Footprint& fp, const SPoint& s, double* value) const {
@@ -99,15 +100,19 @@ RuntimeStatus BandFlakes::addImage(const Footprint& fp, double weight, float* ou
   return FlakeNdfAccess::windowedAddImage(*flakes_, fp, kBandFlakeWindow, weight * norm(), out, out_count);
 }
 
-RuntimeStatus BandFlakes::draw(const Footprint& fp, double u1, double u2, NdfSample* out) const {
+RuntimeStatus BandFlakes::draw(const Footprint& fp, double u1, double u2, NdfSample* out,
+                               const double* known_mass) const {
   if (!out || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0)) return RuntimeStatus::kInvalidArgument;
   double m = 0.0;
-  if (RuntimeStatus st = FlakeNdfAccess::windowedMass(*flakes_, fp, kBandFlakeWindow, &m); st != RuntimeStatus::kOk)
+  if (known_mass) {
+    m = *known_mass;
+  } else if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) {
     return st;
+  }
   if (!(m > 0.0)) return RuntimeStatus::kInvalidArgument;
   flakes::Lobe g;
   double v1 = 0.5, v2 = 0.5;
-  if (RuntimeStatus st = FlakeNdfAccess::windowedPick(*flakes_, fp, kBandFlakeWindow, u1, u2, m, &g, &v1, &v2);
+  if (RuntimeStatus st = FlakeNdfAccess::windowedPick(*flakes_, fp, kBandFlakeWindow, u1, u2, m / norm(), &g, &v1, &v2);
       st != RuntimeStatus::kOk)
     return st;
   flakes::lobePoint(g, v1, v2, &out->s.x, &out->s.y);
@@ -244,7 +249,7 @@ RuntimeStatus HandoverNdf::sample(const Footprint& fp, double u1, double u2, Ndf
   NdfSample picked;
   RuntimeStatus drawn;
   if (&src == &band_flakes_)
-    drawn = band_flakes_.draw(fp, u, u2, &picked);
+    drawn = band_flakes_.draw(fp, u, u2, &picked, first ? &ma : &mb);
   else if (paths_.lobes && &src == paths_.lobes.get())
     drawn = LobeNdfAccess::sample(*paths_.lobes, fp, u, u2, &picked, false, first ? &ma : &mb);
   else

@@ -60,8 +60,10 @@ class BandFlakes final : public AccumulatingNdfSource {
   RuntimeStatus pdf(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus mass(const Footprint& footprint, double* value) const override;
   RuntimeStatus addImage(const Footprint& footprint, double weight, float* out, size_t out_count) const override;
-  // sample() without its density (out->pdf = 0), for a blend that evaluates its own.
-  RuntimeStatus draw(const Footprint& footprint, double u1, double u2, NdfSample* out) const;
+  // sample() without its density (out->pdf = 0), for a blend that evaluates its own. known_mass,
+  // when not null, is mass() of the footprint (the same bits), which saves weighing it again.
+  RuntimeStatus draw(const Footprint& footprint, double u1, double u2, NdfSample* out,
+                     const double* known_mass = nullptr) const;
   // The scale of the truncated sums.
   static double norm();
 

@@ -347,8 +347,7 @@ void laneWeightKernel(bool wide, const Block& b, int count, float sp2, float bx,
 // the answering level and the window.
 struct Terms {
   double sigma, ux, uy, sp2;
-  const Level* level;    // the finest level of the cut (levelFor)
-  int finest, coarsest;  // its index and that of the coarsest level the cut may take tiles from
+  int finest, coarsest;  // the answering level (levelFor) and the coarsest the cut may take tiles from
   bool exact_mode;       // answered by the exact flakes' window (level 0 with every flake a lobe)
   double tile_texels;    // tile side of the finest level
   double reach;
@@ -605,8 +604,7 @@ bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
   if (!t->exact_mode && double(levels[t->finest].tile) <= kTileRatio * fp.sigma * rate)
     t->coarsest = std::min(level_count - 1, t->finest + kMaxCoarser);
   levelBuilt(t->coarsest);
-  t->level = &levels[t->finest];
-  t->tile_texels = t->level->tile * step;
+  t->tile_texels = levels[t->finest].tile * step;
   t->ux = fp.x;
   t->uy = fp.y;
   if (repeat) {
@@ -633,6 +631,7 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Test&& test, Visit&& visit) cons
   struct TileRef {
     size_t index;
     double bx, by, d2, side;
+    double spatial_min;  // set once the tile's bounds are read
   };
   constexpr int kBatch = 64, kAhead = 4;
   TileRef batch[kBatch];
@@ -655,17 +654,17 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Test&& test, Visit&& visit) cons
       if (spatial_min > kMaxSpatial || !test(bound, r.bx, r.by, spatial_min, r.side, inv_a)) continue;
       if (kept < kAhead) fetch(blocks.data + r.index, sizeof(Block));
       batch[kept] = r;
-      batch[kept++].d2 = spatial_min;
+      batch[kept++].spatial_min = spatial_min;
     }
     for (int i = 0; i < kept; ++i) {
       if (i + kAhead < kept) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
       const TileRef& r = batch[i];
-      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by, r.d2, inv_a);
+      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by, r.spatial_min, inv_a);
     }
     n = 0;
   };
   auto accept = [&](size_t index, double bx, double by, double d2, double side) {
-    batch[n++] = {index, bx, by, d2, side};
+    batch[n++] = {index, bx, by, d2, side, 0.0};
     if (n == kBatch) flush();
   };
   const Level& top = levels[t.coarsest];
@@ -958,7 +957,6 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   const LobeNdf::Impl& m = *lobes.impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  const bool exact_level = t.exact_mode;
   // The clustered levels' mass tile by tile (massOf's sum, in its order), kept for the pick.
   double tile_mass[kMaxSampleTiles];
   int tiles = 0;
@@ -967,7 +965,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   if (known_mass) {
     total = *known_mass;
     tiles = kMaxSampleTiles + 1;  // no masses kept: the pick weighs the tiles as it walks
-  } else if (exact_level) {
+  } else if (t.exact_mode) {
     total = m.massOf(t);
   } else {
     m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
@@ -983,7 +981,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
     out->pdf = with_pdf && inSquare(out->s) ? m.evalAt(t, out->s.x, out->s.y) / total : 0.0;
     return RuntimeStatus::kOk;
   };
-  if (exact_level) {  // a flake of the window by its weight
+  if (t.exact_mode) {  // a flake of the window by its weight
     flakes::Lobe g;
     double v1 = 0.5, v2 = 0.5;
     if (FlakeNdfAccess::windowedPick(*m.exact, {t.ux, t.uy, t.sigma}, kWindowSigmas, u1, u2, total / kWindowNorm, &g,
