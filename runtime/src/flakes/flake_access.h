@@ -4,16 +4,21 @@
 
 #include <glintbake/runtime/flake_ndf.h>
 
+#include "flake_model.h"
 #include "gaussian_rect.h"
 
 namespace glintbake::runtime {
 
 struct FlakeNdfAccess {
+  // Widest window (flakes per side) whose weights along an axis are summed on the stack.
+  static constexpr int kPrefixFlakes = 1024;
   // FlakeNdf::eval with the flakes' footprint weights truncated at window_sigmas standard
   // deviations (a disk: spatial exponent below window_sigmas^2 / 2) instead of 6; the same
-  // exponent cutoff and kernels.
+  // exponent cutoff and kernels. With a cut, only the flakes of the tiles inside it count
+  // (windowedEval, windowedMass and windowedPick alike); the caller keeps those tiles inside the
+  // disk, and the window within kPrefixFlakes flakes per side, or mass and pick fail.
   static RuntimeStatus windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s, double window_sigmas,
-                                    double* value);
+                                    double* value, const flakes::TileCut* cut = nullptr);
   // windowedEval with outer_window_sigmas (<= 6, the exact path's window; value) and with
   // inner_window_sigmas (<= outer; inner) from one traversal: the inner window's flakes are a
   // subset of the outer one's with the same lane values, so both equal windowedEval up to the
@@ -32,11 +37,14 @@ struct FlakeNdfAccess {
   static RuntimeStatus sample(const FlakeNdf& f, const Footprint& fp, double u1, double u2, NdfSample* out,
                               bool with_pdf);
   // The sum of the footprint weights of the flakes in that disk (the integral of windowedEval).
-  static RuntimeStatus windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value);
-  // A flake of that disk in proportion to its weight (u1 picks its row, u2 the flake in the row;
-  // mass from windowedMass) and its lobe; v1, v2 are u1, u2 rescaled within the picked intervals.
+  static RuntimeStatus windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value,
+                                    const flakes::TileCut* cut = nullptr);
+  // A flake of that disk in proportion to its weight (u1 picks its row, or with a cut its tile and
+  // then its row in the tile, u2 the flake in the row; mass from windowedMass) and its lobe; v1, v2
+  // are u1, u2 rescaled within the picked intervals.
   static RuntimeStatus windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1, double u2,
-                                    double mass, flakes::Lobe* lobe, double* v1, double* v2);
+                                    double mass, flakes::Lobe* lobe, double* v1, double* v2,
+                                    const flakes::TileCut* cut = nullptr);
 };
 
 class LobeNdf;

@@ -60,6 +60,28 @@ inline void flakeAt(const float* normals, int w, int h, bool repeat, double ux, 
   j[3] = float((down[1] - up[1]) * 0.5);
 }
 
+// Flakes per side of a tile of the exact flakes' hierarchy, and of a tile of the clustered lobes'
+// level 1 (level 0's tiles of 4 flakes, merged in twos): the two grids coincide.
+constexpr int kTileFlakes = 8;
+
+// The tiles of a cut through the clustered lobes that the exact flakes answer (lobe_ndf.cpp): the
+// tiles of kTileFlakes flakes whose nearest point lies within sqrt(limit2) texels of the footprint
+// centre. Both evaluators decide it with tileGap, so that they agree on every tile to the bit.
+struct TileCut {
+  double side;    // tile side, texels
+  double limit2;  // squared distance below which a tile is inside
+};
+
+// The offset u - origin of tile (tx, ty) of side `side` (bx, by) and the distance from u to the
+// tile along each axis (dx, dy; 0 inside), u relative to the origin of a periodic image of the map.
+inline void tileGap(double ux, double uy, int64_t tx, int64_t ty, double side, double* bx, double* by, double* dx,
+                    double* dy) {
+  *bx = ux - double(tx) * side;
+  *by = uy - double(ty) * side;
+  *dx = *bx < 0.0 ? -*bx : (*bx > side ? *bx - side : 0.0);
+  *dy = *by < 0.0 ? -*by : (*by > side ? *by - side : 0.0);
+}
+
 // Query arguments shared by the flake and lobe evaluators.
 inline bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
 inline bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }

@@ -19,7 +19,7 @@ namespace glintbake::runtime {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
-constexpr int kTile = 8;                              // flakes per side of a tile of the hierarchy
+constexpr int kTile = flakes::kTileFlakes;            // flakes per side of a tile of the hierarchy
 constexpr int kLeafFlakes = 8;                        // flakes per leaf of a tile's k-d tree (one block)
 constexpr int kLeaves = kTile * kTile / kLeafFlakes;  // leaves of a full tile
 constexpr double kWindowSigmas = 6;                   // spatial truncation radius, in sqrt(v), as the reference's
@@ -96,6 +96,16 @@ struct FootprintTerms {
   double spatial_cut;      // largest spatial exponent (kMaxExponent: the window of 6 sqrt(v))
   int64_t x0, x1, y0, y1;  // window of fine flake indices (unwrapped, inclusive)
   bool empty;
+  const flakes::TileCut* cut = nullptr;  // when set, only the window's tiles inside the cut
+};
+
+// A tile of the window (forEachWindowTile): periodic image (px, py), tile (tx, ty) of that image,
+// its flakes within the window [fx0, fx1] x [fy0, fy1] (indices within the image) and the image's
+// first flake (ox, oy), so that a flake's unwrapped index is ox + fx.
+struct WindowTile {
+  int64_t px, py, tx, ty;
+  int64_t fx0, fx1, fy0, fy1;
+  int64_t ox, oy;
 };
 
 // A leaf reached by the traversal: its block and the footprint centre relative to
@@ -126,7 +136,7 @@ struct LeafTerms {
 
 // Widest window (flakes) whose disk-row sums come from running sums on the stack (windowedMass,
 // windowedPick): the windows of the lobes' exact level are at most about 140 flakes wide.
-constexpr int kPrefixFlakes = 1024;
+constexpr int kPrefixFlakes = FlakeNdfAccess::kPrefixFlakes;
 
 // Lanes kept by the kernel's first pass, in traversal order (kLaneList of them at most, plus the
 // room the branch-free writes and the padding to a whole vector take).
@@ -216,6 +226,16 @@ struct FlakeNdf::Impl {
   // their leaves are visited, in the order of the window.
   template <typename TileTest, typename LeafTest, typename Visit>
   void forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafTest&& leaves, Visit&& visit) const;
+  // Calls visit(WindowTile) for every tile that overlaps the window's box, in the order of the
+  // window (rows of periodic images, then rows of tiles), but for the tiles outside t.cut when
+  // it is set.
+  template <typename Visit>
+  void forEachWindowTile(const FootprintTerms& t, Visit&& visit) const;
+  // The footprint weights' sum over the flakes of a tile: the product of the two axes' sums.
+  static double tileWeight(const FootprintTerms& t, const WindowTile& w, const double* col, const double* row) {
+    return (col[w.ox + w.fx1 + 1 - t.x0] - col[w.ox + w.fx0 - t.x0]) *
+           (row[w.oy + w.fy1 + 1 - t.y0] - row[w.oy + w.fy0 - t.y0]);
+  }
   // Calls visit(block, lane, dx, dy, spatial exponent) for every flake of the leaf within the
   // truncation disk (scalar paths: average, image).
   template <typename Visit>
@@ -238,7 +258,9 @@ struct FlakeNdf::Impl {
   // The running sums of the footprint weights along x over the window, prefix[i] = the sum over
   // flakes t.x0 .. t.x0 + i - 1 (i = 0 .. width), so that a disk row's sum is one difference;
   // false (nothing written) when the window is wider than kPrefixFlakes.
-  bool columnPrefix(const FootprintTerms& t, double* prefix) const;
+  bool columnPrefix(const FootprintTerms& t, double* prefix) const { return axisPrefix(t, true, prefix); }
+  // The same along either axis (rows: prefix[i] sums flakes t.y0 .. t.y0 + i - 1).
+  bool axisPrefix(const FootprintTerms& t, bool along_x, double* prefix) const;
   // A disk row's sum of weights: from the running sums when columnPrefix wrote them (prefix not
   // null), else added up flake by flake.
   double rowSum(const FootprintTerms& t, const double* prefix, int64_t x0, int64_t x1) const {
@@ -449,10 +471,40 @@ bool FlakeNdf::Impl::terms(const Footprint& fp, FootprintTerms* t, double window
   return true;
 }
 
+template <typename Visit>
+void FlakeNdf::Impl::forEachWindowTile(const FootprintTerms& t, Visit&& visit) const {
+  if (t.empty) return;
+  auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
+  WindowTile w;
+  for (w.py = floorDiv(t.y0, fine_h); w.py <= floorDiv(t.y1, fine_h); ++w.py) {
+    w.oy = w.py * fine_h;
+    const int64_t ly0 = std::max<int64_t>(t.y0 - w.oy, 0), ly1 = std::min<int64_t>(t.y1 - w.oy, fine_h - 1);
+    for (w.px = floorDiv(t.x0, fine_w); w.px <= floorDiv(t.x1, fine_w); ++w.px) {
+      w.ox = w.px * fine_w;
+      const int64_t lx0 = std::max<int64_t>(t.x0 - w.ox, 0), lx1 = std::min<int64_t>(t.x1 - w.ox, fine_w - 1);
+      // The centre relative to this image's origin, as the clustered lobes' cut computes it.
+      const double cx = t.ux - double(w.px) * width, cy = t.uy - double(w.py) * height;
+      for (w.ty = ly0 / kTile; w.ty <= ly1 / kTile; ++w.ty) {
+        w.fy0 = std::max<int64_t>(w.ty * kTile, ly0);
+        w.fy1 = std::min<int64_t>(w.ty * kTile + kTile - 1, ly1);
+        for (w.tx = lx0 / kTile; w.tx <= lx1 / kTile; ++w.tx) {
+          if (t.cut) {
+            double bx, by, dx, dy;
+            flakes::tileGap(cx, cy, w.tx, w.ty, t.cut->side, &bx, &by, &dx, &dy);
+            if (!(dx * dx + dy * dy < t.cut->limit2)) continue;
+          }
+          w.fx0 = std::max<int64_t>(w.tx * kTile, lx0);
+          w.fx1 = std::min<int64_t>(w.tx * kTile + kTile - 1, lx1);
+          visit(w);
+        }
+      }
+    }
+  }
+}
+
 template <typename TileTest, typename LeafTest, typename Visit>
 void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafTest&& leaves, Visit&& visit) const {
   if (t.empty) return;
-  auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
   // |u_Q - u| over the flake positions [p0, p1] of a tile: largest and smallest.
   auto span = [](double q, double p0, double p1, double* dmax, double* dmin) {
     const double a = q - p0, b = q - p1;
@@ -493,37 +545,23 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafT
     }
     batched = 0;
   };
-  for (int64_t py = floorDiv(t.y0, fine_h); py <= floorDiv(t.y1, fine_h); ++py) {
-    const int64_t oy = py * fine_h;
-    const int64_t ly0 = std::max<int64_t>(t.y0 - oy, 0), ly1 = std::min<int64_t>(t.y1 - oy, fine_h - 1);
-    const double offy = double(oy) * step;
-    for (int64_t px = floorDiv(t.x0, fine_w); px <= floorDiv(t.x1, fine_w); ++px) {
-      const int64_t ox = px * fine_w;
-      const int64_t lx0 = std::max<int64_t>(t.x0 - ox, 0), lx1 = std::min<int64_t>(t.x1 - ox, fine_w - 1);
-      const double offx = double(ox) * step;
-      for (int64_t ty = ly0 / kTile; ty <= ly1 / kTile; ++ty) {
-        double dy, dy_min;
-        span(t.uy, offy + flakePosition(std::max<int64_t>(ty * kTile, ly0)),
-             offy + flakePosition(std::min<int64_t>(ty * kTile + kTile - 1, ly1)), &dy, &dy_min);
-        for (int64_t tx = lx0 / kTile; tx <= lx1 / kTile; ++tx) {
-          double dx, dx_min;
-          span(t.ux, offx + flakePosition(std::max<int64_t>(tx * kTile, lx0)),
-               offx + flakePosition(std::min<int64_t>(tx * kTile + kTile - 1, lx1)), &dx, &dx_min);
-          // What the spatial weight leaves of the exponent budget for the nearest flake of the tile.
-          const double spatial_min = (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
-          const double budget = kMaxExponent - spatial_min;
-          if (budget < 0.0 || spatial_min > t.spatial_cut) continue;
-          const size_t index = size_t(ty) * size_t(tiles_x) + size_t(tx);
-          if (!tile(tile_bounds.data[index], std::sqrt(dx * dx + dy * dy), budget)) continue;
-          const char* bytes = reinterpret_cast<const char*>(&leaf_bounds.data[index]);
-          for (size_t o = 0; o < sizeof(LeafBounds); o += 64) flakes::prefetch(bytes + o);
-          flakes::prefetch(bytes + sizeof(LeafBounds) - 1);
-          batch[batched++] = TileVisit{index, t.ux - offx - tileOrigin(tx), t.uy - offy - tileOrigin(ty)};
-          if (batched == kTileBatch) flush();
-        }
-      }
-    }
-  }
+  forEachWindowTile(t, [&](const WindowTile& w) {
+    const double offx = double(w.ox) * step, offy = double(w.oy) * step;
+    double dx, dx_min, dy, dy_min;
+    span(t.uy, offy + flakePosition(w.fy0), offy + flakePosition(w.fy1), &dy, &dy_min);
+    span(t.ux, offx + flakePosition(w.fx0), offx + flakePosition(w.fx1), &dx, &dx_min);
+    // What the spatial weight leaves of the exponent budget for the nearest flake of the tile.
+    const double spatial_min = (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
+    const double budget = kMaxExponent - spatial_min;
+    if (budget < 0.0 || spatial_min > t.spatial_cut) return;
+    const size_t index = size_t(w.ty) * size_t(tiles_x) + size_t(w.tx);
+    if (!tile(tile_bounds.data[index], std::sqrt(dx * dx + dy * dy), budget)) return;
+    const char* bytes = reinterpret_cast<const char*>(&leaf_bounds.data[index]);
+    for (size_t o = 0; o < sizeof(LeafBounds); o += 64) flakes::prefetch(bytes + o);
+    flakes::prefetch(bytes + sizeof(LeafBounds) - 1);
+    batch[batched++] = TileVisit{index, t.ux - offx - tileOrigin(w.tx), t.uy - offy - tileOrigin(w.ty)};
+    if (batched == kTileBatch) flush();
+  });
   flush();
 }
 
@@ -667,13 +705,14 @@ double FlakeNdf::Impl::diskRowSum(const FootprintTerms& t, int64_t x0, int64_t x
   return s;
 }
 
-bool FlakeNdf::Impl::columnPrefix(const FootprintTerms& t, double* prefix) const {
-  if (t.empty || t.x1 - t.x0 + 1 > kPrefixFlakes) return false;
+bool FlakeNdf::Impl::axisPrefix(const FootprintTerms& t, bool along_x, double* prefix) const {
+  const int64_t f0 = along_x ? t.x0 : t.y0, f1 = along_x ? t.x1 : t.y1;
+  if (t.empty || f1 - f0 + 1 > kPrefixFlakes) return false;
   double sum = 0.0;
   prefix[0] = 0.0;
-  forEachWeightIn(t.ux, t.x0, t.x1, t.inv2v, [&](int64_t f, double g) {
+  forEachWeightIn(along_x ? t.ux : t.uy, f0, f1, t.inv2v, [&](int64_t f, double g) {
     sum += g;
-    prefix[f - t.x0 + 1] = sum;
+    prefix[f - f0 + 1] = sum;
     return true;
   });
   return true;
@@ -698,10 +737,11 @@ std::atomic<bool>& portableKernelsOnly() {
 }  // namespace flakes
 
 RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
-                                           double window_sigmas, double* value) {
+                                           double window_sigmas, double* value, const flakes::TileCut* cut) {
   if (!f.impl_ || !value || !validFootprint(fp) || !flakes::validPoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
   if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
+  t.cut = cut;
   *value = flakes::inSquare(s) ? f.impl_->evalAt(t, s.x, s.y) : 0.0;
   return RuntimeStatus::kOk;
 }
@@ -724,12 +764,20 @@ RuntimeStatus FlakeNdfAccess::evalWithInnerWindow(const FlakeNdf& f, const Footp
 }
 
 RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas,
-                                           double* value) {
+                                           double* value, const flakes::TileCut* cut) {
   if (!f.impl_ || !value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
   const FlakeNdf::Impl& m = *f.impl_;
   FootprintTerms t;
   if (!m.terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   double sum = 0.0;
+  if (cut) {  // tile by tile, from the running sums along both axes
+    t.cut = cut;
+    double col[kPrefixFlakes + 1], row[kPrefixFlakes + 1];
+    if (!t.empty && !(m.axisPrefix(t, true, col) && m.axisPrefix(t, false, row))) return RuntimeStatus::kInvalidArgument;
+    m.forEachWindowTile(t, [&](const WindowTile& w) { sum += FlakeNdf::Impl::tileWeight(t, w, col, row); });
+    *value = t.wnorm * sum;
+    return RuntimeStatus::kOk;
+  }
   double buffer[kPrefixFlakes + 1];
   const double* prefix = m.columnPrefix(t, buffer) ? buffer : nullptr;
   m.forEachDiskRow(t, [&](int64_t, double gy, int64_t x0, int64_t x1) {
@@ -741,7 +789,8 @@ RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& f
 }
 
 RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double u1,
-                                           double u2, double mass, flakes::Lobe* lobe, double* v1, double* v2) {
+                                           double u2, double mass, flakes::Lobe* lobe, double* v1, double* v2,
+                                           const flakes::TileCut* cut) {
   if (!f.impl_ || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
   const FlakeNdf::Impl& m = *f.impl_;
   FootprintTerms t;
@@ -753,17 +802,55 @@ RuntimeStatus FlakeNdfAccess::windowedPick(const FlakeNdf& f, const Footprint& f
   bool found = false;
   double buffer[kPrefixFlakes + 1];
   const double* prefix = m.columnPrefix(t, buffer) ? buffer : nullptr;
-  m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
-    const double w = gy * m.rowSum(t, prefix, a, b);
-    if (!(w > 0.0)) return true;
-    fy = y, x0 = a, x1 = b, row_weight = w;
-    if (target < w) {
-      found = true;
-      return false;
+  if (cut) {
+    // A tile by its weight (windowedMass's products, in its order), then a row of it by the
+    // weights along y: the rows of a tile share its sum along x.
+    t.cut = cut;
+    double row[kPrefixFlakes + 1];
+    if (!prefix || !m.axisPrefix(t, false, row)) return RuntimeStatus::kInvalidArgument;
+    WindowTile picked{};
+    bool any = false;
+    m.forEachWindowTile(t, [&](const WindowTile& w) {
+      if (found) return;
+      const double tw = FlakeNdf::Impl::tileWeight(t, w, prefix, row);
+      if (!(tw > 0.0)) return;
+      picked = w;
+      any = true;
+      if (target < tw)
+        found = true;
+      else
+        target -= tw;
+    });
+    if (!any) return RuntimeStatus::kInvalidArgument;
+    x0 = picked.ox + picked.fx0;
+    x1 = picked.ox + picked.fx1;
+    const double across = prefix[x1 + 1 - t.x0] - prefix[x0 - t.x0];
+    if (!found) target = FlakeNdf::Impl::tileWeight(t, picked, prefix, row);
+    found = false;
+    for (int64_t y = picked.oy + picked.fy0; y <= picked.oy + picked.fy1; ++y) {
+      const double w = (row[y + 1 - t.y0] - row[y - t.y0]) * across;
+      if (!(w > 0.0)) continue;
+      fy = y, row_weight = w;
+      if (target < w) {
+        found = true;
+        break;
+      }
+      target -= w;
     }
-    target -= w;
-    return true;
-  });
+    if (!(row_weight > 0.0)) return RuntimeStatus::kInvalidArgument;
+  } else {
+    m.forEachDiskRow(t, [&](int64_t y, double gy, int64_t a, int64_t b) {
+      const double w = gy * m.rowSum(t, prefix, a, b);
+      if (!(w > 0.0)) return true;
+      fy = y, x0 = a, x1 = b, row_weight = w;
+      if (target < w) {
+        found = true;
+        return false;
+      }
+      target -= w;
+      return true;
+    });
+  }
   if (x1 < x0) return RuntimeStatus::kInvalidArgument;
   if (!found) target = row_weight;
   *v1 = std::clamp(target / row_weight, 0.0, 0.99999999999999989);

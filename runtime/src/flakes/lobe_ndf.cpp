@@ -31,6 +31,7 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
 constexpr int kFinestTile = 4;       // flakes per side of a level-0 tile
+static_assert(2 * kFinestTile == flakes::kTileFlakes, "level 1's tiles are the exact flakes' tiles");
 constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
 // Where the footprint weight is low the clustered levels take coarser tiles: a tile k levels above
 // the footprint's own is taken where its nearest point lies at least sqrt(2 k kCoarsenStep)
@@ -346,9 +347,16 @@ void laneWeightKernel(bool wide, const Block& b, int count, float sp2, float bx,
 // The footprint terms of one query: centre (reduced into the map for repeating maps), sigma_p^2,
 // the answering level and the window.
 struct Terms {
+  Footprint fp;  // as queried (the exact flakes reduce its centre as the lobes do)
   double sigma, ux, uy, sp2;
   int finest, coarsest;  // the answering level (levelFor) and the coarsest the cut may take tiles from
   bool exact_mode;       // answered by the exact flakes' window (level 0 with every flake a lobe)
+  // Level 0 with every flake a lobe under a cut: the level-1 tiles the cut would split into
+  // level-0 tiles (inner_cut) are answered by the exact flakes' evaluator, which prunes them by
+  // normal, the coarser tiles farther out by their lobes. skip_inner leaves the inner tiles out of
+  // the lobes' traversal (eval, mass, sample); average and image walk them as level-0 lobes.
+  bool inner_exact, skip_inner;
+  flakes::TileCut inner_cut;
   double tile_texels;    // tile side of the finest level
   double reach;
 };
@@ -381,6 +389,11 @@ struct LobeNdf::Impl {
   void buildLevel(int li);
   void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
+  // The levels of a footprint of this sigma and how level 0 is answered (Terms' finest, coarsest,
+  // exact_mode, inner_exact, skip_inner, inner_cut).
+  void chooseLevels(double sigma, Terms* t) const;
+  // Squared distance from the footprint centre beyond which the cut takes a tile of level li.
+  static double cutLimit(const Terms& t, int li) { return 2.0 * kCoarsenStep * double(li - t.finest) * t.sp2; }
   bool terms(const Footprint& fp, Terms* t) const;
   // Calls visit(block, bound, base_x, base_y, spatial_min, inv_a) for every tile of the footprint's
   // cut within the spatial truncation (tiles of the answering level near the centre, of up to
@@ -406,6 +419,9 @@ struct LobeNdf::Impl {
   double laneWeights(const Block& b, const Bound& bound, double bx, double by, double sp2, float* lanes) const;
   double evalAt(const Terms& t, double sx, double sy) const;
   double massOf(const Terms& t) const;
+  // The exact flakes' share of an inner_exact footprint: eval at s and mass.
+  double innerEval(const Terms& t, double sx, double sy) const;
+  double innerMass(const Terms& t) const;
 };
 
 RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in,
@@ -593,16 +609,38 @@ int LobeNdf::Impl::levelFor(double sigma) const {
   return l;
 }
 
-bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
-  t->sigma = fp.sigma;
-  t->sp2 = fp.sigma * fp.sigma;
-  t->finest = levelFor(fp.sigma);
-  t->exact_mode = t->finest == 0 && exact;
+void LobeNdf::Impl::chooseLevels(double sigma, Terms* t) const {
+  t->sigma = sigma;
+  t->sp2 = sigma * sigma;
+  t->finest = levelFor(sigma);
   // Coarser levels up to kMaxCoarser above the answering one, when its tiles are within
   // kTileRatio sigma (not when the finest level is answering a footprint narrower than that).
   t->coarsest = t->finest;
-  if (!t->exact_mode && double(levels[t->finest].tile) <= kTileRatio * fp.sigma * rate)
+  if (double(levels[t->finest].tile) <= kTileRatio * sigma * rate)
     t->coarsest = std::min(level_count - 1, t->finest + kMaxCoarser);
+  t->exact_mode = t->inner_exact = t->skip_inner = false;
+  t->inner_cut = {0.0, 0.0};
+  if (t->finest != 0 || !exact) return;
+  // The exact flakes answer the inner tiles when every flake of them lies well inside the
+  // window's disk (their mass is then the product of sums along the axes) and the window fits
+  // the flakes' running sums; else, and without a cut, the whole window.
+  const double side = levels[std::min(1, level_count - 1)].tile * step;
+  const double limit2 = cutLimit(*t, 1);
+  const double far = std::sqrt(limit2) + side * std::sqrt(2.0);
+  const double v = t->sp2 + sigma_h2;
+  if (t->coarsest > 0 && far * far < 0.98 * 2.0 * kMaxSpatial * v &&
+      2.0 * kWindowSigmas * std::sqrt(v) * rate + 4.0 < double(FlakeNdfAccess::kPrefixFlakes)) {
+    t->inner_exact = t->skip_inner = true;
+    t->inner_cut = {side, limit2};
+  } else {
+    t->exact_mode = true;
+    t->coarsest = 0;
+  }
+}
+
+bool LobeNdf::Impl::terms(const Footprint& fp, Terms* t) const {
+  t->fp = fp;
+  chooseLevels(fp.sigma, t);
   levelBuilt(t->coarsest);
   t->tile_texels = levels[t->finest].tile * step;
   t->ux = fp.x;
@@ -705,16 +743,16 @@ template <typename Accept>
 void LobeNdf::Impl::visitNode(const Terms& t, int li, int tx, int ty, double ux, double uy, Accept& accept) const {
   const Level& l = levels[li];
   const double side = l.tile * step;
-  const double by = uy - ty * side, bx = ux - tx * side;
-  const double dy = by < 0.0 ? -by : (by > side ? by - side : 0.0);
-  const double dx = bx < 0.0 ? -bx : (bx > side ? bx - side : 0.0);
+  double bx, by, dx, dy;
+  flakes::tileGap(ux, uy, tx, ty, side, &bx, &by, &dx, &dy);
   if (dx > t.reach || dy > t.reach) return;
   const size_t index = l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx);
   const double d2 = dx * dx + dy * dy;
-  if (li == t.finest || d2 >= 2.0 * kCoarsenStep * double(li - t.finest) * t.sp2) {
+  if (li == t.finest || d2 >= cutLimit(t, li)) {
     accept(index, bx, by, d2, side);
     return;
   }
+  if (li == 1 && t.skip_inner) return;  // an inner tile: the exact flakes answer it
   const Level& c = levels[li - 1];
   for (int cy = 2 * ty; cy < std::min(c.tiles_y, 2 * ty + 2); ++cy) {
     for (int cx = 2 * tx; cx < std::min(c.tiles_x, 2 * tx + 2); ++cx) visitNode(t, li - 1, cx, cy, ux, uy, accept);
@@ -813,7 +851,20 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
     if (n > kLaneList - kLanes) drain();
   });
   drain();
-  return ((sums[0] + sums[1]) + (sums[2] + sums[3])) * kWindowNorm / (kTwoPi * kTwoPi);
+  const double lobes_value = ((sums[0] + sums[1]) + (sums[2] + sums[3])) * kWindowNorm / (kTwoPi * kTwoPi);
+  return t.inner_exact ? lobes_value + innerEval(t, sx, sy) : lobes_value;
+}
+
+double LobeNdf::Impl::innerEval(const Terms& t, double sx, double sy) const {
+  double v = 0.0;
+  FlakeNdfAccess::windowedEval(*exact, t.fp, {sx, sy}, kWindowSigmas, &v, &t.inner_cut);
+  return v * kWindowNorm;
+}
+
+double LobeNdf::Impl::innerMass(const Terms& t) const {
+  double m = 0.0;
+  FlakeNdfAccess::windowedMass(*exact, t.fp, kWindowSigmas, &m, &t.inner_cut);
+  return m * kWindowNorm;
 }
 
 double LobeNdf::Impl::massOf(const Terms& t) const {
@@ -827,7 +878,7 @@ double LobeNdf::Impl::massOf(const Terms& t) const {
   forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
     sum += laneWeights(b, bound, bx, by, t.sp2, lanes);
   });
-  return sum;
+  return t.inner_exact ? sum + innerMass(t) : sum;
 }
 
 LobeNdf::LobeNdf() = default;
@@ -886,7 +937,10 @@ RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double*
 
 bool LobeNdfAccess::exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm) {
   const LobeNdf::Impl* m = lobes.impl_.get();
-  if (!m || !m->exact || !(sigma >= 0.0) || m->levelFor(sigma) != 0) return false;
+  if (!m || !m->exact || !(sigma >= 0.0)) return false;
+  Terms t;
+  m->chooseLevels(sigma, &t);
+  if (!t.exact_mode) return false;
   *window_sigmas = kWindowSigmas;
   *norm = kWindowNorm;
   return true;
@@ -914,6 +968,7 @@ RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, do
   const Impl& m = *impl_;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
+  t.skip_inner = false;  // the inner tiles as level-0 lobes (the flakes, one lobe each)
   const double x0 = std::max(rect.x0, -1.0), x1 = std::min(rect.x1, 1.0);
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
@@ -936,6 +991,7 @@ RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float
     return RuntimeStatus::kInvalidArgument;
   Terms t;
   if (!m.terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
+  t.skip_inner = false;  // as average
   const double bin = 2.0 / m.res;
   const double to_density = weight / (bin * bin);
   m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
@@ -962,6 +1018,8 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   int tiles = 0;
   float lanes[kLanes];
   double total = 0.0;
+  const double inner = t.inner_exact ? m.innerMass(t) : 0.0;  // the exact flakes' share
+  bool outer_mass = true;
   if (known_mass) {
     total = *known_mass;
     tiles = kMaxSampleTiles + 1;  // no masses kept: the pick weighs the tiles as it walks
@@ -974,6 +1032,8 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
       if (tiles < kMaxSampleTiles) tile_mass[tiles] = w;
       ++tiles;
     });
+    outer_mass = total > 0.0;
+    if (t.inner_exact) total += inner;  // massOf's order
   }
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
   auto finish = [&](const flakes::Lobe& g, double v1, double v2) {
@@ -989,10 +1049,20 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
       return RuntimeStatus::kInvalidArgument;
     return finish(g, v1, v2);
   }
-  // A tile in proportion to its mass, then a lane of it in proportion to its weight (the sums of
+  // The exact flakes' share first (a target below its mass, or every lobe without weight), then a
+  // tile in proportion to its mass, then a lane of it in proportion to its weight (the sums of
   // massOf, tile by tile), u1 rescaled within the lane. Rounding that leaves the target past the
   // end takes the last lobe of the last tile with mass.
   double target = u1 * total, v1 = 0.99999999999999989;
+  if (inner > 0.0 && (target < inner || !outer_mass)) {
+    flakes::Lobe g;
+    double w1 = 0.5, w2 = 0.5;
+    if (FlakeNdfAccess::windowedPick(*m.exact, t.fp, kWindowSigmas, std::min(target / inner, v1), u2,
+                                     inner / kWindowNorm, &g, &w1, &w2, &t.inner_cut) != RuntimeStatus::kOk)
+      return RuntimeStatus::kInvalidArgument;
+    return finish(g, w1, w2);
+  }
+  target -= inner;
   flakes::Lobe picked{0.0, 0.0, 1.0, 0.0, 1.0};
   const Block* last_block = nullptr;
   const Bound* last_bound = nullptr;

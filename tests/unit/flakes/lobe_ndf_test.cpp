@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace glintbake {
@@ -57,10 +58,10 @@ struct Pair {
   runtime::FlakeNdf flakes;
   LobeNdf lobes;
   int res;
-  Pair(bake::NormalMap m, int lobes_per_tile, int r = 64) : map(std::move(m)), res(r) {
+  Pair(bake::NormalMap m, int lobes_per_tile, int r = 64, int rate = 1) : map(std::move(m)), res(r) {
     const auto texels = mapTexels(map);
-    EXPECT_EQ(flakes.build(texels, 1, reference::kDefaultSigmaR, res), RuntimeStatus::kOk);
-    EXPECT_EQ(lobes.build(texels, 1, reference::kDefaultSigmaR, lobes_per_tile, res), RuntimeStatus::kOk);
+    EXPECT_EQ(flakes.build(texels, rate, reference::kDefaultSigmaR, res), RuntimeStatus::kOk);
+    EXPECT_EQ(lobes.build(texels, rate, reference::kDefaultSigmaR, lobes_per_tile, res), RuntimeStatus::kOk);
   }
   double imageError(const Footprint& fp) const {
     std::vector<float> a(size_t(res) * res), b(size_t(res) * res);
@@ -104,6 +105,64 @@ TEST(LobeNdf, ClusteredLevelsStayCloseToTheExactFlakes) {
       ASSERT_EQ(p.flakes.mass(fp, &mf), RuntimeStatus::kOk);
       EXPECT_NEAR(ml / mf, 1.0, 0.01) << "kind " << int(kind);
       std::printf("kind %d sigma %g: relative L1 %.3f\n", int(kind), sigma, e);
+    }
+  }
+}
+
+// From 11.4 texels the single-flake level takes a cut too: the level-1 tiles within sqrt(2) sigma
+// of the centre come from the exact flakes' evaluator (pruned by normal), the tiles farther out
+// from coarser lobes; the image walks those inner tiles as level-0 lobes instead. Every tile is
+// counted once on every path: eval integrates to the mass, the image holds the mass, and the mass
+// stays within 1% of the exact flakes', at the map's corners too (repeating and clamped), and at
+// two flakes per texel (where the band starts at half the footprint).
+TEST(LobeNdf, InnerTilesFromTheExactFlakesCountOnce) {
+  struct Case {
+    bake::MapKind kind;
+    bake::Wrap wrap;
+    int rate;
+  };
+  for (const Case& c : {Case{bake::MapKind::kBeckmann, bake::Wrap::kRepeat, 1},
+                        Case{bake::MapKind::kBeckmann, bake::Wrap::kClamp, 1},
+                        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 1},
+                        Case{bake::MapKind::kScratches, bake::Wrap::kClamp, 1},
+                        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 2}}) {
+    const bake::MapKind kind = c.kind;
+    const bake::Wrap wrap = c.wrap;
+    {
+      bake::NormalMap map = mapOf(kind, 96 / c.rate, 31);
+      map.wrap = wrap;
+      Pair p(std::move(map), 16, 64, c.rate);
+      const double r = c.rate;
+      for (double sigma : {12.0 / r, 19.0 / r}) {
+        for (const Footprint& fp : {Footprint{40.3 / r, 57.6 / r, sigma}, Footprint{2.7 / r, 94.1 / r, sigma}}) {
+          ASSERT_EQ(p.lobes.tileFor(sigma), 4);
+          double mass = 0.0, mf = 0.0;
+          ASSERT_EQ(p.lobes.mass(fp, &mass), RuntimeStatus::kOk);
+          ASSERT_EQ(p.flakes.mass(fp, &mf), RuntimeStatus::kOk);
+          EXPECT_NEAR(mass / mf, 1.0, 0.01);
+          // Midpoint rule on a 256^2 grid: spacing 0.0078 against lobes of std >= sigma_r = 0.005
+          // integrates a Gaussian to about 1e-4.
+          const int n = 256;
+          const double h = 2.0 / n;
+          double integral = 0.0;
+          for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+              double v = 0.0;
+              ASSERT_EQ(p.lobes.eval(fp, {-1.0 + (i + 0.5) * h, -1.0 + (j + 0.5) * h}, &v), RuntimeStatus::kOk);
+              integral += v * h * h;
+            }
+          }
+          std::vector<float> img(size_t(64) * 64);
+          ASSERT_EQ(p.lobes.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
+          double held = 0.0;
+          for (float b : img) held += double(b) * (2.0 / 64) * (2.0 / 64);
+          const std::string where = "kind " + std::to_string(int(kind)) + " wrap " + std::to_string(int(wrap)) +
+                                    " rate " + std::to_string(c.rate) + " sigma " + std::to_string(sigma) +
+                                    " x " + std::to_string(fp.x);
+          EXPECT_NEAR(integral / mass, 1.0, 2e-3) << where;
+          EXPECT_NEAR(held / mass, 1.0, 2e-3) << where;
+        }
+      }
     }
   }
 }
@@ -164,7 +223,8 @@ TEST(LobeNdf, RotatedMapRotatesTheNdf) {
 }
 
 TEST(LobeNdf, SamplesFollowTheirPdf) {
-  // 6 and 14: the exact flakes of level 0; 30: a clustered level with coarser tiles far out.
+  // 6: the exact flakes of level 0; 14: their inner tiles with coarser lobes farther out; 30: a
+  // clustered level with coarser tiles far out.
   Pair p(mapOf(bake::MapKind::kBeckmann, 128, 21), 16, 32);
   for (double sigma : {6.0, 14.0, 30.0}) {
     const Footprint fp{40.5, 22.25, sigma};

@@ -39,15 +39,25 @@
 // of the kernel (the blocks, about a kilobyte each, are scattered over the levels): 0.6-0.7
 // times the time of the cut without it. The kernel has two passes (a division-free test, then exp and sqrt
 // on the kept lobes only; AVX2 where the processor has it, with the same bits as the SSE2
-// kernel). With lobes_per_tile = 16, level 0 keeps every flake as its own lobe, and its eval,
-// mass and sampling are those of the exact flakes (flake_ndf.h, which prunes by normal within
-// tiles) with the 3-sigma window, without a cut. On 1024^2 maps (bench/bench_flakes.cpp) eval
-// costs about 4 us at sigma_p = 6 texels, 12-15 us at 12 (level 0, up to 23 texels, is the
-// costliest band: 30-44 us at 20-22) and 8.4-9.7 us on the clustered levels at 24 and 48 (21-25
-// and 16-17 before the cut). Sample: on level 0 the disk rows' weights come from running sums of
-// the column weights (linear in the window's side), so it costs about one eval; on the
-// clustered levels one weighing of the cut's tiles (AVX2 where the processor has it), whose tile
-// masses the pick reuses, plus the eval of its density: about 2 evals.
+// kernel). With lobes_per_tile = 16, level 0 keeps every flake as its own lobe. Below 0.35 x
+// sigma_p = 4 flakes (11.4 texels at one flake per texel) its eval, mass and sampling are those of
+// the exact flakes (flake_ndf.h, which prunes by normal within tiles) with the 3-sigma window,
+// without a cut. From there to the first clustered level (22.9 texels) level 0 takes the cut as
+// the others do, and the tiles it would split into level-0 tiles (the level-1 tiles within
+// sqrt(2) sigma_p of the centre, which lie inside the window's disk) are answered by the exact
+// flakes' evaluator restricted to them: their eval prunes by normal, their mass is a product of
+// running sums along the axes, and a sample picks one of them by that mass, then a row, then a
+// flake; average and image walk the same tiles as level-0 lobes (the same flakes). Against the
+// whole window of exact flakes this is 0.6-0.73x the eval time at 16-22 texels and costs 0.01-0.02
+// in image relative L1 on the README's maps (0.003-0.017 -> 0.017-0.027 at 12-20 texels); a cut
+// from 1 standard deviation saved another 12-17% at 0.01-0.017 more. On 1024^2 maps
+// (bench/bench_flakes.cpp) eval costs about 4 us at sigma_p = 6 texels, 14-21 us at 12-16 and
+// 32-34 us at 22 (the costliest band, 44-57 us without the cut) and 8.4-9.7 us on the clustered
+// levels at 24 and 48 (21-25 and 16-17 before the cut). Sample: on level 0 the disk rows' weights
+// come from running sums of the column weights (linear in the window's side), so it costs about
+// one eval, 1.4-1.5 evals with the cut; on the clustered levels one weighing of the cut's tiles
+// (AVX2 where the processor has it), whose tile masses the pick reuses, plus the eval of its
+// density: about 2 evals.
 //
 // What it gives up against the exact path: the shape of each group beyond its covariance. It is
 // close where a tile's flakes form a few tight groups (sharp flakes, scratches) or vary smoothly,
