@@ -2,6 +2,8 @@
 // Writing the flakes section of NDF assets (see flakes_section.h).
 #include <glintbake/bake/ndf/flakes_section.h>
 
+#include <glintbake/bake/ndf/pyramid_builder.h>
+
 #include <glintbake/format/kinds/flakes.h>
 
 #include <algorithm>
@@ -16,7 +18,19 @@ namespace {
 constexpr double kFlakesUpTo = 4.0;  // texels: the flakes answer at least this far
 constexpr double kHalfOctave = 1.4142135623730951;
 constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
+
 }  // namespace
+
+FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat) {
+  FlakesHandover h = handover;
+  if (!repeat || h.lobes_per_tile <= 0 || !(h.lobes_up_to < kLobesUnbounded)) return h;
+  const double flat = kFlatAxisSigma * double(std::max(map_width, map_height));
+  if (!(h.pyramid_from > flat)) return h;
+  const double lobes_from = kFlakesUpTo * format::kLobesBand;
+  h.pyramid_from = std::max(std::max(flat, lobes_from), h.flakes_up_to);
+  h.lobes_up_to = std::min(std::max(lobes_from, std::min(h.lobes_up_to, h.pyramid_from / kHalfOctave)), h.pyramid_from);
+  return h;
+}
 
 FlakesHandover defaultHandover(double sigma0, int lobes_per_tile) {
   FlakesHandover h;
@@ -62,6 +76,20 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   return h;
 }
 
+namespace {
+// The record's hand-over, capped as capAtFlatFootprint does.
+void capRecord(format::FlakesRecord* rec) {
+  FlakesHandover h;
+  h.flakes_up_to = rec->flakes_up_to;
+  h.lobes_per_tile = int(rec->lobes_per_tile);
+  h.lobes_up_to = rec->lobes_up_to;
+  h.pyramid_from = rec->pyramid_from;
+  h = capAtFlatFootprint(h, int(rec->map_width), int(rec->map_height), rec->wrap == 0);
+  rec->lobes_up_to = h.lobes_up_to;
+  rec->pyramid_from = h.pyramid_from;
+}
+}  // namespace
+
 Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
                                                 const FlakesHandover& handover) {
   format::FlakesRecord rec;
@@ -74,6 +102,7 @@ Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, 
   rec.pyramid_from = handover.pyramid_from;
   rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
   rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
+  capRecord(&rec);
   const uint64_t size = format::flakesSectionSize(rec);
   if (const char* why = format::checkFlakesRecord(rec, size)) return makeError(ErrorCode::kBadArgument, why);
   std::vector<uint8_t> section;
@@ -101,6 +130,7 @@ BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover
   rec.pyramid_from = handover.pyramid_from;
   rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
   rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
+  capRecord(&rec);
   if (const char* why = format::checkFlakesRecord(rec, section.size())) return makeError(ErrorCode::kInvalidInput, why);
   std::memcpy(section.data(), &rec, sizeof(rec));
   return okStatus();

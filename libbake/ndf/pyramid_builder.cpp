@@ -124,14 +124,20 @@ BakeStatus validatePyramidOptions(const PyramidOptions& o) {
   return okStatus();
 }
 
-LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions& options, int level) {
+LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions& options, int level, bool periodic) {
   LevelGeometry g;
   const double stride = options.stride0 * std::ldexp(1.0, level);
-  g.grid_width = std::max(1, int(std::lround(std::min(double(map_width) / stride, 1e9))));
-  g.grid_height = std::max(1, int(std::lround(std::min(double(map_height) / stride, 1e9))));
+  g.sigma = options.sigma0 * std::ldexp(1.0, level);
+  // Centres along an axis of `size` texels: the stride rounded so that they tile the axis; on a
+  // periodic axis at least two while the footprint is narrower than kFlatAxisSigma periods.
+  auto centres = [&](int size) {
+    const int n = std::max(1, int(std::lround(std::min(double(size) / stride, 1e9))));
+    return periodic && n < 2 && g.sigma < kFlatAxisSigma * double(size) ? 2 : n;
+  };
+  g.grid_width = centres(map_width);
+  g.grid_height = centres(map_height);
   g.stride_x = double(map_width) / g.grid_width;
   g.stride_y = double(map_height) / g.grid_height;
-  g.sigma = options.sigma0 * std::ldexp(1.0, level);
   g.regions_x = (g.grid_width + options.region_size - 1) / options.region_size;
   g.regions_y = (g.grid_height + options.region_size - 1) / options.region_size;
   return g;
@@ -226,6 +232,8 @@ class PyramidBuild {
   };
 
   bool cancelled() const { return cancel_ && cancel_->load(std::memory_order_relaxed); }
+  // Footprints of the map's flakes wrap around it (levelGeometry's periodic axes).
+  bool periodic() const { return !source_ && map_.wrap == Wrap::kRepeat; }
   static BakeStatus cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
 
   BakeStatus prepare();
@@ -293,10 +301,10 @@ PyramidBuild::Level PyramidBuild::planLevel(int level, std::vector<Sample> sampl
   lv.start = Clock::now();
   lv.bytes_before = sink_.storedBytes();
   lv.level = level;
-  lv.geo = levelGeometry(map_.width, map_.height, options_, level);
+  lv.geo = levelGeometry(map_.width, map_.height, options_, level, periodic());
   lv.rec = levelRecord(map_, options_, level, lv.geo);
   lv.samples = std::move(samples);
-  lv.next = planSamples(levelGeometry(map_.width, map_.height, options_, level + 1), lv.rec, image_floats_);
+  lv.next = planSamples(levelGeometry(map_.width, map_.height, options_, level + 1, periodic()), lv.rec, image_floats_);
   // Footprints with very many flakes (the top levels: few images, each costing up to several
   // map's worth of flakes) are split; the split depends only on the level.
   lv.split = !source_ && splatters_->local().flakesPerImage(lv.geo.sigma) > kSplitFlakes;
@@ -339,7 +347,7 @@ BakeStatus PyramidBuild::probe(Level& lv, bool* converged) {
   if (options_.levels != 0 || lv.samples.empty()) return okStatus();
   if (lv.level - 1 < options_.converge_from_level) return okStatus();
   if (options_.converge_from_grid > 0 && lv.level > 0) {
-    const LevelGeometry below = levelGeometry(map_.width, map_.height, options_, lv.level - 1);
+    const LevelGeometry below = levelGeometry(map_.width, map_.height, options_, lv.level - 1, periodic());
     if (std::max(below.grid_width, below.grid_height) > options_.converge_from_grid) return okStatus();
   }
   try {

@@ -31,7 +31,8 @@ bool isExactLevel(const format::NdfLevelRecord& record, const TensorPackOptions&
   const uint64_t centres = uint64_t(record.grid_width) * uint64_t(record.grid_height);
   const uint64_t level_bytes = centres * uint64_t(record.ndf_res) * uint64_t(record.ndf_res) * 4u;
   return options.exact_level_bytes > 0 && level_bytes <= options.exact_level_bytes && centres <= kMaxExactCentres &&
-         int(record.level) >= options.exact_min_level && options.block <= int(format::kTensorMaxRank);
+         (int(record.level) >= options.exact_min_level || (centres <= kExactAnyLevelCentres && record.wrap == 0)) &&
+         options.block <= int(format::kTensorMaxRank);
 }
 
 TensorAssembler::TensorAssembler(format::Writer& writer, const TensorPackOptions& options, TensorPackReport& report)

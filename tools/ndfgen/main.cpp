@@ -217,7 +217,7 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
     cli::requireBakeableMap(map, input);
     cli::checkMemoryBudget(pyramid, map, t.threadCount(), /*tensor=*/false);
 
-    const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid);
+    const bake::ndf::FlakesHandover handover = cli::defaultFlakesHandover(pyramid, map);
     // The asset's metadata, the same whether one machine bakes it or a shard does.
     auto assetMetadata = [&](const bake::ndf::PyramidReport& report, uint64_t flake_bytes) {
       Json params = cli::pyramidOptionsJson(pyramid);

@@ -232,7 +232,7 @@ int sourceLobesPerTile(const format::Reader& reader, const std::string& input) {
 std::vector<uint8_t> mapFlakes(const Options& o, const bake::NormalMap& map) {
   if (!o.pyramid.flakes) return {};
   return cli::unwrap(bake::ndf::flakesSectionBytes(map, o.pyramid.options.rate, o.pyramid.options.splat.sigma_r,
-                                                   cli::defaultFlakesHandover(o.pyramid)));
+                                                   cli::defaultFlakesHandover(o.pyramid, map)));
 }
 
 // What the end of the bake needs besides the report (the same on one machine and in the merge).

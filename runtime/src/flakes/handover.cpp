@@ -135,8 +135,15 @@ HandoverNdf::HandoverNdf(FlakePaths paths, std::unique_ptr<NdfSource> pyramid)
   if (paths_.lobes) {
     // The lobes answer up to the record's bound, and never beyond their own window limit.
     lobes_from_ = r.flakes_up_to * format::kLobesBand;
-    lobes_up_to_ = std::max(lobes_from_, std::min(r.lobes_up_to, paths_.lobes->footprintRange().clustered_max_sigma));
+    const double limit = paths_.lobes->footprintRange().clustered_max_sigma;
+    lobes_up_to_ = std::max(lobes_from_, std::min(r.lobes_up_to, limit));
     pyramid_from_ = std::max(pyramid_from_, lobes_up_to_);
+    if (pyramid_from_ > limit) {
+      // The record's band reaches past what the lobes' window allows (a record whose lobes answer
+      // every footprint, on a small map): the pyramid takes over over the half octave below it.
+      pyramid_from_ = std::max(lobes_from_, limit);
+      lobes_up_to_ = std::max(lobes_from_, std::min(lobes_up_to_, pyramid_from_ / kHalfOctaveWithSlack));
+    }
     // The levels the lobes stand in for never answer, not even through the pyramid's own blend
     // (whose deconvolution would otherwise prefer the finest level): the pyramid answers from the
     // first level of at least lobes_up_to / sqrt(2), the level the hand-over was placed above.

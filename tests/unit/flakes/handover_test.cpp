@@ -6,6 +6,7 @@
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/kinds/flakes.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
@@ -18,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -29,9 +31,10 @@ using runtime::Footprint;
 using runtime::RuntimeStatus;
 using runtime::SPoint;
 
-// Writes an ndf-pyramid of `map` (sigma0 4, stride 8, 2 levels, R 32) with the flakes of `flakes_map`.
+// Writes an ndf-pyramid of `map` (sigma0 4, stride 8, 2 levels, R 32) with the flakes of `flakes_map`
+// and the default hand-over for `lobes` lobes per tile, or `handover` when given.
 std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes_map, const std::string& name,
-                       bool with_flakes = true, int lobes = 0) {
+                       bool with_flakes = true, int lobes = 0, const bake::ndf::FlakesHandover* handover = nullptr) {
   bake::ndf::PyramidOptions o;
   o.splat.ndf_res = 32;
   o.stride0 = 8;
@@ -43,7 +46,8 @@ std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes
   EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
   if (with_flakes) {
     EXPECT_TRUE(bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r,
-                                              bake::ndf::defaultHandover(o.sigma0, lobes), nullptr)
+                                              handover ? *handover : bake::ndf::defaultHandover(o.sigma0, lobes),
+                                              nullptr)
                     .ok());
   }
   EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
@@ -56,6 +60,22 @@ bake::NormalMap beckmann(int size, uint64_t seed) {
   p.size = size;
   p.seed = seed;
   return bake::generateMap(bake::MapKind::kBeckmann, p);
+}
+
+// `count` samples of the asset at fp: each sample's pdf is pdf(s), and pdf x mass = eval.
+void expectSamplesMatchPdf(const runtime::NdfSource& asset, const Footprint& fp, double mass, uint64_t seed,
+                           int count) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < count; ++i) {
+    runtime::NdfSample smp;
+    ASSERT_EQ(asset.sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
+    double pdf = -1.0, e = -1.0;
+    ASSERT_EQ(asset.pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
+    ASSERT_EQ(asset.eval(fp, smp.s, &e), RuntimeStatus::kOk);
+    EXPECT_EQ(pdf, smp.pdf);
+    EXPECT_NEAR(pdf * mass, e, 1e-12 * e);
+  }
 }
 
 TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
@@ -99,17 +119,7 @@ TEST(Handover, FlakesBelowBandBlendAndPyramidAbove) {
   const double f = reference::evalPndf(set, {fp.x, fp.y, sigma}, s.x, s.y, reference::kDefaultSigmaR);
   EXPECT_NEAR(v, 0.5 * f + 0.5 * p, 1e-4 * v);
   ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (int i = 0; i < 200; ++i) {
-    runtime::NdfSample smp;
-    ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
-    double pdf = -1.0, e = -1.0;
-    ASSERT_EQ(asset->pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
-    ASSERT_EQ(asset->eval(fp, smp.s, &e), RuntimeStatus::kOk);
-    EXPECT_EQ(pdf, smp.pdf);
-    EXPECT_NEAR(pdf * m, e, 1e-12 * e);
-  }
+  expectSamplesMatchPdf(*asset, fp, m, 3, 200);
 }
 
 TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
@@ -135,17 +145,7 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
     double m = 0.0;
     ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
     EXPECT_NEAR(m, 1.0, 0.01) << sigma;
-    std::mt19937_64 rng(5);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    for (int i = 0; i < 200; ++i) {
-      runtime::NdfSample smp;
-      ASSERT_EQ(asset->sample(fp, u(rng), u(rng), &smp), RuntimeStatus::kOk);
-      double pdf = -1.0, e = -1.0;
-      ASSERT_EQ(asset->pdf(fp, smp.s, &pdf), RuntimeStatus::kOk);
-      ASSERT_EQ(asset->eval(fp, smp.s, &e), RuntimeStatus::kOk);
-      EXPECT_EQ(pdf, smp.pdf);
-      EXPECT_NEAR(pdf * m, e, 1e-12 * e);
-    }
+    expectSamplesMatchPdf(*asset, fp, m, 5, 200);
   }
 }
 
@@ -275,6 +275,73 @@ TEST(Handover, CompressedPyramidsHandOverAtTheirFirstFaithfulLevel) {
   h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 0, exact);
   EXPECT_EQ(h.lobes_per_tile, 0);
   EXPECT_DOUBLE_EQ(h.flakes_up_to, bake::ndf::defaultHandover(8.0, 0).flakes_up_to);
+}
+
+// A record whose lobes answer every footprint (a compressed pyramid without a faithful level) on a
+// map small enough that the lobes' window bounds them: the pyramid answers beyond that bound
+// instead of the query failing, and the band below it stays consistent.
+TEST(Handover, LobesBoundedByTheirWindowHandOverToThePyramid) {
+  const bake::NormalMap map = beckmann(16, 6);
+  bake::ndf::FlakesHandover h = bake::ndf::defaultHandover(4.0, 16);
+  h.lobes_up_to = h.pyramid_from = 1e6;
+  std::unique_ptr<runtime::NdfSource> asset, pyramid;
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "u.gbk", true, 16, &h).c_str(), &asset), RuntimeStatus::kOk);
+  ASSERT_EQ(runtime::openNdfAsset(writeAsset(map, map, "v.gbk", false).c_str(), &pyramid), RuntimeStatus::kOk);
+  runtime::LobeNdf lobes;
+  const runtime::InterleavedTexels texels(map.width, map.height, true, map.normals.data(), 3);
+  ASSERT_EQ(lobes.build(texels, 1, reference::kDefaultSigmaR, 16, 32), RuntimeStatus::kOk);
+  const double limit = lobes.footprintRange().clustered_max_sigma;
+  ASSERT_LT(limit, 1e5);
+  const runtime::FootprintRange r = asset->footprintRange();
+  EXPECT_DOUBLE_EQ(r.handover_max_sigma, limit);
+  EXPECT_NEAR(r.clustered_max_sigma, limit / std::sqrt(2.0), 1e-6 * limit);
+  const SPoint s{0.05, -0.03};
+  for (double sigma : {limit, 3.0 * limit, 1e5}) {
+    double a = -1.0, b = -2.0;
+    ASSERT_EQ(asset->eval({5.2, 3.7, sigma}, s, &a), RuntimeStatus::kOk) << sigma;
+    ASSERT_EQ(pyramid->eval({5.2, 3.7, sigma}, s, &b), RuntimeStatus::kOk) << sigma;
+    EXPECT_EQ(a, b) << sigma;
+  }
+  // Inside the band below the bound: sample, pdf, eval and mass agree.
+  const Footprint fp{5.2, 3.7, limit / std::pow(2.0, 0.25)};
+  double m = 0.0;
+  ASSERT_EQ(asset->mass(fp, &m), RuntimeStatus::kOk);
+  EXPECT_NEAR(m, 1.0, 0.01);
+  expectSamplesMatchPdf(*asset, fp, m, 7, 50);
+}
+
+TEST(Handover, SmallRepeatingMapsHandOverWhereTheFootprintIsFlat) {
+  const bake::ndf::FlakesHandover d = bake::ndf::defaultHandover(8.0, 16);  // lobes to 11.3, pyramid from 16
+  // A 16 x 16 repeating map: flat from 0.62 x 16 = 9.92 texels.
+  bake::ndf::FlakesHandover h = bake::ndf::capAtFlatFootprint(d, 16, 12, true);
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 0.62 * 16);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 0.62 * 16 / std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(h.flakes_up_to, d.flakes_up_to);
+  h = bake::ndf::capAtFlatFootprint(d, 9, 6, true);  // never below the lobes' start
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 4.0 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 4.0 * std::sqrt(2.0));
+  h = bake::ndf::capAtFlatFootprint(d, 20, 25, true);  // 15.5: the band ends there
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 0.62 * 25);
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 0.62 * 25 / std::sqrt(2.0));
+  // Unchanged: larger maps, clamped maps, lobes that answer every footprint, no lobes.
+  for (const bake::ndf::FlakesHandover& same :
+       {bake::ndf::capAtFlatFootprint(d, 64, 64, true), bake::ndf::capAtFlatFootprint(d, 16, 16, false)}) {
+    EXPECT_EQ(same.pyramid_from, d.pyramid_from);
+    EXPECT_EQ(same.lobes_up_to, d.lobes_up_to);
+  }
+  bake::ndf::FlakesHandover unbounded = d;
+  unbounded.lobes_up_to = unbounded.pyramid_from = 1e6;
+  EXPECT_EQ(bake::ndf::capAtFlatFootprint(unbounded, 16, 16, true).pyramid_from, 1e6);
+  const bake::ndf::FlakesHandover none = bake::ndf::defaultHandover(8.0, 0);
+  EXPECT_EQ(bake::ndf::capAtFlatFootprint(none, 16, 16, true).pyramid_from, none.pyramid_from);
+  // The section records the capped hand-over whatever it is given.
+  const bake::NormalMap map = beckmann(16, 8);
+  auto bytes = bake::ndf::flakesSectionBytes(map, 1, reference::kDefaultSigmaR, d);
+  ASSERT_TRUE(bytes.ok());
+  format::FlakesRecord rec;
+  std::memcpy(&rec, bytes.value().data(), sizeof(rec));
+  EXPECT_DOUBLE_EQ(rec.pyramid_from, 0.62 * 16);
+  EXPECT_DOUBLE_EQ(rec.lobes_up_to, 0.62 * 16 / std::sqrt(2.0));
 }
 
 TEST(Handover, FlakesOfAnotherMapAreRefused) {

@@ -51,17 +51,17 @@ PyramidOptions smallOptions() {
 TEST(PyramidGeometry, GridsCoverTheMapAndNest) {
   PyramidOptions o;
   o.stride0 = 16;
-  LevelGeometry g0 = levelGeometry(1024, 512, o, 0), g2 = levelGeometry(1024, 512, o, 2);
+  LevelGeometry g0 = levelGeometry(1024, 512, o, 0, true), g2 = levelGeometry(1024, 512, o, 2, true);
   EXPECT_EQ(g0.grid_width, 64);
   EXPECT_EQ(g0.grid_height, 32);
   EXPECT_DOUBLE_EQ(g0.stride_x, 16.0);
   EXPECT_EQ(g2.grid_width, 16);
   EXPECT_DOUBLE_EQ(g2.sigma, o.sigma0 * 4);
   // A map that is not a multiple of the stride: the stride stretches so the grid stays periodic.
-  LevelGeometry odd = levelGeometry(100, 100, o, 0);
+  LevelGeometry odd = levelGeometry(100, 100, o, 0, true);
   EXPECT_EQ(odd.grid_width, 6);
   EXPECT_DOUBLE_EQ(odd.stride_x * odd.grid_width, 100.0);
-  EXPECT_EQ(levelGeometry(100, 100, o, 10).grid_width, 1);
+  EXPECT_EQ(levelGeometry(100, 100, o, 10, true).grid_width, 1);
 }
 
 TEST(PyramidBuilder, RejectsBadOptions) {
@@ -99,7 +99,7 @@ TEST(PyramidBuilder, WritesLevelsAndChunksThatMatchTheSplat) {
     ASSERT_EQ(bytes.size(), sizeof(runtime::NdfLevelRecord));
     runtime::NdfLevelRecord rec;
     std::memcpy(&rec, bytes.data(), sizeof(rec));
-    const LevelGeometry g = levelGeometry(40, 40, o, l);
+    const LevelGeometry g = levelGeometry(40, 40, o, l, true);
     EXPECT_EQ(int(rec.grid_width), g.grid_width);
     EXPECT_DOUBLE_EQ(rec.sigma_texels, 4.0 * (1 << l));
     EXPECT_DOUBLE_EQ(rec.origin_x, 0.5 * rec.stride_x);
@@ -120,7 +120,7 @@ TEST(PyramidBuilder, WritesLevelsAndChunksThatMatchTheSplat) {
   ASSERT_TRUE(flakes.ok());
   Splatter sp(flakes.value(), o.splat);
   std::vector<float> expect(32 * 32), stored(32 * 32);
-  const LevelGeometry g0 = levelGeometry(40, 40, o, 0);
+  const LevelGeometry g0 = levelGeometry(40, 40, o, 0, true);
   const FootprintPartition part =
       footprintPartition(flakes.value(), g0.sigma, g0.grid_width, g0.stride_x, g0.grid_height, g0.stride_y);
   EXPECT_FALSE(part.empty());  // stride 8 = 2 sigma on a repeating map
@@ -197,6 +197,74 @@ TEST(PyramidBuilder, PartitionOfUnityMakesTheLevelMeanTheWholeMap) {
   Result<FlakeSet> cf = buildFlakes(clamped, 1);
   ASSERT_TRUE(cf.ok());
   EXPECT_TRUE(footprintPartition(cf.value(), sigma, n, stride, n, stride).empty());
+}
+
+TEST(PyramidGeometry, PeriodicAxesKeepTwoCentresUntilTheFootprintIsFlat) {
+  PyramidOptions o;  // stride 16, sigma 8
+  // 37 x 23: level 0 rounds to 2 x 1 centres, but one centre along 23 texels at sigma 8 (0.35 of
+  // the period) cannot mix wider footprints, so a repeating map keeps two there.
+  const LevelGeometry clamp0 = levelGeometry(37, 23, o, 0, false), rep0 = levelGeometry(37, 23, o, 0, true);
+  EXPECT_EQ(clamp0.grid_width, 2);
+  EXPECT_EQ(clamp0.grid_height, 1);
+  EXPECT_EQ(rep0.grid_width, 2);
+  EXPECT_EQ(rep0.grid_height, 2);
+  EXPECT_DOUBLE_EQ(rep0.stride_y, 11.5);
+  // Level 1 (sigma 16): flat along 23 texels (16 >= 0.62 x 23), not along 37.
+  const LevelGeometry rep1 = levelGeometry(37, 23, o, 1, true);
+  EXPECT_EQ(rep1.grid_width, 2);
+  EXPECT_EQ(rep1.grid_height, 1);
+  const LevelGeometry rep2 = levelGeometry(37, 23, o, 2, true);
+  EXPECT_EQ(rep2.grid_width * rep2.grid_height, 1);
+  // Large maps are unchanged.
+  EXPECT_EQ(levelGeometry(1024, 1024, o, 4, true).grid_width, levelGeometry(1024, 1024, o, 4, false).grid_width);
+}
+
+TEST(PyramidBuilder, SmallRepeatingMapsAnswerWideFootprintsWithTheWholeMap) {
+  // A 20 x 13 repeating map: the pyramid of every automatic level count must give a footprint
+  // far wider than the map the whole map's NDF (what the footprint sees, exactly, on a periodic
+  // map), and footprints of a few times the map's size nearly that.
+  MapParams mp;
+  mp.size = 40;
+  mp.seed = 5;
+  const NormalMap big = generateMap(MapKind::kFlakes, mp);
+  NormalMap map;
+  map.width = 20;
+  map.height = 13;
+  map.wrap = Wrap::kRepeat;
+  for (int y = 0; y < map.height; ++y) {
+    const float* row = big.normals.data() + size_t(y) * size_t(big.width) * 3;
+    map.normals.insert(map.normals.end(), row, row + size_t(map.width) * 3);
+  }
+  PyramidOptions o = smallOptions();  // R 32, stride 8, sigma 4
+  const std::string path = tempPath("small_periodic");
+  PyramidReport rep;
+  ASSERT_TRUE(buildTo(map, o, path, &rep).ok());
+  runtime::NdfPyramid pyr;
+  ASSERT_EQ(pyr.open(path.c_str()), runtime::RuntimeStatus::kOk);
+
+  Result<FlakeSet> flakes = buildFlakes(map, 1);
+  ASSERT_TRUE(flakes.ok());
+  Splatter sp(flakes.value(), o.splat);
+  const size_t bins = 32 * 32;
+  std::vector<float> whole(bins), got(bins);
+  sp.image(10.0, 6.5, 60.0, whole.data());  // 3 map widths: flat to 1e-70
+  auto relL1 = [&](const std::vector<float>& a) {
+    double num = 0.0, den = 0.0;
+    for (size_t b = 0; b < bins; ++b) {
+      num += std::fabs(double(a[b]) - double(whole[b]));
+      den += double(whole[b]);
+    }
+    return num / den;
+  };
+  for (double sigma : {1000.0, 40.0, 20.0}) {
+    for (double x : {0.0, 7.3}) {
+      ASSERT_EQ(pyr.image(runtime::Footprint{x, 4.1, sigma}, got.data(), bins), runtime::RuntimeStatus::kOk);
+      const double e = relL1(got);
+      std::printf("[ measured ] sigma %g at x %g: relative L1 against the whole map %.2e\n", sigma, x, e);
+      EXPECT_LT(e, sigma >= 40.0 ? 4e-3 : 1.5e-2) << sigma << " " << x;
+    }
+  }
+  std::remove(path.c_str());
 }
 
 TEST(PyramidBuilder, IdenticalBytesForEveryThreadCount) {

@@ -33,7 +33,8 @@ inline std::vector<uint8_t> readFile(const std::string& path) {
   return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
-// 64^2 map, R = 32, blocks of 16 (nb = 2), levels of 4x4, 2x2 and 1x1 centres, regions of 2x2.
+// 64^2 map, R = 32, blocks of 16 (nb = 2), levels of 4x4, 2x2 and 2x2 centres (the top level's
+// sigma 24 is below 0.62 times the map: pyramid_builder.h, levelGeometry), regions of 2x2.
 inline bake::ndf::PyramidOptions tinyPyramid() {
   bake::ndf::PyramidOptions o;
   o.splat.ndf_res = 32;
@@ -77,7 +78,7 @@ inline std::vector<uint8_t> packAsset(const bake::NormalMap& map, bool nonneg, i
 }
 
 // The shared assets of a test program: HALS (non-negative) and plain-ALS packs of one map, and a
-// HALS pack whose levels of 2 x 2 and 1 x 1 centres are stored exactly.
+// HALS pack whose levels of 2 x 2 centres are stored exactly.
 struct Assets {
   std::vector<uint8_t> nonneg_bytes, signed_bytes, exact_bytes;
   TensorNdf nonneg, plain, exact;

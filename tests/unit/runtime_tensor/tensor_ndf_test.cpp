@@ -38,10 +38,10 @@ TEST(TensorNdf, DescribesTheAsset) {
   EXPECT_EQ(assets().plain.info()->flags & kTensorFlagNonNegative, 0u);
   EXPECT_GT(t.groupCount(), 0);
   EXPECT_GT(t.blocksKept(), 0u);
-  EXPECT_LE(t.blocksKept(), uint64_t(16 + 4 + 1) * 4);
+  EXPECT_LE(t.blocksKept(), uint64_t(16 + 4 + 4) * 4);
   EXPECT_GT(t.memoryBytes(), 0u);
   EXPECT_EQ(t.level(0)->grid_width, 4u);
-  EXPECT_EQ(t.level(2)->grid_width, 1u);
+  EXPECT_EQ(t.level(2)->grid_width, 2u);
   EXPECT_EQ(t.level(3), nullptr);
   EXPECT_EQ(t.group(t.groupCount()), nullptr);
   EXPECT_EQ(t.indexEntry(0, 4, 0, 0), nullptr);

@@ -121,8 +121,9 @@ Json pyramidOptionsJson(const PyramidCliOptions& p) {
   return j;
 }
 
-bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& p) {
-  return bake::ndf::defaultHandover(p.options.sigma0, p.lobes);
+bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& p, const bake::NormalMap& map) {
+  return bake::ndf::capAtFlatFootprint(bake::ndf::defaultHandover(p.options.sigma0, p.lobes), map.width, map.height,
+                                       map.wrap == bake::Wrap::kRepeat);
 }
 
 uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p,

@@ -29,6 +29,15 @@ struct FlakesHandover {
 constexpr int kDefaultLobesPerTile = 16;
 constexpr int kMaxLobesPerTile = 16;
 
+// `handover` on a map of that size: on a repeating map a footprint of std F = kFlatAxisSigma (0.62)
+// times its longer side weighs every texel alike (ripple 1e-3), and from there the pyramid, whose
+// levels are flat over the map once that wide (levelGeometry), answers with the whole map's NDF
+// where the lobes of a map a few tiles across are coarser (a 9 x 6 map at 12 texels: 0.05 relative
+// L1 against 0.000). So the pyramid answers alone from F and the lobes up to F / sqrt(2) (at least
+// 4 sqrt(2)) when the hand-over's bounds are higher; unchanged when the lobes answer every
+// footprint (no faithful level). flakesSectionBytes and setFlakesHandover record it so capped.
+FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat);
+
 // The hand-over for a pyramid whose finest level has footprint std sigma0 (texels) and is faithful
 // from there on (an uncompressed pyramid). With lobes (1..16 per tile): the flakes answer up to 4
 // texels, the lobes from 4 sqrt(2) to sqrt(2) sigma0 (between the centres of its finest level the

@@ -43,8 +43,8 @@ void checkMemoryBudget(const PyramidCliOptions& pyramid, const bake::NormalMap& 
 // Canonical JSON form of the options (for provenance metadata and --json reports).
 Json pyramidOptionsJson(const PyramidCliOptions& pyramid);
 
-// The hand-over of an uncompressed pyramid with these options (--sigma0, --lobes).
-bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& pyramid);
+// The hand-over of an uncompressed pyramid with these options (--sigma0, --lobes) on this map.
+bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& pyramid, const bake::NormalMap& map);
 
 // Writes the flakes section of the map (unless --no-flakes) with this hand-over; returns its raw
 // size in bytes (0 when left out). Error exit 4 on failure.
