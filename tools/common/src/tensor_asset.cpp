@@ -134,7 +134,7 @@ bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report,
     // footprints from single flakes, closer than the blend of its few centres (on a 37 x 23 map
     // 0.11 relative L1 at 12 texels where the lobes give 0.03): it never moves the lobes' bound
     // below the default.
-    exact[l] = report.levels[l].exact && report.levels[l].level > 0;
+    exact[l] = report.levels[l].exact && l > 0;
   }
   return bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes_per_tile,
                                        exact.get(), variations.data());
