@@ -18,7 +18,6 @@ namespace {
 constexpr double kFlakesUpTo = 4.0;  // texels: the flakes answer at least this far
 constexpr double kHalfOctave = 1.4142135623730951;
 constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
-
 }  // namespace
 
 FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat) {
@@ -26,9 +25,10 @@ FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width,
   if (!repeat || h.lobes_per_tile <= 0 || !(h.lobes_up_to < kLobesUnbounded)) return h;
   const double flat = kFlatAxisSigma * double(std::max(map_width, map_height));
   if (!(h.pyramid_from > flat)) return h;
-  const double lobes_from = kFlakesUpTo * format::kLobesBand;
-  h.pyramid_from = std::max(std::max(flat, lobes_from), h.flakes_up_to);
-  h.lobes_up_to = std::min(std::max(lobes_from, std::min(h.lobes_up_to, h.pyramid_from / kHalfOctave)), h.pyramid_from);
+  // Both stay within the record's bounds: lobes_from <= lobes_up_to <= pyramid_from.
+  const double lobes_from = h.flakes_up_to * format::kLobesBand;
+  h.pyramid_from = std::max(flat, lobes_from);
+  h.lobes_up_to = std::max(lobes_from, std::min(h.lobes_up_to, h.pyramid_from / kHalfOctave));
   return h;
 }
 

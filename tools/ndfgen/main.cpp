@@ -17,9 +17,9 @@
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/flakes.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -73,7 +73,8 @@ cli::ExitCode bakeProcedural(cli::Tool& t, const cli::GlitterCliOptions& glitter
     cli::ContainerOutput out(t, output, format::AssetKind::kNdfPyramid, zstd_level);
     const bake::glitter::GlitterImageSource source(model, opt.splat.ndf_res, opt.sigma0);
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
+    const bake::BakeStatus built =
+        bake::ndf::buildNdfPyramid(source, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     asset["ndf_res"] = opt.splat.ndf_res;
@@ -186,8 +187,10 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
   const bake::ndf::PyramidOptions& opt = pyramid.options;
   int zstd_level = 3;
   tool.addExample("ndfgen brushed.png -o brushed.gbk", "Bake the footprint pyramid of a normal map.");
-  tool.addExample("ndfgen brushed.png -o brushed.gbk --ndf-res 32 --depfile brushed.gbk.d -q", "Smaller NDF images, a depfile for make or ninja, warnings only.");
-  tool.addExample("ndfgen --procedural glitter -o glitter.gbk", "The pyramid of a procedural glitter surface instead of a map.");
+  tool.addExample("ndfgen brushed.png -o brushed.gbk --ndf-res 32 --depfile brushed.gbk.d -q",
+                  "Smaller NDF images, a depfile for make or ninja, warnings only.");
+  tool.addExample("ndfgen --procedural glitter -o glitter.gbk",
+                  "The pyramid of a procedural glitter surface instead of a map.");
   CLI::App& app = tool.app();
   app.add_option("map", input, "Normal map (or height field with --height); none with --procedural");
   app.add_option("-o,--output", output, "Output ndf-pyramid container (.gbk)")->required();
@@ -245,7 +248,8 @@ int glintbake::cli::ndfgenMain(int argc, char** argv) {
 
     bake::ndf::PyramidReport report;
     cli::LevelProgress progress(t);
-    const bake::BakeStatus built = bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
+    const bake::BakeStatus built =
+        bake::ndf::buildNdfPyramid(map, opt, out.writer(), &report, progress.callback(), cli::cancelFlag());
     progress.finish();
     cli::check(built);
     const uint64_t flake_bytes = cli::writeFlakes(out.writer(), map, pyramid, handover);

@@ -26,7 +26,8 @@ PyramidShardPlan::PyramidShardPlan(const bake::NormalMap& map, const bake::ndf::
   const double map_w = double(map.width), map_h = double(map.height);
   const double rate2 = double(options.rate) * double(options.rate);
   for (int level = 0; level < max_levels; ++level) {
-    const bake::ndf::LevelGeometry g = bake::ndf::levelGeometry(map.width, map.height, options, level, map.wrap == bake::Wrap::kRepeat);
+    const bake::ndf::LevelGeometry g =
+        bake::ndf::levelGeometry(map.width, map.height, options, level, map.wrap == bake::Wrap::kRepeat);
     level_base_.push_back(costs_.size());
     level_regions_.push_back(size_t(g.regions_x) * size_t(g.regions_y));
     const double extent = 2.0 * options.splat.footprint_truncation * g.sigma;

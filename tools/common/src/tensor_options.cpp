@@ -35,7 +35,8 @@ void addTensorPackOptions(CLI::App& app, TensorCliOptions& o, const std::string&
       ->capture_default_str();
   app.add_option("--precision", o.precision_text, "Factor storage: float32 or float16")->capture_default_str();
   app.add_option("--exact-levels", o.exact_mib,
-                 "Store the levels above the finest (and a repeating map's finest level of at most 4 centres) whose NDF images take at "
+                 "Store the levels above the finest (and a repeating map's finest level of at most 4 centres) whose "
+                 "NDF images take at "
                  "most this many MiB (and 16 x 16 centres) (float32) exactly instead of compressed (0..1024; 0: "
                  "compress every level)")
       ->capture_default_str();
