@@ -234,6 +234,13 @@ class PyramidBuild {
   bool cancelled() const { return cancel_ && cancel_->load(std::memory_order_relaxed); }
   // Footprints of the map's flakes wrap around it (levelGeometry's periodic axes).
   bool periodic() const { return !source_ && map_.wrap == Wrap::kRepeat; }
+  // Whether a level of one centre is the last: on a clamped normal map only once its footprint is
+  // nearly flat over the map (kClampedFlatSigma), since wider footprints get that image's shape.
+  bool lastSingleCentre(const LevelGeometry& geo) const {
+    if (geo.grid_width != 1 || geo.grid_height != 1) return false;
+    if (source_ || map_.wrap == Wrap::kRepeat) return true;
+    return geo.sigma >= kClampedFlatSigma * double(std::max(map_.width, map_.height));
+  }
   static BakeStatus cancelError() { return makeError(ErrorCode::kRuntime, "cancelled"); }
 
   BakeStatus prepare();
@@ -556,7 +563,7 @@ BakeStatus PyramidBuild::run() {
     bool converged = false;
     if (BakeStatus s = probe(lv, &converged); !s || converged) return s;
     if (BakeStatus s = buildLevel(lv); !s) return s;
-    if (options_.levels == 0 && lv.geo.grid_width == 1 && lv.geo.grid_height == 1) {
+    if (options_.levels == 0 && lastSingleCentre(lv.geo)) {
       rep_.stop_reason = "grid-1x1";
       return okStatus();
     }

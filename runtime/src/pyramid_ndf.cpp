@@ -77,6 +77,10 @@ void PyramidNdf::answerFromSigma(double sigma) {
   if (format::NdfPyramidBlend* b = blender()) b->answerFromSigma(sigma);
 }
 
+void PyramidNdf::holdEdges() {
+  if (format::NdfPyramidBlend* b = blender()) b->holdEdges();
+}
+
 MapSize PyramidNdf::mapSize() const {
   const NdfLevelRecord* first = level(0);
   return first ? MapSize{int(first->map_width), int(first->map_height)} : MapSize{};

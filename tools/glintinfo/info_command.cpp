@@ -5,6 +5,7 @@
 
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/format/kinds/ndf_pyramid.h>
+#include <glintbake/format/kinds/ndf_pyramid_blend.h>
 
 #include <cinttypes>
 #include <cstdio>
@@ -71,8 +72,9 @@ cli::Json footprintSummary(const format::Reader& reader, const std::string& path
       }
     }
   }
-  // Above the top level: a repeating map whose top grid fits the blend spreads to any width.
-  fp["unbounded_above_top"] = first.wrap == 0 && top.grid_width <= 16 && top.grid_height <= 16;
+  // Above the top level: a top grid that fits the blend spreads to any width (repeating or clamped).
+  fp["unbounded_above_top"] =
+      top.grid_width <= uint32_t(format::kWholeGridAxis) && top.grid_height <= uint32_t(format::kWholeGridAxis);
   doc["footprints"] = fp;
   return doc;
 }

@@ -2,6 +2,9 @@
 // Wang-tiles assets: loading the tile set and each tile's NDF asset, and answering footprints as
 // sums over the tiles they cover (see wang_ndf.h).
 #include <glintbake/runtime/wang_ndf.h>
+
+#include <glintbake/runtime/ndf_pyramid.h>
+#include <glintbake/runtime/tensor_ndf.h>
 #include "../format_status.h"
 
 #include <algorithm>
@@ -28,8 +31,8 @@ bool sectionHasSize(const format::Reader& reader, uint32_t type, size_t size) {
 }
 
 bool validFootprint(const Footprint& f) {
-  return std::isfinite(f.x) && std::isfinite(f.y) && std::fabs(f.x) <= kMaxPosition &&
-         std::fabs(f.y) <= kMaxPosition && std::isfinite(f.sigma) && f.sigma >= 0.0;
+  return std::isfinite(f.x) && std::isfinite(f.y) && std::fabs(f.x) <= kMaxPosition && std::fabs(f.y) <= kMaxPosition &&
+         std::isfinite(f.sigma) && f.sigma >= 0.0;
 }
 
 uint32_t tileOfCell(const format::WangRecord& rec, const uint32_t* code_to_tile, int64_t i, int64_t j) {
@@ -159,16 +162,24 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
     if (idx < 0) return RuntimeStatus::kInvalidAsset;
     if (format::ContainerStatus st = reader.readSection(size_t(idx), &bytes); st != format::ContainerStatus::kOk)
       return fromFormatStatus(st);
-    {
-      // Only the NDF kinds a tile may hold: never another wang-tiles asset.
-      format::Reader inner;
-      if (inner.openMemory(bytes.data(), bytes.size()) != format::ContainerStatus::kOk) return RuntimeStatus::kInvalidAsset;
-      if (inner.kind() != format::AssetKind::kTensorNdf && inner.kind() != format::AssetKind::kNdfPyramid)
-        return RuntimeStatus::kInvalidAsset;
-    }
-    std::unique_ptr<NdfSource>& asset = impl->assets[t];
-    if (RuntimeStatus s = openNdfAssetMemory(bytes.data(), bytes.size(), &asset); s != RuntimeStatus::kOk)
+    // Only the NDF kinds a tile may hold (never another wang-tiles asset), without flakes; their
+    // blend holds the edge centres beyond the extended square (formats/SPEC.md 10.7).
+    format::Reader inner;
+    if (inner.openMemory(bytes.data(), bytes.size()) != format::ContainerStatus::kOk)
+      return RuntimeStatus::kInvalidAsset;
+    std::unique_ptr<PyramidNdf> pyramid;
+    if (inner.kind() == format::AssetKind::kTensorNdf)
+      pyramid.reset(new (std::nothrow) TensorNdf());
+    else if (inner.kind() == format::AssetKind::kNdfPyramid)
+      pyramid.reset(new (std::nothrow) NdfPyramid());
+    else
+      return RuntimeStatus::kInvalidAsset;
+    if (!pyramid) return RuntimeStatus::kOutOfMemory;
+    if (RuntimeStatus s = pyramid->load(inner); s != RuntimeStatus::kOk)
       return s == RuntimeStatus::kOutOfMemory ? s : RuntimeStatus::kInvalidAsset;
+    pyramid->holdEdges();
+    std::unique_ptr<NdfSource>& asset = impl->assets[t];
+    asset = std::move(pyramid);
     const MapSize size = asset->mapSize();
     if (asset->resolution() != int(rec.ndf_res) || size.width != extended || size.height != extended)
       return RuntimeStatus::kInvalidAsset;

@@ -52,9 +52,18 @@ struct LevelSpec {
   double sigma;
 };
 
-// Writes a pyramid container over a kMap^2 map with the given levels and region size.
+// The mass over [0, kMap] of a normalised 1-D Gaussian of std s centred at c.
+double massOverMap(double c, double s) {
+  return 0.5 * std::erfc((c - kMap) / (s * std::sqrt(2.0))) - 0.5 * std::erfc(c / (s * std::sqrt(2.0)));
+}
+// A stored footprint's spatial std at rate 1: sigma_l with the flakes' own sigma_h = 1.5 / sqrt 12.
+double storedStd(double sigma) { return std::sqrt(sigma * sigma + 1.5 * 1.5 / 12.0); }
+
+// Writes a pyramid container over a kMap^2 map with the given levels and region size. With
+// footprint_mass, each centre's image holds the mass its footprint keeps over the map (as a
+// baker writes a clamped map's images) instead of 1.
 std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int region, uint32_t wrap = 0,
-                                 const std::string& path = "") {
+                                 const std::string& path = "", bool footprint_mass = false) {
   const std::string file = path.empty() ? glintbake::testing::processTempDir() + "rt_pyramid.gbk" : path;
   format::Writer w;
   EXPECT_EQ(w.open(file, format::AssetKind::kNdfPyramid, 1), format::ContainerStatus::kOk);
@@ -83,7 +92,14 @@ std::vector<uint8_t> makePyramid(const std::vector<LevelSpec>& levels, int regio
         std::vector<uint8_t> bytes(sizeof(hdr));
         std::memcpy(bytes.data(), &hdr, sizeof(hdr));
         for (int k = 0; k < cw * ch; ++k) {
-          const std::vector<float> img = testImage(int(l), int(rx) * region + k % cw, int(ry) * region + k / cw);
+          const int i = int(rx) * region + k % cw, j = int(ry) * region + k / cw;
+          std::vector<float> img = testImage(int(l), i, j);
+          if (footprint_mass) {
+            const double s = storedStd(levels[l].sigma);
+            const double m =
+                massOverMap(rec.origin_x + i * rec.stride_x, s) * massOverMap(rec.origin_y + j * rec.stride_y, s);
+            for (float& v : img) v = float(v * m);
+          }
           const uint8_t* p = reinterpret_cast<const uint8_t*>(img.data());
           bytes.insert(bytes.end(), p, p + img.size() * 4);
         }
@@ -382,7 +398,7 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
   EXPECT_LT(worst, 1e-10);
   // Weights of one axis (16 centres, repeating, stride 4) at spreads up to the level's limit.
   format::NdfBlendAxis axis;
-  axis.set(64.0, 2.0, 4.0, 16, true);
+  axis.set(64.0, 2.0, 4.0, 16, true, 2.0);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> pos(0.0, 64.0), extra(0.1, 6.0);
   double worst_w = 0.0;
@@ -412,13 +428,60 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
   std::printf("[ figures  ] ramp error %.2g, weight error %.2g\n", worst, worst_w);
 }
 
-TEST(NdfPyramidClamp, ClampMapsUseEdgeCentres) {
+// Wang-tiles tile assets hold their edge centres beyond the edges (holdEdges).
+TEST(NdfPyramidClamp, HeldEdgesUseTheEdgeCentres) {
   const std::vector<uint8_t> bytes = makePyramid({{4, 4.0}}, 2, 1);
   NdfPyramid p;
   ASSERT_EQ(p.openMemory(bytes.data(), bytes.size()), RuntimeStatus::kOk);
+  p.holdEdges();
   std::vector<float> a(kRes * kRes);
   ASSERT_EQ(p.image(fp(-30.0, 200.0, 4.0), a.data(), a.size()), RuntimeStatus::kOk);
   EXPECT_EQ(a, testImage(0, 0, 3));
+}
+
+// On a clamped map there is no surface beyond the edges: a footprint keeps the mass it has over
+// the map, prod_axes (Phi((W - u) / s) - Phi(-u / s)), s^2 = sigma^2 + sigma_h^2, wherever it lies
+// and however wide it is, from the finest level's sigma up (the stored images hold their own
+// footprints' masses, as baked). The
+// blend folds the centres beyond the edges onto the edge centres with that falloff; holding the
+// edge centres instead gave masses up to 1 far outside the map (where the reference has none).
+TEST(NdfPyramidClamp, FootprintsKeepTheMassTheyHaveOverTheMap) {
+  const std::vector<LevelSpec> levels = {{8, 4.0}, {4, 8.0}, {2, 16.0}, {1, 32.0}, {1, 64.0}, {1, 128.0}};
+  const std::vector<uint8_t> bytes = makePyramid(levels, 4, 1, "", true);
+  NdfPyramid p;
+  ASSERT_EQ(p.openMemory(bytes.data(), bytes.size()), RuntimeStatus::kOk);
+  // Within the grid, at a centre of level 0 and a level-0 footprint: that centre's image.
+  std::vector<float> a(kRes * kRes);
+  ASSERT_EQ(p.image(fp(12.0, 20.0, 4.0), a.data(), a.size()), RuntimeStatus::kOk);
+  std::vector<float> centre = testImage(0, 1, 2);
+  const double s0 = storedStd(4.0), m0 = massOverMap(12.0, s0) * massOverMap(20.0, s0);
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], centre[k] * m0, 1e-6 * (1.0 + centre[k])) << k;
+  // Footprints centred on the map, from twice the finest sigma (where the blend's Gaussian spreads
+  // over the centres; closer to a level's own sigma the mass field is its centres' bilinearly,
+  // sampled at the stride, within the map as beyond it): within a few percent of the truth. Beyond
+  // the edges: never more than a trace above the truth. Holding the edge centres instead (the
+  // old blend) gave 237 and 0.84: it kept their mass for footprints far wider than the map.
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> on_map(0.0, double(kMap)), off_map(-3.0 * kMap, 4.0 * kMap);
+  std::uniform_real_distribution<double> log_sigma(std::log(8.0), std::log(2000.0));
+  double worst = 0.0, worst_excess = 0.0;
+  for (int q = 0; q < 4000; ++q) {
+    const bool inside = q % 2 == 0;
+    const double x = inside ? on_map(rng) : off_map(rng), y = inside ? on_map(rng) : off_map(rng);
+    const double sigma = std::exp(log_sigma(rng));
+    const double s = storedStd(sigma), truth = massOverMap(x, s) * massOverMap(y, s);
+    double m = 0.0;
+    ASSERT_EQ(p.mass(fp(x, y, sigma), &m), RuntimeStatus::kOk);
+    if (inside) {
+      worst = std::max(worst, std::fabs(m - truth) / truth);
+    } else {
+      worst_excess = std::max(worst_excess, m - truth);
+    }
+  }
+  EXPECT_LT(worst, 0.03);
+  EXPECT_LT(worst_excess, 0.005);
+  std::printf("[ figures  ] clamped mass: worst relative error on the map %.3g, worst excess off it %.3g\n", worst,
+              worst_excess);
 }
 
 TEST(NdfPyramidC, CApiMatchesTheClass) {

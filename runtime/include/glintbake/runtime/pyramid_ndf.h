@@ -63,6 +63,11 @@ class PyramidNdf : public NdfSource {
   // footprint range reports that level as pyramid_min_sigma. Not thread-safe: call it before the
   // asset is shared. A later open() uses every level again.
   void answerFromSigma(double sigma) final;
+  // On a clamped map the blend gives centres beyond the edges the edge centres' images scaled by
+  // the mass their footprints keep over the map (formats/SPEC.md 10.1). holdEdges() makes it hold
+  // the edge centres instead, as the tile assets of wang-tiles containers are read (10.7). Not
+  // thread-safe, as answerFromSigma; a later open() falls off again.
+  void holdEdges();
 
  protected:
   PyramidNdf() = default;

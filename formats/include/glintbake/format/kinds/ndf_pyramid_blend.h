@@ -13,9 +13,16 @@
 //    one stride), tau'^2 = tau^2 - stride^2 / 6 taking out the variance the tent adds (tau' = 0
 //    is plain bilinear interpolation); as q approaches kMaxSpread the next level is blended in, so
 //    the weights are continuous in sigma. Above the top level's reach the spread is held at
-//    kMaxSpread (a clamp).
-// Repeating maps wrap the centre grid, clamped maps clamp to the edge centres. Every weight is
-// separable (x times y); the weights sum to 1 up to the truncation at 3.5 tau' (below 1e-3).
+//    kMaxSpread (a clamp);
+//  - a level of one centre (from the one whose stride reached the map size, on a clamped map)
+//    answers up to the next level's sigma, blended with it linearly in log sigma: its image scaled
+//    to the footprint's mass over the map (singleLevel), at any width above the top level.
+// Repeating maps wrap the centre grid. On a clamped map there is no surface beyond the edges, so a
+// centre beyond them (which the grid does not store) has the image of the edge centre scaled by the
+// ratio of their footprints' masses over the map (edge falloff, NdfBlendAxis::set): its weight
+// goes to the edge centre times that ratio, and a footprint that leaves the map loses the mass the
+// reference loses. Every weight is separable (x times y); on a repeating map the weights sum to 1
+// up to the truncation at 3.5 tau' (below 1e-3), on a clamped map to less near and beyond the edges.
 // Header-only; no allocation; every per-level constant is computed once by init().
 #pragma once
 
@@ -77,18 +84,100 @@ class NdfRamp {
 
 // One axis of a level's centre grid, with the divisions of the blend done once at init.
 struct NdfBlendAxis {
+  // Most virtual centres beyond each edge of a clamped axis whose images (scaled edge images) the
+  // blend mixes; farther ones weigh below kFoldFloor of the edge centre (or are beyond this count).
+  static constexpr int kMaxFold = 32;
+  static constexpr double kFoldFloor = 1e-12;
+
   double size = 1.0, inv_size = 1.0;      // map texels along the axis and their reciprocal
   double origin = 0.0, inv_stride = 1.0;  // centre 0 and 1 / texels between centres
   int n = 1;                              // centres along the axis
   bool repeat = true;
+  // Clamped axes: fold[k - 1] is the mass over the map of a level footprint k strides before
+  // centre 0 over that of centre 0, and fold_hi the same after centre n - 1 (edge falloff); `folds`
+  // of them are above kFoldFloor.
+  int folds = 0;
+  double fold_lo[kMaxFold] = {}, fold_hi[kMaxFold] = {};
+  // Clamped axes whose asset holds the edge centres beyond the edges instead (the tile assets of
+  // wang-tiles containers, formats/SPEC.md 10.7): no falloff, and spreads held at max_spread.
+  bool hold = false;
 
-  void set(double map_size, double origin_texels, double stride, int centres, bool wraps) {
+  // footprint_std: the level footprint's spatial std along the axis (sigma_l with the flakes' own
+  // sigma_h), which sets how fast the mass of centres beyond a clamped edge falls.
+  void set(double map_size, double origin_texels, double stride, int centres, bool wraps, double footprint_std) {
     size = map_size;
     inv_size = 1.0 / map_size;
     origin = origin_texels;
     inv_stride = 1.0 / stride;
     n = centres;
     repeat = wraps;
+    hold = false;
+    folds = 0;
+    if (repeat) return;
+    const double first = origin, last = origin + double(n - 1) * stride;
+    const double m_first = massWithin(first, footprint_std), m_last = massWithin(last, footprint_std);
+    if (!(m_first > 0.0) || !(m_last > 0.0)) return;  // degenerate records: hold the edges
+    for (int k = 1; k <= kMaxFold; ++k) {
+      fold_lo[k - 1] = massWithin(first - k * stride, footprint_std) / m_first;
+      fold_hi[k - 1] = massWithin(last + k * stride, footprint_std) / m_last;
+      if (!(fold_lo[k - 1] > kFoldFloor) && !(fold_hi[k - 1] > kFoldFloor)) break;
+      folds = k;
+    }
+  }
+
+  // The mass over [0, size] of a normalised Gaussian of std s centred at c (no cancellation on
+  // either side of the axis).
+  double massWithin(double c, double s) const {
+    constexpr double kInvSqrt2 = 0.70710678118654752;
+    const double t = c / s * kInvSqrt2, u = (size - c) / s * kInvSqrt2;  // Phi(x) = erfc(-x / sqrt 2) / 2
+    if (t <= 0.0) return 0.5 * (std::erfc(-t) - std::erfc(u));
+    if (u <= 0.0) return 0.5 * (std::erfc(-u) - std::erfc(t));
+    return 1.0 - 0.5 * (std::erfc(t) + std::erfc(u));
+  }
+
+  // Centre index i of a clamped axis (any integer) -> the stored centre whose image stands for it
+  // and the factor that scales it (1 within the grid, the edge falloff beyond; 0 past the folds).
+  int foldedCentre(int i, double* factor) const {
+    if (i < 0) {
+      *factor = -i <= folds ? fold_lo[-i - 1] : 0.0;
+      return 0;
+    }
+    if (i >= n) {
+      *factor = i - n + 1 <= folds ? fold_hi[i - n] : 0.0;
+      return n - 1;
+    }
+    *factor = 1.0;
+    return i;
+  }
+
+  // The bilinear weights of a position (texels): up to two centres. Repeating axes as neighbours();
+  // clamped ones interpolate towards the virtual centres beyond an edge (edge falloff), so both
+  // neighbours may be the same edge centre (merged). Returns the count of entries.
+  int bilinear(double pos, int* idx, double* w) const {
+    const double g = (pos - origin) * inv_stride;              // (unwrapped; only used on clamped axes)
+    if (repeat || hold || (g >= 0.0 && g <= double(n - 1))) {  // as neighbours()
+      int i0, i1;
+      double f;
+      neighbours(pos, &i0, &i1, &f);
+      idx[0] = i0;
+      w[0] = 1.0 - f;
+      if (i1 == i0 || f == 0.0) {
+        w[0] = 1.0;
+        return 1;
+      }
+      idx[1] = i1;
+      w[1] = f;
+      return 2;
+    }
+    // Beyond an edge both neighbours fold onto the edge centre (|g| is bounded by the footprint
+    // check, and far beyond the folds both factors are 0).
+    const double gc = std::fmax(std::fmin(g, double(n) + kMaxFold + 1.0), -double(kMaxFold) - 2.0);
+    const double fl = floorOf(gc), f = gc - fl;
+    double a, b;
+    idx[0] = foldedCentre(int(fl), &a);
+    foldedCentre(int(fl) + 1, &b);
+    w[0] = (1.0 - f) * a + f * b;
+    return 1;
   }
 
   // Bilinear neighbours i0, i1 of a position (texels) and the weight f of i1.
@@ -129,25 +218,13 @@ struct NdfBlendAxis {
   // The centres around a position (texels) with their weights for a footprint of std sigma over a
   // level of std sigma_l: the Gaussian of std tau' (strides, at most max_spread) integrated against
   // each centre's tent, tau * (F(d + 1/tau) - 2 F(d) + F(d - 1/tau)) with d = (g - i) / tau and
-  // F(z) = z Phi(z) + phi(z) (NdfRamp); plain bilinear weights when tau' = 0. Indices wrapped (repeat) or
-  // clamped, equal indices merged, weights normalised to sum 1. Writes at most kMaxBlendAxis
-  // entries; returns their count.
+  // F(z) = z Phi(z) + phi(z) (NdfRamp); bilinear weights when tau' = 0 (bilinear()). Indices
+  // wrapped (repeat) or folded onto the edge centres with the edge falloff (clamp), equal indices
+  // merged, weights normalised to sum 1 over the window before the falloff. Writes at most
+  // kMaxBlendAxis entries; returns their count.
   int gaussianWeights(double pos, double sigma, double sigma_l, double max_spread, int* idx, double* w) const {
     const double tau = std::fmin(spread(sigma, sigma_l), max_spread);
-    if (!(tau > 1e-3)) {
-      int i0, i1;
-      double f;
-      neighbours(pos, &i0, &i1, &f);
-      idx[0] = i0;
-      w[0] = 1.0 - f;
-      if (i1 == i0 || f == 0.0) {
-        w[0] = 1.0;
-        return 1;
-      }
-      idx[1] = i1;
-      w[1] = f;
-      return 2;
-    }
+    if (!(tau > 1e-3)) return bilinear(pos, idx, w);
     if (repeat) pos -= floorOf(pos * inv_size) * size;
     const double g = (pos - origin) * inv_stride;  // continuous centre index
     const double reach = 3.5 * tau + 1.0;
@@ -160,6 +237,7 @@ struct NdfBlendAxis {
       }
       return n;
     }
+    if (!repeat && !hold) return clampedWeights(g, tau, reach, idx, w);
     const int first = int(floorOf(g - reach)), last = int(floorOf(g + reach)) + 1;
     int count = 0;
     double total = 0.0;
@@ -175,18 +253,73 @@ struct NdfBlendAxis {
       r_cur = r_next;
       if (!(wi > 0.0)) continue;
       const int k = repeat ? ((i % n) + n) % n : (i < 0 ? 0 : (i >= n ? n - 1 : i));
-      int e = 0;
-      while (e < count && idx[e] != k) ++e;
-      if (e == count) {
-        if (count == kMaxBlendAxis) continue;  // the far tail beyond the entries (below 1e-3)
-        idx[count] = k;
-        w[count++] = 0.0;
-      }
-      w[e] += wi;
-      total += wi;
+      if (addWeight(k, wi, idx, w, &count)) total += wi;
     }
     for (int e = 0; e < count; ++e) w[e] /= total;
     return count;
+  }
+
+  // gaussianWeights on a clamped axis: the same tent-integrated weights over centres within
+  // `reach` strides of g, those beyond the edges folded onto the edge centres with the edge
+  // falloff (only the virtual centres with a fold are visited, so any spread costs at most
+  // n + 2 kMaxFold steps), normalised by the sum over the whole window (a telescoping sum of the
+  // ramp: the footprint keeps the mass it has within the map). Spreads above kDensitySpread use
+  // the Gaussian density of variance tau^2 + 1/6 (the tent's) per centre instead, where the
+  // ramp's second differences would lose their precision.
+  static constexpr double kDensitySpread = 32.0;
+  int clampedWeights(double g, double tau, double reach, int* idx, double* w) const {
+    const double lo = std::fmax(g - reach, -double(folds) - 1.0),
+                 hi = std::fmin(g + reach, double(n - 1 + folds) + 1.0);
+    int count = 0;
+    if (!(lo <= hi)) return 0;  // the footprint's window misses the map and its folds
+    const int first = std::max(int(floorOf(lo)), -folds), last = std::min(int(floorOf(hi)) + 1, n - 1 + folds);
+    const bool density = tau > kDensitySpread;
+    const double tau_f = std::sqrt(tau * tau + 1.0 / 6.0), inv_tau = 1.0 / (density ? tau_f : tau);
+    const NdfRamp& ramp = NdfRamp::table();
+    double total;
+    if (density) {
+      total = std::erf((reach + 0.5) * inv_tau * 0.70710678118654752);
+    } else {
+      // sum_{i = a..b} tau (r_{i-1} - 2 r_i + r_{i+1}) = tau ((r_{a-1} - r_a) - (r_b - r_{b+1})).
+      const double a = floorOf(g - reach), b = floorOf(g + reach) + 1.0;
+      total = tau * ((ramp((g - (a - 1.0)) * inv_tau) - ramp((g - a) * inv_tau)) -
+                     (ramp((g - b) * inv_tau) - ramp((g - (b + 1.0)) * inv_tau)));
+    }
+    if (!(total > 0.0)) return 0;
+    double r_prev = 0.0, r_cur = 0.0;
+    if (!density) r_prev = ramp((g - double(first - 1)) * inv_tau), r_cur = ramp((g - double(first)) * inv_tau);
+    for (int i = first; i <= last; ++i) {
+      double wi;
+      if (density) {
+        const double d = (g - double(i)) * inv_tau;
+        wi = 0.39894228040143267794 * inv_tau * std::exp(-0.5 * d * d);
+      } else {
+        const double r_next = ramp((g - double(i + 1)) * inv_tau);
+        wi = tau * (r_prev - 2.0 * r_cur + r_next);
+        r_prev = r_cur;
+        r_cur = r_next;
+      }
+      double factor;
+      const int k = foldedCentre(i, &factor);
+      wi *= factor;
+      if (wi > 0.0) addWeight(k, wi, idx, w, &count);
+    }
+    for (int e = 0; e < count; ++e) w[e] /= total;
+    return count;
+  }
+
+  // Adds weight wi to centre k's entry (a new one if k has none); false when the entries are full
+  // (the far tail beyond them, below 1e-3).
+  static bool addWeight(int k, double wi, int* idx, double* w, int* count) {
+    int e = 0;
+    while (e < *count && idx[e] != k) ++e;
+    if (e == *count) {
+      if (*count == kMaxBlendAxis) return false;
+      idx[*count] = k;
+      w[(*count)++] = 0.0;
+    }
+    w[e] += wi;
+    return true;
   }
 
   // floor() for |x| well inside the int range, without a library call on targets without a
@@ -221,8 +354,14 @@ class NdfPyramidBlend {
       const NdfLevelRecord& r = records[l];
       const bool repeat = r.wrap == 0;
       Level& g = level_[l];
-      g.x.set(double(r.map_width), r.origin_x, r.stride_x, int(r.grid_width), repeat);
-      g.y.set(double(r.map_height), r.origin_y, r.stride_y, int(r.grid_height), repeat);
+      // A stored footprint's spatial std: sigma_l with the flakes' own sigma_h (formats/SPEC.md 10.5).
+      const double step = 1.0 / double(r.rate > 0 ? r.rate : 1), sigma_h = step * 1.5 / std::sqrt(12.0);
+      const double footprint_std = std::sqrt(r.sigma_texels * r.sigma_texels + sigma_h * sigma_h);
+      g.x.set(double(r.map_width), r.origin_x, r.stride_x, int(r.grid_width), repeat, footprint_std);
+      g.y.set(double(r.map_height), r.origin_y, r.stride_y, int(r.grid_height), repeat, footprint_std);
+      g.sigma_h2 = sigma_h * sigma_h;
+      g.centre_mass =
+          repeat ? 1.0 : g.x.massWithin(r.origin_x, footprint_std) * g.y.massWithin(r.origin_y, footprint_std);
       g.grid_width = size_t(r.grid_width);
       g.sigma = r.sigma_texels;
       g.log_sigma = std::log(r.sigma_texels);
@@ -242,14 +381,38 @@ class NdfPyramidBlend {
     }
     int l = first_;
     double q = spread(first_, sigma);
-    while (q > kMaxSpread && l + 1 < count_) q = spread(++l, sigma);
+    // A level of one centre has no positions to spread over (its spread only moves mass across a
+    // clamped map's edges), so it answers only up to the next level's sigma.
+    while (l + 1 < count_ && (singleCentre(l) ? sigma >= level_[l + 1].sigma : q > kMaxSpread)) q = spread(++l, sigma);
     double beta = 0.0;  // weight of level l + 1
-    if (q > kBlendSpread && l + 1 < count_) {
+    if (l + 1 < count_ && singleCentre(l)) {
+      beta = (std::log(sigma) - level_[l].log_sigma) * level_[l].inv_log_step;  // linear in log sigma
+      beta = beta > 0.0 ? (beta < 1.0 ? beta : 1.0) : 0.0;
+    } else if (q > kBlendSpread && l + 1 < count_) {
       const double t = (q - kBlendSpread) / (kMaxSpread - kBlendSpread);
       beta = t * t * (3.0 - 2.0 * t);
     }
+    if (singleCentre(l)) {
+      singleLevel(l, 1.0 - beta, x, y, sigma, emit);
+      if (beta > 0.0) singleLevel(l + 1, beta, x, y, sigma, emit);
+      return;
+    }
     gaussianLevel(l, 1.0 - beta, x, y, sigma, emit);
     if (beta > 0.0) gaussianLevel(l + 1, beta, x, y, sigma, emit);
+  }
+
+  // A level of one centre for a footprint (x, y, sigma): its image, scaled on a clamped map by the
+  // footprint's mass over the map over that of the level's own footprint (no centres to mix: the
+  // shape is the level's, the mass the footprint's, exactly, wherever it lies and however wide).
+  template <typename Emit>
+  void singleLevel(int l, double level_weight, double x, double y, double sigma, Emit& emit) const {
+    const Level& g = level_[l];
+    double w = level_weight;
+    if (!g.x.repeat) {
+      const double s = std::sqrt(sigma * sigma + g.sigma_h2);
+      w = g.centre_mass > 0.0 ? w * (g.x.massWithin(x, s) * g.y.massWithin(y, s) / g.centre_mass) : 0.0;
+    }
+    if (w > 0.0) emit(l, 0, w);
   }
 
   // blend() uses the levels from the first whose sigma is at least `sigma` (the top level when
@@ -274,11 +437,11 @@ class NdfPyramidBlend {
     const Level& g = level_[l];
     int xi[kMaxBlendAxis], yi[kMaxBlendAxis];
     double xw[kMaxBlendAxis], yw[kMaxBlendAxis];
-    // The top level of a repeating map spreads as far as the footprint needs when its whole grid
-    // fits the weights (a footprint far wider than the map sees the mean of every centre).
-    auto reach = [&](const NdfBlendAxis& a) {
-      return l == count_ - 1 && a.repeat && a.n <= kWholeGridAxis ? 1e300 : kMaxSpread;
-    };
+    // The top level spreads as far as the footprint needs when its whole grid fits the weights: on
+    // a repeating map a footprint far wider than the map sees the mean of every centre, on a
+    // clamped one their Gaussian-weighted sum with the mass the footprint keeps over the map.
+    // A level of one centre answers up to the next level's sigma, however far that spreads it.
+    auto reach = [&](const NdfBlendAxis& a) { return unboundedAbove(l, a) || singleCentre(l) ? 1e300 : kMaxSpread; };
     const int nx = g.x.gaussianWeights(x, sigma, g.sigma, reach(g.x), xi, xw);
     const int ny = g.y.gaussianWeights(y, sigma, g.sigma, reach(g.y), yi, yw);
     for (int b = 0; b < ny; ++b) {
@@ -289,19 +452,41 @@ class NdfPyramidBlend {
     }
   }
 
-  // Within level l, the 4 nearest centres of (x, y) bilinearly, each weight times level_weight
-  // (zero weights skipped), in the order (i0, j0), (i1, j0), (i0, j1), (i1, j1).
+  // Within level l, the (up to) 4 nearest centres of (x, y) bilinearly (NdfBlendAxis::bilinear),
+  // each weight times level_weight (zero weights skipped), rows then columns.
   template <typename Emit>
   void blendLevel(int l, double level_weight, double x, double y, Emit& emit) const {
     const Level& g = level_[l];
-    int x0, x1, y0, y1;
-    double fx, fy;
-    g.x.neighbours(x, &x0, &x1, &fx);
-    g.y.neighbours(y, &y0, &y1, &fy);
-    const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-    const double ws[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-    for (int k = 0; k < 4; ++k) {
-      if (ws[k] > 0.0) emit(l, size_t(ys[k]) * g.grid_width + size_t(xs[k]), level_weight * ws[k]);
+    int xi[2], yi[2];
+    double xw[2], yw[2];
+    const int nx = g.x.bilinear(x, xi, xw), ny = g.y.bilinear(y, yi, yw);
+    for (int b = 0; b < ny; ++b) {
+      for (int a = 0; a < nx; ++a) {
+        const double w = xw[a] * yw[b];
+        if (w > 0.0) emit(l, size_t(yi[b]) * g.grid_width + size_t(xi[a]), level_weight * w);
+      }
+    }
+  }
+
+  // Whether level l has one centre (and is not held, NdfBlendAxis::hold): a clamped map's top
+  // levels from the one whose stride reached the map size.
+  bool singleCentre(int l) const {
+    const Level& g = level_[l];
+    return g.x.n == 1 && g.y.n == 1 && !g.x.hold && !g.y.hold;
+  }
+
+  // Whether the blend spreads level l to any width along an axis: the top level's axes of at most
+  // kWholeGridAxis centres.
+  bool unboundedAbove(int l, const NdfBlendAxis& a) const {
+    return l == count_ - 1 && !a.hold && a.n <= kWholeGridAxis;
+  }
+
+  // Clamped levels hold their edge centres beyond the edges (NdfBlendAxis::hold): the blend of the
+  // tile assets of wang-tiles containers, whose margins already lie beyond their flakes.
+  void holdEdges() {
+    for (int l = 0; l < count_; ++l) {
+      level_[l].x.hold = !level_[l].x.repeat;
+      level_[l].y.hold = !level_[l].y.repeat;
     }
   }
 
@@ -311,6 +496,8 @@ class NdfPyramidBlend {
     size_t grid_width = 1;
     double sigma = 1.0, log_sigma = 0.0;
     double inv_log_step = 0.0;  // 1 / log(sigma_{l+1} / sigma_l); 0 on the top level
+    double sigma_h2 = 0.0;      // the flakes' own spatial variance (formats/SPEC.md 10.5)
+    double centre_mass = 1.0;   // clamped maps: the mass over the map of centre 0's footprint
   };
 
   Level level_[kMaxNdfLevels];

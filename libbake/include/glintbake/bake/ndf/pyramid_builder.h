@@ -29,8 +29,9 @@
 // computing it (stop reason "converged"; the probe's MSE is reported). Otherwise the probed images
 // are reused when their regions are computed, so the probe costs nothing extra. The pyramid also
 // stops after the first level whose grid is 1 x 1 (the stride reached the map size and, on a
-// repeating map, the footprint is flat over it: levelGeometry), or at
-// kMaxPyramidLevels (README.md, "Figures": what skipping the converged level saves).
+// repeating map, the footprint is flat over it: levelGeometry; on a clamped map, once its sigma
+// is kClampedFlatSigma times the longer side), or at kMaxPyramidLevels (README.md, "Figures":
+// what skipping the converged level saves).
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
@@ -97,6 +98,13 @@ struct LevelGeometry {
 // sigma 16 gave the whole map's NDF to 0.03 relative L1, and its level 0 (one centre along the
 // 23 texels) 0.10 at 32 texels.
 constexpr double kFlatAxisSigma = 0.62;
+// A clamped map has no surface beyond its edges: a footprint far wider than the map keeps only the
+// mass over it (the runtime's edge falloff, formats/SPEC.md 10.1) with the shape of the top level's
+// image, whose footprint weighs the middle of the map more than its edges. So the automatic level
+// count adds levels of one centre until sigma is this many times the longer side, where the
+// weights over the map vary by exp(-1/32) (3%) from its centre to the middle of an edge. On a
+// 128^2 tufted-leather map the top level of sigma 64 gave 0.092 relative L1 at 128 texels.
+constexpr double kClampedFlatSigma = 2.0;
 LevelGeometry levelGeometry(int map_width, int map_height, const PyramidOptions& options, int level, bool periodic);
 
 struct PyramidLevelReport {
