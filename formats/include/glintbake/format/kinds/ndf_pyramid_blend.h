@@ -286,8 +286,9 @@ struct NdfBlendAxis {
                      (ramp((g - b) * inv_tau) - ramp((g - (b + 1.0)) * inv_tau)));
     }
     if (!(total > 0.0)) return 0;
-    double r_prev = 0.0, r_cur = 0.0;
-    if (!density) r_prev = ramp((g - double(first - 1)) * inv_tau), r_cur = ramp((g - double(first)) * inv_tau);
+    // The ramp at centres i - 1 and i (the ramp branch; see gaussianWeights).
+    double r_prev = density ? 0.0 : ramp((g - double(first - 1)) * inv_tau);
+    double r_cur = density ? 0.0 : ramp((g - double(first)) * inv_tau);
     for (int i = first; i <= last; ++i) {
       double wi;
       if (density) {
