@@ -40,10 +40,11 @@ class ScratchDir {
   std::filesystem::path path_;
 };
 
-// Writes `values` (width*height*channels, in the given data type) as `stored` pixels.
+// Writes `values` (width*height*channels, in the given data type) as `stored` pixels; tiled files
+// in tiles of tile_side^2 pixels.
 inline void writeRaw(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
                      OIIO::TypeDesc data_type, const void* values, bool tiled = false,
-                     const char* compression = nullptr) {
+                     const char* compression = nullptr, int tile_side = 16) {
   auto out = OIIO::ImageOutput::create(path);
   ASSERT_TRUE(out) << OIIO::geterror();
   OIIO::ImageSpec spec(width, height, channels, stored);
@@ -54,8 +55,8 @@ inline void writeRaw(const std::string& path, int width, int height, int channel
   }
   if (compression) spec.attribute("compression", compression);
   if (tiled) {
-    spec.tile_width = 16;
-    spec.tile_height = 16;
+    spec.tile_width = tile_side;
+    spec.tile_height = tile_side;
   }
   ASSERT_TRUE(out->open(path, spec)) << out->geterror();
   ASSERT_TRUE(out->write_image(data_type, values)) << out->geterror();
@@ -63,8 +64,9 @@ inline void writeRaw(const std::string& path, int width, int height, int channel
 }
 
 inline void writeFloats(const std::string& path, int width, int height, int channels, OIIO::TypeDesc stored,
-                        const std::vector<float>& values, bool tiled = false, const char* compression = nullptr) {
-  writeRaw(path, width, height, channels, stored, OIIO::TypeDesc::FLOAT, values.data(), tiled, compression);
+                        const std::vector<float>& values, bool tiled = false, const char* compression = nullptr,
+                        int tile_side = 16) {
+  writeRaw(path, width, height, channels, stored, OIIO::TypeDesc::FLOAT, values.data(), tiled, compression, tile_side);
 }
 
 inline std::string readBytes(const std::string& path) {
