@@ -5,6 +5,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/runtime/flake_ndf.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,8 @@ namespace glintbake::bake::ndf {
 namespace {
 constexpr double kFlakesUpTo = 4.0;  // texels: the flakes answer at least this far
 constexpr double kHalfOctave = 1.4142135623730951;
-constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
+constexpr double kLobesUnbounded = 1e6;     // the record's largest footprint bound
+constexpr double kFlakeWindowSigmas = 6.0;  // the flakes path's window radius (runtime FlakeNdf), in sigma
 }  // namespace
 
 FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat) {
@@ -29,6 +31,25 @@ FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width,
   const double lobes_from = h.flakes_up_to * format::kLobesBand;
   h.pyramid_from = std::max(flat, lobes_from);
   h.lobes_up_to = std::max(lobes_from, std::min(h.lobes_up_to, h.pyramid_from / kHalfOctave));
+  return h;
+}
+
+FlakesHandover fitHandoverToMap(const FlakesHandover& handover, int map_width, int map_height, bool repeat, int rate) {
+  if (repeat) return capAtFlatFootprint(handover, map_width, map_height, true);
+  if (map_width < 1 || map_height < 1 || rate < 1) return handover;
+  const uint64_t flakes = uint64_t(map_width) * uint64_t(map_height) * uint64_t(rate) * uint64_t(rate);
+  const double flat = kClampedFlatSigma * double(std::max(map_width, map_height));
+  // The flakes path's window at F: 2 x 6 sqrt(F^2 + sigma_h^2) flakes across (sigma_h < 1 texel),
+  // plus the two rounded ends.
+  const double window = 2.0 * kFlakeWindowSigmas * std::sqrt(flat * flat + 1.0) * double(rate) + 2.0;
+  if (flakes > kSmallClampedMapFlakes || !(window < double(runtime::kMaxFlakeWindow)) ||
+      !(handover.flakes_up_to < flat))
+    return handover;
+  FlakesHandover h;
+  h.flakes_up_to = flat;
+  h.lobes_per_tile = 0;
+  h.lobes_up_to = 0.0;
+  h.pyramid_from = flat * kHalfOctave;
   return h;
 }
 
@@ -77,15 +98,17 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
 }
 
 namespace {
-// The record's hand-over, capped as capAtFlatFootprint does.
+// The record's hand-over, fitted to its map as fitHandoverToMap does.
 void capRecord(format::FlakesRecord* rec) {
   FlakesHandover h;
   h.flakes_up_to = rec->flakes_up_to;
   h.lobes_per_tile = int(rec->lobes_per_tile);
   h.lobes_up_to = rec->lobes_up_to;
   h.pyramid_from = rec->pyramid_from;
-  h = capAtFlatFootprint(h, int(rec->map_width), int(rec->map_height), rec->wrap == 0);
-  rec->lobes_up_to = h.lobes_up_to;
+  h = fitHandoverToMap(h, int(rec->map_width), int(rec->map_height), rec->wrap == 0, int(rec->rate));
+  rec->flakes_up_to = h.flakes_up_to;
+  rec->lobes_per_tile = uint32_t(std::max(h.lobes_per_tile, 0));
+  rec->lobes_up_to = h.lobes_per_tile > 0 ? h.lobes_up_to : 0.0;
   rec->pyramid_from = h.pyramid_from;
 }
 }  // namespace

@@ -122,8 +122,8 @@ Json pyramidOptionsJson(const PyramidCliOptions& p) {
 }
 
 bake::ndf::FlakesHandover defaultFlakesHandover(const PyramidCliOptions& p, const bake::NormalMap& map) {
-  return bake::ndf::capAtFlatFootprint(bake::ndf::defaultHandover(p.options.sigma0, p.lobes), map.width, map.height,
-                                       map.wrap == bake::Wrap::kRepeat);
+  return bake::ndf::fitHandoverToMap(bake::ndf::defaultHandover(p.options.sigma0, p.lobes), map.width, map.height,
+                                     map.wrap == bake::Wrap::kRepeat, p.options.rate);
 }
 
 uint64_t writeFlakes(format::Writer& writer, const bake::NormalMap& map, const PyramidCliOptions& p,

@@ -149,7 +149,8 @@ TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::Tensor
   if (flakes && flakes->size() >= sizeof(format::FlakesRecord)) {
     format::FlakesRecord rec;
     std::memcpy(&rec, flakes->data(), sizeof(rec));
-    out.handover = bake::ndf::capAtFlatFootprint(out.handover, int(rec.map_width), int(rec.map_height), rec.wrap == 0);
+    out.handover = bake::ndf::fitHandoverToMap(out.handover, int(rec.map_width), int(rec.map_height), rec.wrap == 0,
+                                               int(rec.rate));
   }
   // The gate runs before anything more is written: a failure leaves no output.
   out.gated = gatedError(report, out.handover);

@@ -35,8 +35,24 @@ constexpr int kMaxLobesPerTile = 16;
 // where the lobes of a map a few tiles across are coarser (a 9 x 6 map at 12 texels: 0.05 relative
 // L1 against 0.000). So the pyramid answers alone from F and the lobes up to F / sqrt(2) (at least
 // 4 sqrt(2)) when the hand-over's bounds are higher; unchanged when the lobes answer every
-// footprint (no faithful level). flakesSectionBytes and setFlakesHandover record it so capped.
+// footprint (no faithful level). fitHandoverToMap applies it to repeating maps.
 FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat);
+
+// Clamped maps of at most this many flakes (texels x rate^2) are answered by their flakes alone up
+// to kClampedFlatSigma (2) times their longer side, where a footprint's weights are within 3% of
+// flat over the map: an exact query then costs at most this many flakes whatever the footprint
+// (a clamped map has no flakes beyond its edges), within a pyramid query's budget, where the
+// pyramid of a map a few dozen texels across has one centre per level (a 37 x 23 map at 24
+// texels: 0.17 relative L1 against the reference).
+constexpr uint64_t kSmallClampedMapFlakes = 4096;
+
+// `handover` fitted to a map of that size, wrap and rate (flakes per texel side): on a repeating
+// map capAtFlatFootprint; on a clamped one of at most kSmallClampedMapFlakes flakes whose window
+// at that footprint fits runtime::kMaxFlakeWindow, the flakes answer alone up to F =
+// kClampedFlatSigma x the longer side (no clustered lobes) and hand over to the pyramid across the
+// half octave above F, when the given hand-over's flakes stop below F; unchanged otherwise.
+// flakesSectionBytes and setFlakesHandover record it so fitted.
+FlakesHandover fitHandoverToMap(const FlakesHandover& handover, int map_width, int map_height, bool repeat, int rate);
 
 // The hand-over for a pyramid whose finest level has footprint std sigma0 (texels) and is faithful
 // from there on (an uncompressed pyramid). With lobes (1..16 per tile): the flakes answer up to 4
