@@ -18,8 +18,7 @@ namespace glintbake::bake::ndf {
 namespace {
 constexpr double kFlakesUpTo = 4.0;  // texels: the flakes answer at least this far
 constexpr double kHalfOctave = 1.4142135623730951;
-constexpr double kLobesUnbounded = 1e6;     // the record's largest footprint bound
-constexpr double kFlakeWindowSigmas = 6.0;  // the flakes path's window radius (runtime FlakeNdf), in sigma
+constexpr double kLobesUnbounded = 1e6;  // the record's largest footprint bound
 }  // namespace
 
 FlakesHandover capAtFlatFootprint(const FlakesHandover& handover, int map_width, int map_height, bool repeat) {
@@ -39,9 +38,9 @@ FlakesHandover fitHandoverToMap(const FlakesHandover& handover, int map_width, i
   if (map_width < 1 || map_height < 1 || rate < 1) return handover;
   const uint64_t flakes = uint64_t(map_width) * uint64_t(map_height) * uint64_t(rate) * uint64_t(rate);
   const double flat = kClampedFlatSigma * double(std::max(map_width, map_height));
-  // The flakes path's window at F: 2 x 6 sqrt(F^2 + sigma_h^2) flakes across (sigma_h < 1 texel),
-  // plus the two rounded ends.
-  const double window = 2.0 * kFlakeWindowSigmas * std::sqrt(flat * flat + 1.0) * double(rate) + 2.0;
+  // The flakes path's window at F: 2 kFlakeWindowSigmas sqrt(F^2 + sigma_h^2) flakes across
+  // (sigma_h < 1 texel), plus the two rounded ends.
+  const double window = 2.0 * runtime::kFlakeWindowSigmas * std::sqrt(flat * flat + 1.0) * double(rate) + 2.0;
   if (flakes > kSmallClampedMapFlakes || !(window < double(runtime::kMaxFlakeWindow)) ||
       !(handover.flakes_up_to < flat))
     return handover;
@@ -99,7 +98,7 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
 
 namespace {
 // The record's hand-over, fitted to its map as fitHandoverToMap does.
-void capRecord(format::FlakesRecord* rec) {
+void fitRecord(format::FlakesRecord* rec) {
   FlakesHandover h;
   h.flakes_up_to = rec->flakes_up_to;
   h.lobes_per_tile = int(rec->lobes_per_tile);
@@ -125,7 +124,7 @@ Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, 
   rec.pyramid_from = handover.pyramid_from;
   rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
   rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
-  capRecord(&rec);
+  fitRecord(&rec);
   const uint64_t size = format::flakesSectionSize(rec);
   if (const char* why = format::checkFlakesRecord(rec, size)) return makeError(ErrorCode::kBadArgument, why);
   std::vector<uint8_t> section;
@@ -153,7 +152,7 @@ BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover
   rec.pyramid_from = handover.pyramid_from;
   rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
   rec.lobes_up_to = handover.lobes_per_tile > 0 ? handover.lobes_up_to : 0.0;
-  capRecord(&rec);
+  fitRecord(&rec);
   if (const char* why = format::checkFlakesRecord(rec, section.size())) return makeError(ErrorCode::kInvalidInput, why);
   std::memcpy(section.data(), &rec, sizeof(rec));
   return okStatus();

@@ -22,7 +22,7 @@ constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kTile = flakes::kTileFlakes;            // flakes per side of a tile of the hierarchy
 constexpr int kLeafFlakes = 8;                        // flakes per leaf of a tile's k-d tree (one block)
 constexpr int kLeaves = kTile * kTile / kLeafFlakes;  // leaves of a full tile
-constexpr double kWindowSigmas = 6;                   // spatial truncation radius, in sqrt(v), as the reference's
+constexpr double kWindowSigmas = kFlakeWindowSigmas;  // spatial truncation radius, in sqrt(v)
 // A flake is left out when its spatial exponent |u_Q - u_k|^2 / 2v plus its lobe's exponent at s
 // exceeds this: its contribution is below e^-18 of its own peak. The spatial part alone is the
 // reference evaluator's truncation (a disk of 6 sqrt(v)).

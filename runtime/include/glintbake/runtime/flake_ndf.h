@@ -51,6 +51,9 @@ namespace glintbake::runtime {
 // Largest window a query accepts, in flakes per side (about sigma_p = 340 texels at rate 1);
 // larger footprints return kInvalidArgument (answer them from a pyramid).
 constexpr int64_t kMaxFlakeWindow = 4096;
+// Spatial truncation radius of a query's window, in footprint stds sqrt(sigma^2 + sigma_h^2), as
+// the reference evaluator's: a window is 2 x this x that std x rate flakes across.
+constexpr double kFlakeWindowSigmas = 6.0;
 
 // The kernels of FlakeNdf and LobeNdf use AVX2 where the processor has it (chosen at run time, no
 // -march flag needed; they give the same bits as the portable SSE2 or scalar kernels). true
