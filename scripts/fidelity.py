@@ -27,13 +27,17 @@ Whole-map NDF (--baseline):
 References: `glintref image` (exact bin averages, lobes truncated at 6 sigma) for sigma up to
 --splat-above (default 16 texels). Its cost grows as sigma^2 (about 170 s of one core for one
 128^2 image at sigma 64), so above that the reference is one footprint splatted by ndfgen
-(--levels 1, one centre at the map's centre) on a copy of the map shifted periodically by whole
-texels so that the footprint lands on that centre: footprint centres of those sigmas keep the
-fractional part of the map's centre (whole texels for even sizes). The splatter truncates
-footprints at 4 sigma and agrees with glintref to relative L1 4e-4 (sigma 16, two real maps,
-random positions); it is the baker's own evaluator, so `--splat-above -1` gives an independent
-reference everywhere when time allows. The shift needs a non-interlaced 8/16-bit PNG and wrap
-repeat; other maps use glintref at every sigma.
+(--levels 1, --no-flakes) on a copy of the map shifted periodically by whole texels so that the
+footprint lands on a centre of that level: footprint centres of those sigmas keep the fractional
+part of the map's centre (whole texels for even sizes). ndfgen keeps one centre along a repeating
+axis only where the footprint is flat over it, and reweighs the footprints of centres closer than
+2.5 stds into a partition of unity; so an axis the footprint is not flat over is repeated over 2
+or 6 periods (two centres 1 or 3 periods apart, the first at the shifted footprint), and the
+image is that of the plain Gaussian footprint. The splatter truncates footprints at 4 sigma and
+agrees with glintref to relative L1 2e-4 to 5e-4 (sigma 12 to 60, maps of 64 x 48 to 1024^2, odd
+and even sizes, axes of 1, 2 and 6 periods); it is the baker's own evaluator, so
+`--splat-above -1` gives an independent reference everywhere when time allows. The shift needs a
+non-interlaced 8/16-bit PNG and wrap repeat; other maps use glintref at every sigma.
 
 Caching (--cache, default build/fidelity-cache under the repository): reference images are keyed by
 (map content hash, x, y, sigma, R, sigma_r, and any non-default ingest option); baked assets by
@@ -212,20 +216,22 @@ def _read_png_rows(path):
     return width, height, bpp, ihdr, rows
 
 
-def _write_png_shifted(path, png, dx, dy):
-    """Writes the map periodically shifted by (dx, dy) whole texels: texel (c, r) moves to (c+dx, r+dy)."""
+def _write_png_shifted(path, png, dx, dy, tiles=(1, 1)):
+    """Writes the map periodically shifted by (dx, dy) whole texels (texel (c, r) moves to (c+dx, r+dy)),
+    repeated tiles[0] times across and tiles[1] times down: the same periodic surface."""
     width, height, bpp, ihdr, rows = png
     dx %= width
     dy %= height
     cut = (width - dx) * bpp
     shifted = [rows[(r - dy) % height] for r in range(height)]
-    body = b"".join(b"\x00" + row[cut:] + row[:cut] for row in shifted)
+    body = b"".join(b"\x00" + (row[cut:] + row[:cut]) * tiles[0] for row in shifted) * tiles[1]
+    header = struct.pack(">II", width * tiles[0], height * tiles[1]) + ihdr[8:]
 
     def chunk(ctype, payload):
         return struct.pack(">I", len(payload)) + ctype + payload + struct.pack(">I", zlib.crc32(ctype + payload))
 
     with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(body, 1)) +
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(body, 1)) +
                 chunk(b"IEND", b""))
 
 
@@ -420,7 +426,9 @@ class Harness:
         tag = "" if not extra else "_" + hashlib.sha256(" ".join(extra).encode()).hexdigest()[:8]
         splat = self.splat_sigma(minfo, sigma) and "--wrap" not in extra
         if splat:
-            tag += "_splat2"  # "_splat" references were answered by the clustered lobes, not the splat
+            # "_splat" references were answered by the clustered lobes, "_splat2" ones (made after ndfgen
+            # kept two centres on repeating axes) partly by a neighbouring centre: neither is reused.
+            tag += "_splat3"
         name = "%s_%s_%s_%s_%d_%s%s.exr" % (minfo["hash"], _fmt_num(x), _fmt_num(y), _fmt_num(sigma), params["res"],
                                             _fmt_num(params["sigma_r"]), tag)
         path = os.path.join(self.cache, "ref", name)
@@ -435,17 +443,40 @@ class Harness:
 
     def splat_reference(self, map_path, minfo, x, y, sigma, params, extra, path):
         """One footprint baked by ndfgen on a periodically shifted copy of the map (see --splat-above)."""
-        cx, cy = minfo["width"] / 2, minfo["height"] / 2
+        width, height = minfo["width"], minfo["height"]
+        cx, cy = width / 2, height / 2
         dx, dy = int(round(cx - x)), int(round(cy - y))
         base = path + ".%d.%d" % (os.getpid(), threading.get_ident())
         try:
-            _write_png_shifted(base + ".png", self.png(map_path), dx, dy)
+            # ndfgen keeps one centre along a repeating axis only where the footprint is flat over it
+            # (sigma >= 0.62 periods; pyramid_builder.h, levelGeometry), and otherwise two, whose
+            # footprints it reweighs into a partition of unity when they lie within 2.5 footprint
+            # stds (splat.h, footprintPartition), which is not the Gaussian footprint measured here.
+            # So such an axis is repeated over 2 m periods (m = 1, or 3 where a period is within 2.5
+            # stds): two centres m periods apart, the first at m / 2 periods, which is the map's
+            # centre shifted by whole periods, where the shift put the footprint.
+            def periods(size):
+                if sigma >= 0.62 * size:
+                    return 1
+                return 2 if size > 2.5 * (sigma + 0.5) else 6
+            tiles = (periods(width), periods(height))
+            _write_png_shifted(base + ".png", self.png(map_path), dx, dy, tiles)
             # --no-flakes: the pyramid alone answers (with flakes and lobes the asset's own hand-over
             # would answer this footprint from the clustered lobes).
-            _run([self.tool("ndfgen"), "-q", "-j1", "--levels", "1", "--stride", str(2 * max(minfo["width"], minfo["height"])),
-                  "--sigma0", repr(sigma), "--ndf-res", str(params["res"]), "--sigma-r", repr(params["sigma_r"]),
-                  "--no-flakes", base + ".png", "-o", base + ".gbk"] + extra)
-            _run([self.tool("glintquery"), "-q", "-j1", "image", base + ".gbk", "--at", "%r,%r" % (cx, cy),
+            longest = max(width * tiles[0], height * tiles[1])
+            report = json.loads(_run([self.tool("ndfgen"), "--json", "-q", "-j1", "--levels", "1",
+                                      "--stride", str(2 * longest), "--max-size", str(max(16384, longest)),
+                                      "--sigma0", repr(sigma), "--ndf-res", str(params["res"]),
+                                      "--sigma-r", repr(params["sigma_r"]), "--no-flakes", base + ".png",
+                                      "-o", base + ".gbk"] + extra))
+            level = report["levels"][0]
+            at = level["first_centre"]
+            for axis, (c, size) in enumerate(((cx, width), (cy, height))):
+                expect = c + (tiles[axis] // 2 - 1) / 2 * size if tiles[axis] > 1 else c
+                if level["grid"][axis] != min(tiles[axis], 2) or abs(at[axis] - expect) > 1e-9:
+                    raise RuntimeError("splat reference of %s at sigma %r: centres %r from %r, expected one at %r" %
+                                       (map_path, sigma, level["grid"], at, (cx, cy)))
+            _run([self.tool("glintquery"), "-q", "-j1", "image", base + ".gbk", "--at", "%r,%r" % tuple(at),
                   "--sigma", repr(sigma), "-o", base + ".exr"])
             os.replace(base + ".exr", path)
         finally:

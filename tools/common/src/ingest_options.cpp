@@ -6,10 +6,22 @@
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/cli/stdin_input.h>
 
+#include <cstdio>
 #include <map>
 #include <string>
 
 namespace glintbake::cli {
+namespace {
+
+// Four significant digits, in exponent form when large or small ("1.732", "2e+30"): a report's
+// figure, not a value to parse back.
+std::string shortNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", v);
+  return text;
+}
+
+}  // namespace
 
 void addIngestOptions(CLI::App& app, bake::IngestOptions& options) {
   static const std::map<std::string, bake::Encoding> kEncodings = {
@@ -93,7 +105,7 @@ bake::NormalMap loadNormalMapForTool(Tool& tool, const std::string& path, const 
   }
   if (r->far_from_unit > 0) {
     tool.warning(name + ": renormalised " + std::to_string(r->far_from_unit) + " of " + std::to_string(r->texels) +
-                 " texel(s) far from unit length (mean length " + std::to_string(r->mean_length) + ")");
+                 " texel(s) far from unit length (mean length " + shortNumber(r->mean_length) + ")");
   }
   return std::move(loaded).value();
 }
