@@ -763,8 +763,8 @@ RuntimeStatus FlakeNdfAccess::evalWithInnerWindow(const FlakeNdf& f, const Footp
   return RuntimeStatus::kOk;
 }
 
-RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas,
-                                           double* value, const flakes::TileCut* cut) {
+RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& fp, double window_sigmas, double* value,
+                                           const flakes::TileCut* cut) {
   if (!f.impl_ || !value || !validFootprint(fp)) return RuntimeStatus::kInvalidArgument;
   const FlakeNdf::Impl& m = *f.impl_;
   FootprintTerms t;
@@ -773,7 +773,8 @@ RuntimeStatus FlakeNdfAccess::windowedMass(const FlakeNdf& f, const Footprint& f
   if (cut) {  // tile by tile, from the running sums along both axes
     t.cut = cut;
     double col[kPrefixFlakes + 1], row[kPrefixFlakes + 1];
-    if (!t.empty && !(m.axisPrefix(t, true, col) && m.axisPrefix(t, false, row))) return RuntimeStatus::kInvalidArgument;
+    if (!t.empty && !(m.axisPrefix(t, true, col) && m.axisPrefix(t, false, row)))
+      return RuntimeStatus::kInvalidArgument;
     m.forEachWindowTile(t, [&](const WindowTile& w) { sum += FlakeNdf::Impl::tileWeight(t, w, col, row); });
     *value = t.wnorm * sum;
     return RuntimeStatus::kOk;
