@@ -11,6 +11,11 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
   if(GLINTBAKE_WERROR)
     target_compile_options(glintbake_warnings INTERFACE -Werror)
   endif()
+  # In a unity build (CMAKE_UNITY_BUILD) GCC takes each source for a header of the unity file, and
+  # warns where one of its classes holds a member whose type is in the source's anonymous namespace.
+  if(CMAKE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(glintbake_warnings INTERFACE -Wno-subobject-linkage)
+  endif()
 elseif(MSVC)
   target_compile_options(glintbake_warnings INTERFACE /W4)
 endif()

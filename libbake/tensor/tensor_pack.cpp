@@ -33,7 +33,7 @@ BakeStatus inArena(int threads, F&& f) {
   return result;
 }
 
-Error invalid(const std::string& message) { return makeError(ErrorCode::kInvalidInput, message); }
+Error invalidPyramidInput(const std::string& message) { return makeError(ErrorCode::kInvalidInput, message); }
 
 // Maps a reader failure to the library's categories: unreadable files are I/O errors, everything
 // else (checksums, decoding, sizes) means the container is corrupt.
@@ -47,10 +47,10 @@ Error readError(const std::string& what, format::ContainerStatus st) {
 BakeStatus checkLevelRecord(const format::NdfLevelRecord& rec, int level, const format::NdfLevelRecord* below) {
   const std::string where = "ndf-level " + std::to_string(level) + ": ";
   if (format::RecordCheck c = format::checkNdfLevelRecord(rec, uint32_t(level), below); !c)
-    return invalid(where + c.detail);
+    return invalidPyramidInput(where + c.detail);
   if (uint64_t(rec.grid_width) * rec.grid_height > (uint64_t(1) << 26))
-    return invalid(where + "centre grid out of range");
-  if (rec.region_size > 256) return invalid(where + "region layout inconsistent with the grid");
+    return invalidPyramidInput(where + "centre grid out of range");
+  if (rec.region_size > 256) return invalidPyramidInput(where + "region layout inconsistent with the grid");
   return okStatus();
 }
 
@@ -138,8 +138,8 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
   const auto t0 = Clock::now();
   if (BakeStatus s = validateTensorPackOptions(options); !s) return s;
   if (reader.kind() != format::AssetKind::kNdfPyramid) {
-    return invalid(std::string("not an ndf-pyramid container (asset kind ") + format::assetKindString(reader.kind()) +
-                   ")");
+    return invalidPyramidInput(std::string("not an ndf-pyramid container (asset kind ") +
+                               format::assetKindString(reader.kind()) + ")");
   }
   TensorPackReport local;
   TensorPackReport& rep = report ? *report : local;
@@ -155,9 +155,9 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
       const int li = reader.find(format::kSectionNdfLevel, uint64_t(level));
       if (li < 0) break;
       if (level >= ndf::kMaxPyramidLevels)
-        return invalid("more than " + std::to_string(ndf::kMaxPyramidLevels) + " levels");
+        return invalidPyramidInput("more than " + std::to_string(ndf::kMaxPyramidLevels) + " levels");
       if (reader.sections()[size_t(li)].raw_size != sizeof(format::NdfLevelRecord)) {
-        return invalid("ndf-level " + std::to_string(level) + ": wrong section size");
+        return invalidPyramidInput("ndf-level " + std::to_string(level) + ": wrong section size");
       }
       if (format::ContainerStatus st = reader.readSection(size_t(li), &bytes); st != format::ContainerStatus::kOk) {
         return readError("ndf-level " + std::to_string(level), st);
@@ -188,10 +188,11 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
         chunk.ndf_res = int(rec.ndf_res);
         const std::string what = "ndf-chunk " + std::to_string(r) + " of level " + std::to_string(level);
         const int ci = reader.find(format::kSectionNdfChunk, format::ndfChunkKey(uint32_t(level), uint64_t(r)));
-        if (ci < 0) return invalid("missing " + what);
+        if (ci < 0) return invalidPyramidInput("missing " + what);
         const size_t layers = size_t(chunk.width) * size_t(chunk.height);
         const size_t expected = sizeof(format::ImageSectionHeader) + layers * image_floats * sizeof(float);
-        if (reader.sections()[size_t(ci)].raw_size != expected) return invalid(what + ": wrong section size");
+        if (reader.sections()[size_t(ci)].raw_size != expected)
+          return invalidPyramidInput(what + ": wrong section size");
         try {
           chunk_buffer.resize(expected / sizeof(float));
         } catch (const std::bad_alloc&) {
@@ -205,11 +206,11 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
         std::memcpy(static_cast<void*>(&header), chunk_buffer.data(), sizeof(header));
         if (header.magic != format::ImageSectionHeader{}.magic || header.width != rec.ndf_res ||
             header.height != rec.ndf_res || header.channels != 1 || header.layers != layers) {
-          return invalid(what + ": image header disagrees with the level");
+          return invalidPyramidInput(what + ": image header disagrees with the level");
         }
         const float* images = chunk_buffer.data() + sizeof(header) / sizeof(float);
         for (size_t n = 0; n < layers * image_floats; ++n) {
-          if (!std::isfinite(images[n])) return invalid(what + ": non-finite NDF value");
+          if (!std::isfinite(images[n])) return invalidPyramidInput(what + ": non-finite NDF value");
         }
         chunk.images = images;
         chunk.section = chunk_buffer.data();
@@ -218,7 +219,7 @@ BakeStatus packTensorNdfFromPyramid(const format::Reader& reader, const TensorPa
       }
       if (BakeStatus s = sink.endLevel(level); !s) return s;
     }
-    if (level == 0) return invalid("the container has no ndf-level sections");
+    if (level == 0) return invalidPyramidInput("the container has no ndf-level sections");
     if (BakeStatus s = sink.finish(); !s) return s;
     if (BakeStatus s = assembler.finish(); !s) return s;
     rep.total_seconds = secondsSince(t0);

@@ -13,7 +13,7 @@
 namespace glintbake::bake::tensor {
 namespace {
 
-Error invalid(const std::string& message) { return makeError(ErrorCode::kInvalidInput, message); }
+Error invalidShard(const std::string& message) { return makeError(ErrorCode::kInvalidInput, message); }
 
 template <typename T>
 void append(std::vector<uint8_t>& out, const T* values, size_t count) {
@@ -122,7 +122,7 @@ BakeStatus TensorShardRecorder::finish() {
 
 BakeStatus replayTensorRegion(const uint8_t* data, size_t size, TensorRegionConsumer& consumer) {
   format::TensorShardRegionLayout layout;
-  if (const char* why = format::checkTensorShardRegion(data, size, &layout)) return invalid(why);
+  if (const char* why = format::checkTensorShardRegion(data, size, &layout)) return invalidShard(why);
   const format::TensorShardRegionRecord& r = layout.record;
   std::vector<double> image_sum(size_t(r.ndf_res) * r.ndf_res);
   std::memcpy(image_sum.data(), data + layout.image_sum, image_sum.size() * sizeof(double));

@@ -22,17 +22,17 @@
 namespace glintbake::format {
 namespace {
 
-std::string frozenPath(const char* name) { return std::string(GLINTBAKE_TEST_DATA_DIR) + "/" + name; }
+std::string frozenKindPath(const char* name) { return std::string(GLINTBAKE_TEST_DATA_DIR) + "/" + name; }
 
 // Opens a frozen file with every check on and expects a clean validation.
 void openFrozen(const char* name, AssetKind kind, Reader* reader) {
   ReaderOptions options;
   options.verify_file_checksum = true;
-  ASSERT_EQ(reader->open(frozenPath(name), options), ContainerStatus::kOk);
+  ASSERT_EQ(reader->open(frozenKindPath(name), options), ContainerStatus::kOk);
   EXPECT_EQ(reader->header().version_major, 1);
   EXPECT_EQ(reader->header().version_minor, 0);
   EXPECT_EQ(reader->kind(), kind);
-  const ValidationReport report = validateFile(frozenPath(name));
+  const ValidationReport report = validateFile(frozenKindPath(name));
   EXPECT_TRUE(report.valid());
   for (const ValidationMessage& m : report.messages) ADD_FAILURE() << m.id << ": " << m.message;
 }

@@ -15,7 +15,7 @@ namespace {
 
 using namespace glintbake::runtime;
 
-int32_t code(RuntimeStatus s) { return static_cast<int32_t>(s); }
+int32_t statusCode(RuntimeStatus s) { return static_cast<int32_t>(s); }
 
 Vec3 toVec(const double v[3]) { return Vec3{v[0], v[1], v[2]}; }
 Rgb toRgb(const double v[3]) { return Rgb{v[0], v[1], v[2]}; }
@@ -61,17 +61,17 @@ bool makeSg(const gb_sg* in, SphericalGaussian* out) {
 extern "C" {
 
 int32_t gb_brdf_ndf_open(const char* path, gb_brdf_ndf** out) {
-  if (out == nullptr) return code(RuntimeStatus::kInvalidArgument);
+  if (out == nullptr) return statusCode(RuntimeStatus::kInvalidArgument);
   *out = nullptr;
-  if (path == nullptr) return code(RuntimeStatus::kInvalidArgument);
+  if (path == nullptr) return statusCode(RuntimeStatus::kInvalidArgument);
   std::unique_ptr<NdfSource> source;
   const RuntimeStatus st = openNdfAsset(path, &source);
-  if (st != RuntimeStatus::kOk) return code(st);
+  if (st != RuntimeStatus::kOk) return statusCode(st);
   gb_brdf_ndf* ndf = new (std::nothrow) gb_brdf_ndf;
-  if (ndf == nullptr) return code(RuntimeStatus::kOutOfMemory);
+  if (ndf == nullptr) return statusCode(RuntimeStatus::kOutOfMemory);
   ndf->source = std::move(source);
   *out = ndf;
-  return code(RuntimeStatus::kOk);
+  return statusCode(RuntimeStatus::kOk);
 }
 
 void gb_brdf_ndf_close(gb_brdf_ndf* ndf) { delete ndf; }
@@ -79,51 +79,51 @@ void gb_brdf_ndf_close(gb_brdf_ndf* ndf) { delete ndf; }
 int32_t gb_brdf_eval(const gb_brdf_params* params, const double wi[3], const double wo[3], double f[3]) {
   MicrofacetBrdf brdf;
   if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || f == nullptr)
-    return code(RuntimeStatus::kInvalidArgument);
+    return statusCode(RuntimeStatus::kInvalidArgument);
   Rgb value;
   const RuntimeStatus st = brdf.eval(toVec(wi), toVec(wo), &value);
   if (st == RuntimeStatus::kOk) fromRgb(value, f);
-  return code(st);
+  return statusCode(st);
 }
 
 int32_t gb_brdf_sample(const gb_brdf_params* params, const double wo[3], double u1, double u2, double wi[3],
                        double* pdf, double weight[3]) {
   MicrofacetBrdf brdf;
   if (!makeBrdf(params, &brdf) || wo == nullptr || wi == nullptr || pdf == nullptr || weight == nullptr)
-    return code(RuntimeStatus::kInvalidArgument);
+    return statusCode(RuntimeStatus::kInvalidArgument);
   BrdfSample s;
   const RuntimeStatus st = brdf.sample(toVec(wo), u1, u2, &s);
-  if (st != RuntimeStatus::kOk) return code(st);
+  if (st != RuntimeStatus::kOk) return statusCode(st);
   wi[0] = s.wi.x;
   wi[1] = s.wi.y;
   wi[2] = s.wi.z;
   *pdf = s.pdf;
   fromRgb(s.weight, weight);
-  return code(RuntimeStatus::kOk);
+  return statusCode(RuntimeStatus::kOk);
 }
 
 int32_t gb_brdf_pdf(const gb_brdf_params* params, const double wi[3], const double wo[3], double* pdf) {
   MicrofacetBrdf brdf;
   if (!makeBrdf(params, &brdf) || wi == nullptr || wo == nullptr || pdf == nullptr)
-    return code(RuntimeStatus::kInvalidArgument);
-  return code(brdf.pdf(toVec(wi), toVec(wo), pdf));
+    return statusCode(RuntimeStatus::kInvalidArgument);
+  return statusCode(brdf.pdf(toVec(wi), toVec(wo), pdf));
 }
 
 int32_t gb_sg_support(const gb_sg* sg, double eps, double* cos_theta_max, int32_t* empty) {
   SphericalGaussian g;
   if (!makeSg(sg, &g) || !(eps > 0.0) || cos_theta_max == nullptr || empty == nullptr)
-    return code(RuntimeStatus::kInvalidArgument);
+    return statusCode(RuntimeStatus::kInvalidArgument);
   const SgSupport support = sgSupport(g, eps);
   *cos_theta_max = support.cos_theta_max;
   *empty = support.empty ? 1 : 0;
-  return code(RuntimeStatus::kOk);
+  return statusCode(RuntimeStatus::kOk);
 }
 
 int32_t gb_sg_integral(const gb_sg* sg, double integral[3]) {
   SphericalGaussian g;
-  if (!makeSg(sg, &g) || integral == nullptr) return code(RuntimeStatus::kInvalidArgument);
+  if (!makeSg(sg, &g) || integral == nullptr) return statusCode(RuntimeStatus::kInvalidArgument);
   fromRgb(sgIntegral(g), integral);
-  return code(RuntimeStatus::kOk);
+  return statusCode(RuntimeStatus::kOk);
 }
 
 int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg, double eps, const double wo[3],
@@ -131,11 +131,11 @@ int32_t gb_sg_prefiltered_shading(const gb_brdf_params* params, const gb_sg* sg,
   MicrofacetBrdf brdf;
   SphericalGaussian g;
   if (!makeBrdf(params, &brdf) || !makeSg(sg, &g) || wo == nullptr || radiance == nullptr)
-    return code(RuntimeStatus::kInvalidArgument);
+    return statusCode(RuntimeStatus::kInvalidArgument);
   Rgb value;
   const RuntimeStatus st = prefilteredSgShading(brdf, g, eps, toVec(wo), &value);
   if (st == RuntimeStatus::kOk) fromRgb(value, radiance);
-  return code(st);
+  return statusCode(st);
 }
 
 }  // extern "C"

@@ -12,9 +12,9 @@
 namespace glintbake::runtime {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kGlitterPi = 3.14159265358979323846;
 
-bool finitePoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
+bool finiteGlitterPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 
 // Reads one raw section into a caller buffer of exactly `size` bytes.
 RuntimeStatus readExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
@@ -122,13 +122,13 @@ double GlitterNdf::coneWeight(const format::GlitterGaussian& g, const SPoint& s)
 }
 
 RuntimeStatus GlitterNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!validFootprint(footprint) || !finitePoint(s) || !value) return RuntimeStatus::kInvalidArgument;
+  if (!validFootprint(footprint) || !finiteGlitterPoint(s) || !value) return RuntimeStatus::kInvalidArgument;
   const double r2 = s.x * s.x + s.y * s.y;
   if (!(r2 < 1.0)) {
     *value = 0.0;
     return RuntimeStatus::kOk;
   }
-  const double cone = 2.0 * kPi * (1.0 - std::cos(record_.gamma));
+  const double cone = 2.0 * kGlitterPi * (1.0 - std::cos(record_.gamma));
   *value = coneWeight(gaussian(footprint), s) / (double(record_.particles) * cone * std::sqrt(1.0 - r2));
   return RuntimeStatus::kOk;
 }
@@ -142,7 +142,7 @@ RuntimeStatus GlitterNdf::mass(const Footprint& footprint, double* value) const 
 }
 
 RuntimeStatus GlitterNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!validFootprint(footprint) || !finitePoint(s) || !value) return RuntimeStatus::kInvalidArgument;
+  if (!validFootprint(footprint) || !finiteGlitterPoint(s) || !value) return RuntimeStatus::kInvalidArgument;
   double m = 0.0, e = 0.0;
   mass(footprint, &m);
   if (!(m > 0.0)) {
@@ -166,7 +166,8 @@ RuntimeStatus GlitterNdf::sample(const Footprint& footprint, double u1, double u
   uint64_t bits1, bits2;
   std::memcpy(&bits1, &u1, 8);
   std::memcpy(&bits2, &u2, 8);
-  const double phi = 2.0 * kPi * format::glitterUniform(format::glitterMix(bits1 ^ format::glitterMix(bits2)), 0);
+  const double phi =
+      2.0 * kGlitterPi * format::glitterUniform(format::glitterMix(bits1 ^ format::glitterMix(bits2)), 0);
   const double ct = 1.0 - u2 * (1.0 - std::cos(record_.gamma));
   const format::GlitterVec3 h = format::glitterConeDirection(n, ct, phi);
   // The mirror image of a direction below the horizon has the same s.

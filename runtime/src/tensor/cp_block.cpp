@@ -226,7 +226,7 @@ void descendInto(Node& n, int child) {
   }
 }
 
-constexpr double kOneMinusEpsilon = 0x1.fffffffffffffp-1;
+constexpr double kLargestBelowOne = 0x1.fffffffffffffp-1;
 
 }  // namespace
 
@@ -259,8 +259,8 @@ bool CpMix::descend(int32_t component, double u1, double u2, CpBlockSample* out)
     p *= q[child];
     descendInto(n, child);
   }
-  u1 = u1 < kOneMinusEpsilon ? (u1 > 0.0 ? u1 : 0.0) : kOneMinusEpsilon;
-  u2 = u2 < kOneMinusEpsilon ? (u2 > 0.0 ? u2 : 0.0) : kOneMinusEpsilon;
+  u1 = u1 < kLargestBelowOne ? (u1 > 0.0 ? u1 : 0.0) : kLargestBelowOne;
+  u2 = u2 < kLargestBelowOne ? (u2 > 0.0 ? u2 : 0.0) : kLargestBelowOne;
   out->i = n.x0;
   out->j = n.y0;
   // float(i + u) can round up to i + 1 for large i: keep the point inside its bin.
@@ -316,7 +316,7 @@ bool CpMix::sample(double u1, double u2, CpBlockSample* out) const {
   }
   if (chosen == -2) return false;
   u1 = (target - before) / chosen_mass;
-  u1 = u1 < kOneMinusEpsilon ? (u1 > 0.0 ? u1 : 0.0) : kOneMinusEpsilon;
+  u1 = u1 < kLargestBelowOne ? (u1 > 0.0 ? u1 : 0.0) : kLargestBelowOne;
   if (!descend(chosen, u1, u2, out)) return false;
   out->pdf = mixturePdf(out->i, out->j);
   return true;

@@ -19,7 +19,7 @@ constexpr double kMaxPosition = 1e15;  // texels; beyond, cell and local coordin
 constexpr int kMaxTerms = 18;          // 3 x 3 tiles, on two paths in the hand-over band
 
 // Reads section (type, key 0) into a caller buffer of exactly `size` bytes.
-RuntimeStatus readExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
+RuntimeStatus readWangSection(const format::Reader& reader, uint32_t type, void* out, size_t size) {
   const int idx = reader.find(type, 0);
   if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
   return fromFormatStatus(reader.readSectionInto(size_t(idx), out, size));
@@ -129,7 +129,7 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
   std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
   if (!impl) return RuntimeStatus::kOutOfMemory;
   format::WangRecord& rec = impl->rec;
-  if (RuntimeStatus s = readExact(reader, format::kSectionWangInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
+  if (RuntimeStatus s = readWangSection(reader, format::kSectionWangInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
     return s;
   if (rec.magic == format::WangRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkWangRecord(rec)) return RuntimeStatus::kInvalidAsset;
@@ -145,11 +145,13 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
   impl->texels.reset(new (std::nothrow) float[texel_floats]);
   impl->assets.reset(new (std::nothrow) std::unique_ptr<NdfSource>[rec.tile_count]);
   if (!edges || !impl->code_to_tile || !impl->texels || !impl->assets) return RuntimeStatus::kOutOfMemory;
-  if (RuntimeStatus s = readExact(reader, format::kSectionWangEdges, edges.get(), edge_bytes); s != RuntimeStatus::kOk)
+  if (RuntimeStatus s = readWangSection(reader, format::kSectionWangEdges, edges.get(), edge_bytes);
+      s != RuntimeStatus::kOk)
     return s;
   if (format::checkWangEdges(rec, edges.get(), edge_bytes)) return RuntimeStatus::kInvalidAsset;
   std::memcpy(impl->code_to_tile.get(), edges.get(), size_t(rec.tile_count) * 4);
-  if (RuntimeStatus s = readExact(reader, format::kSectionWangTexels, impl->texels.get(), texel_floats * sizeof(float));
+  if (RuntimeStatus s =
+          readWangSection(reader, format::kSectionWangTexels, impl->texels.get(), texel_floats * sizeof(float));
       s != RuntimeStatus::kOk)
     return s;
   for (size_t i = 0; i < texel_floats; ++i) {

@@ -32,11 +32,11 @@ using runtime::LobeNdf;
 using runtime::RuntimeStatus;
 using runtime::SPoint;
 
-runtime::InterleavedTexels mapTexels(const bake::NormalMap& map) {
+runtime::InterleavedTexels lobeTexels(const bake::NormalMap& map) {
   return runtime::InterleavedTexels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(), 3);
 }
 
-bake::NormalMap mapOf(bake::MapKind kind, int size, uint64_t seed) {
+bake::NormalMap lobeMap(bake::MapKind kind, int size, uint64_t seed) {
   bake::MapParams p;
   p.size = size;
   p.seed = seed;
@@ -59,7 +59,7 @@ struct Pair {
   LobeNdf lobes;
   int res;
   Pair(bake::NormalMap m, int lobes_per_tile, int r = 64, int rate = 1) : map(std::move(m)), res(r) {
-    const auto texels = mapTexels(map);
+    const auto texels = lobeTexels(map);
     EXPECT_EQ(flakes.build(texels, rate, reference::kDefaultSigmaR, res), RuntimeStatus::kOk);
     EXPECT_EQ(lobes.build(texels, rate, reference::kDefaultSigmaR, lobes_per_tile, res), RuntimeStatus::kOk);
   }
@@ -75,7 +75,7 @@ TEST(LobeNdf, UnclusteredLevelIsTheExactFlakesButForTheWindow) {
   // 16 lobes per tile keep every flake of a 4 x 4 tile: the only difference to the exact path is
   // the 3-sigma window (about 1% of the mass).
   for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kScratches}) {
-    Pair p(mapOf(kind, 64, 5), 16);
+    Pair p(lobeMap(kind, 64, 5), 16);
     for (double sigma : {4.0, 7.0}) {
       ASSERT_EQ(p.lobes.tileFor(sigma), 4);
       const Footprint fp{21.3, 40.8, sigma};
@@ -93,7 +93,7 @@ TEST(LobeNdf, UnclusteredLevelIsTheExactFlakesButForTheWindow) {
 TEST(LobeNdf, ClusteredLevelsStayCloseToTheExactFlakes) {
   for (bake::MapKind kind :
        {bake::MapKind::kBeckmann, bake::MapKind::kFlakes, bake::MapKind::kBrushed, bake::MapKind::kScratches}) {
-    Pair p(mapOf(kind, 128, 8), 16);
+    Pair p(lobeMap(kind, 128, 8), 16);
     for (double sigma : {24.0}) {
       EXPECT_GT(p.lobes.tileFor(sigma), 4);
       const Footprint fp{70.2, 33.9, sigma};
@@ -121,15 +121,14 @@ TEST(LobeNdf, InnerTilesFromTheExactFlakesCountOnce) {
     bake::Wrap wrap;
     int rate;
   };
-  for (const Case& c : {Case{bake::MapKind::kBeckmann, bake::Wrap::kRepeat, 1},
-                        Case{bake::MapKind::kBeckmann, bake::Wrap::kClamp, 1},
-                        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 1},
-                        Case{bake::MapKind::kScratches, bake::Wrap::kClamp, 1},
-                        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 2}}) {
+  for (const Case& c :
+       {Case{bake::MapKind::kBeckmann, bake::Wrap::kRepeat, 1}, Case{bake::MapKind::kBeckmann, bake::Wrap::kClamp, 1},
+        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 1}, Case{bake::MapKind::kScratches, bake::Wrap::kClamp, 1},
+        Case{bake::MapKind::kScratches, bake::Wrap::kRepeat, 2}}) {
     const bake::MapKind kind = c.kind;
     const bake::Wrap wrap = c.wrap;
     {
-      bake::NormalMap map = mapOf(kind, 96 / c.rate, 31);
+      bake::NormalMap map = lobeMap(kind, 96 / c.rate, 31);
       map.wrap = wrap;
       Pair p(std::move(map), 16, 64, c.rate);
       const double r = c.rate;
@@ -157,8 +156,8 @@ TEST(LobeNdf, InnerTilesFromTheExactFlakesCountOnce) {
           double held = 0.0;
           for (float b : img) held += double(b) * (2.0 / 64) * (2.0 / 64);
           const std::string where = "kind " + std::to_string(int(kind)) + " wrap " + std::to_string(int(wrap)) +
-                                    " rate " + std::to_string(c.rate) + " sigma " + std::to_string(sigma) +
-                                    " x " + std::to_string(fp.x);
+                                    " rate " + std::to_string(c.rate) + " sigma " + std::to_string(sigma) + " x " +
+                                    std::to_string(fp.x);
           EXPECT_NEAR(integral / mass, 1.0, 2e-3) << where;
           EXPECT_NEAR(held / mass, 1.0, 2e-3) << where;
         }
@@ -169,7 +168,7 @@ TEST(LobeNdf, InnerTilesFromTheExactFlakesCountOnce) {
 
 TEST(LobeNdf, FlatMapIsTheIntrinsicGaussian) {
   const bake::NormalMap map = reference::testing::constantMap(64, 64, 0.1, -0.2);
-  const auto texels = mapTexels(map);
+  const auto texels = lobeTexels(map);
   LobeNdf ndf;
   ASSERT_EQ(ndf.build(texels, 1, reference::kDefaultSigmaR, 8, 64), RuntimeStatus::kOk);
   const double sr = reference::kDefaultSigmaR;
@@ -192,7 +191,7 @@ TEST(LobeNdf, FlatMapIsTheIntrinsicGaussian) {
 TEST(LobeNdf, RotatedMapRotatesTheNdf) {
   // Rotating the map by 90 degrees (texel (x, y) -> (h - 1 - y, x), normal (nx, ny) -> (-ny, nx))
   // rotates the NDF at the rotated footprint centre.
-  const bake::NormalMap map = mapOf(bake::MapKind::kBeckmann, 64, 13);
+  const bake::NormalMap map = lobeMap(bake::MapKind::kBeckmann, 64, 13);
   bake::NormalMap rot = map;
   for (int y = 0; y < map.height; ++y) {
     for (int x = 0; x < map.width; ++x) {
@@ -203,7 +202,7 @@ TEST(LobeNdf, RotatedMapRotatesTheNdf) {
       r[2] = n[2];
     }
   }
-  const auto ta = mapTexels(map), tb = mapTexels(rot);
+  const auto ta = lobeTexels(map), tb = lobeTexels(rot);
   LobeNdf a, b;
   ASSERT_EQ(a.build(ta, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
   ASSERT_EQ(b.build(tb, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
@@ -225,7 +224,7 @@ TEST(LobeNdf, RotatedMapRotatesTheNdf) {
 TEST(LobeNdf, SamplesFollowTheirPdf) {
   // 6: the exact flakes of level 0; 14: their inner tiles with coarser lobes farther out; 30: a
   // clustered level with coarser tiles far out.
-  Pair p(mapOf(bake::MapKind::kBeckmann, 128, 21), 16, 32);
+  Pair p(lobeMap(bake::MapKind::kBeckmann, 128, 21), 16, 32);
   for (double sigma : {6.0, 14.0, 30.0}) {
     const Footprint fp{40.5, 22.25, sigma};
     double mass = 0.0;
@@ -255,7 +254,7 @@ TEST(LobeNdf, SamplesFollowTheirPdf) {
 }
 
 TEST(LobeNdf, AverageIsTheMeanOfTheImageBins) {
-  Pair p(mapOf(bake::MapKind::kFlakes, 64, 3), 8, 32);
+  Pair p(lobeMap(bake::MapKind::kFlakes, 64, 3), 8, 32);
   const Footprint fp{30.0, 12.5, 9.0};
   std::vector<float> img(32 * 32);
   ASSERT_EQ(p.lobes.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
@@ -274,7 +273,7 @@ TEST(LobeNdf, AverageIsTheMeanOfTheImageBins) {
 // lobe, evaluated by the exact flakes' evaluator with the 3-sigma window) and on a clustered level.
 TEST(LobeNdf, EvalStaysCloseToTheExactFlakes) {
   for (bake::MapKind kind : {bake::MapKind::kBeckmann, bake::MapKind::kScratches, bake::MapKind::kFlakes}) {
-    Pair p(mapOf(kind, 128, 12), 16);
+    Pair p(lobeMap(kind, 128, 12), 16);
     for (double sigma : {6.0, 12.0, 24.0}) {
       const Footprint fp{50.7, 81.2, sigma};
       double num = 0.0, den = 0.0;
@@ -296,7 +295,7 @@ TEST(LobeNdf, EvalStaysCloseToTheExactFlakes) {
 
 // The AVX2 kernels (where the processor has them) and the portable ones give the same bits.
 TEST(LobeNdf, KernelsGiveTheSameBits) {
-  Pair p(mapOf(bake::MapKind::kBeckmann, 128, 13), 16);
+  Pair p(lobeMap(bake::MapKind::kBeckmann, 128, 13), 16);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> pos(0.0, 128.0), any(-0.6, 0.6);
   for (double sigma : {6.0, 14.0, 30.0}) {
@@ -316,8 +315,8 @@ TEST(LobeNdf, KernelsGiveTheSameBits) {
 
 // The reduction's merge costs run four wide under AVX2 and two wide otherwise: the same hierarchy.
 TEST(LobeNdf, BuildGivesTheSameBitsWithEitherKernel) {
-  const bake::NormalMap map = mapOf(bake::MapKind::kScratches, 128, 21);
-  const auto texels = mapTexels(map);
+  const bake::NormalMap map = lobeMap(bake::MapKind::kScratches, 128, 21);
+  const auto texels = lobeTexels(map);
   LobeNdf wide, portable;
   runtime::usePortableFlakeKernels(false);
   ASSERT_EQ(wide.build(texels, 1, reference::kDefaultSigmaR, 16, 64), RuntimeStatus::kOk);
@@ -336,8 +335,8 @@ TEST(LobeNdf, BuildGivesTheSameBitsWithEitherKernel) {
 }
 
 TEST(LobeNdf, DeterministicAndRejectsBadArguments) {
-  const bake::NormalMap map = mapOf(bake::MapKind::kScratches, 64, 4);
-  const auto texels = mapTexels(map);
+  const bake::NormalMap map = lobeMap(bake::MapKind::kScratches, 64, 4);
+  const auto texels = lobeTexels(map);
   LobeNdf a, b;
   ASSERT_EQ(a.build(texels, 1, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kOk);
   ASSERT_EQ(b.build(texels, 1, reference::kDefaultSigmaR, 8, 32), RuntimeStatus::kOk);

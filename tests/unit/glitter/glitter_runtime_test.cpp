@@ -24,7 +24,7 @@
 namespace glintbake {
 namespace {
 
-bake::glitter::GlitterParams params(uint64_t n, double alpha, double gamma = 0.06) {
+bake::glitter::GlitterParams assetParams(uint64_t n, double alpha, double gamma = 0.06) {
   bake::glitter::GlitterParams p;
   p.particles = n;
   p.alpha = alpha;
@@ -71,7 +71,7 @@ runtime::Footprint fp(double x, double y, double sigma) {
 }
 
 TEST(GlitterRuntime, OpensThroughOpenNdfAssetAndRefusesBadRecords) {
-  const auto bytes = glitterAsset(params(1000000, 0.3), "glitter_open.gbk");
+  const auto bytes = glitterAsset(assetParams(1000000, 0.3), "glitter_open.gbk");
   std::unique_ptr<runtime::NdfSource> src;
   ASSERT_EQ(runtime::openNdfAssetMemory(bytes.data(), bytes.size(), &src), runtime::RuntimeStatus::kOk);
   EXPECT_EQ(src->kind(), format::AssetKind::kGlitter);
@@ -96,7 +96,7 @@ TEST(GlitterRuntime, OpensThroughOpenNdfAssetAndRefusesBadRecords) {
 }
 
 TEST(GlitterRuntime, PdfIsEvalOverMassAndSamplesCarryTheirPdf) {
-  const auto bytes = glitterAsset(params(200000, 0.3), "glitter_pdf.gbk");
+  const auto bytes = glitterAsset(assetParams(200000, 0.3), "glitter_pdf.gbk");
   runtime::GlitterNdf g;
   ASSERT_EQ(g.openMemory(bytes.data(), bytes.size()), runtime::RuntimeStatus::kOk);
   const runtime::Footprint f = fp(40.0, 200.0, 3.0);
@@ -129,7 +129,7 @@ TEST(GlitterRuntime, PdfIsEvalOverMassAndSamplesCarryTheirPdf) {
 // from eval / mass integrated over each bin by a midpoint rule.
 TEST(GlitterRuntime, SamplerPassesChiSquare) {
   // Wide cones (0.2 rad) keep the midpoint rule of the expected counts accurate.
-  const auto bytes = glitterAsset(params(60000, 0.25, 0.2), "glitter_chi2.gbk");
+  const auto bytes = glitterAsset(assetParams(60000, 0.25, 0.2), "glitter_chi2.gbk");
   runtime::GlitterNdf g;
   ASSERT_EQ(g.openMemory(bytes.data(), bytes.size()), runtime::RuntimeStatus::kOk);
   const runtime::Footprint f = fp(100.0, 60.0, 1.5);  // about 50 facets under the footprint
@@ -158,7 +158,7 @@ TEST(GlitterRuntime, SamplerPassesChiSquare) {
 }
 
 TEST(GlitterPyramid, BakedPyramidIntegratesToOneAndSamples) {
-  bake::glitter::GlitterParams p = params(20000, 0.3);
+  bake::glitter::GlitterParams p = assetParams(20000, 0.3);
   p.map_width = p.map_height = 64;
   bake::glitter::GlitterModel model(p);
   bake::ndf::PyramidOptions opt;

@@ -15,7 +15,7 @@
 namespace glintbake::reference {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kBinImagePi = 3.14159265358979323846;
 
 // Probability of [a, b] under N(mean, sigma^2), written independently of the library.
 double axisMass(double a, double b, double mean, double sigma) {
@@ -54,7 +54,7 @@ TEST(ReferenceBinImage, RectangleIntegralOfACorrelatedGaussianMatchesBruteForce)
       brute += std::exp(-0.5 * (a * dx * dx - 2 * b * dx * dy + a * dy * dy) / det);
     }
   }
-  brute *= (x1 - x0) * (y1 - y0) / (n * double(n)) / (2 * kPi * std::sqrt(det));
+  brute *= (x1 - x0) * (y1 - y0) / (n * double(n)) / (2 * kBinImagePi * std::sqrt(det));
   EXPECT_NEAR(gaussianRectangleIntegral(mean, cov, x0, x1, y0, y1), brute, 2e-5 * brute);
   // The whole plane holds all the mass.
   EXPECT_NEAR(gaussianRectangleIntegral(mean, cov, -10, 10, -10, 10), 1.0, 1e-12);
@@ -89,8 +89,8 @@ TEST(ReferenceBinImage, FlatMapGivesBinAveragedIntrinsicGaussian) {
 
 TEST(ReferenceBinImage, WrappedMapImagesIntegrateToOne) {
   const FlakeSet set = buildFlakes(testing::wavyMap(32, 24, 0.25));
-  const Footprint footprints[] = {{0.2, 0.4, 1.0}, {16.0, 12.0, 2.0}, {31.7, 3.3, 4.0}, {7.5, 23.9, 8.0},
-                                  {20.0, 5.0, 16.0}};
+  const Footprint footprints[] = {
+      {0.2, 0.4, 1.0}, {16.0, 12.0, 2.0}, {31.7, 3.3, 4.0}, {7.5, 23.9, 8.0}, {20.0, 5.0, 16.0}};
   for (const Footprint& fp : footprints) {
     // Coarser bins for the widest footprint keep the test short (the cost grows with the number of
     // bins every lobe reaches).

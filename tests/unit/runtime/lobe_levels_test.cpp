@@ -49,21 +49,21 @@ std::vector<double> queries(const LobeNdf& lobes, int seed, int map) {
 }
 
 TEST(LobeLevels, ConcurrentFirstQueriesMatchLevelsGroupedUpFront) {
-  constexpr int kMap = 128, kThreads = 4;
-  const std::vector<float> normals = bumpyNormals(kMap);
-  const InterleavedTexels texels(kMap, kMap, true, normals.data(), 2);
+  constexpr int kMapSide = 128, kThreads = 4;
+  const std::vector<float> normals = bumpyNormals(kMapSide);
+  const InterleavedTexels texels(kMapSide, kMapSide, true, normals.data(), 2);
   LobeNdf eager, lazy;
   ASSERT_EQ(eager.build(texels, 1, 0.005, 8, 32), RuntimeStatus::kOk);
   eager.prepare();
   ASSERT_EQ(lazy.build(texels, 1, 0.005, 8, 32), RuntimeStatus::kOk);
   std::vector<std::vector<double>> serial(kThreads), threaded(kThreads);
-  for (int t = 0; t < kThreads; ++t) serial[size_t(t)] = queries(eager, t, kMap);
+  for (int t = 0; t < kThreads; ++t) serial[size_t(t)] = queries(eager, t, kMapSide);
   std::vector<std::thread> threads;
-  for (int t = 0; t < kThreads; ++t) threads.emplace_back([&, t] { threaded[size_t(t)] = queries(lazy, t, kMap); });
+  for (int t = 0; t < kThreads; ++t) threads.emplace_back([&, t] { threaded[size_t(t)] = queries(lazy, t, kMapSide); });
   for (auto& thread : threads) thread.join();
   for (int t = 0; t < kThreads; ++t) EXPECT_EQ(serial[size_t(t)], threaded[size_t(t)]) << "thread " << t;
   lazy.prepare();  // built already: a no-op that changes nothing
-  EXPECT_EQ(queries(lazy, 0, kMap), serial[0]);
+  EXPECT_EQ(queries(lazy, 0, kMapSide), serial[0]);
 }
 
 }  // namespace

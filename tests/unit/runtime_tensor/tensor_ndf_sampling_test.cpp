@@ -14,7 +14,7 @@
 namespace glintbake::runtime::testing {
 namespace {
 
-Footprint footprint(double x, double y, double sigma) {
+Footprint footprintAt(double x, double y, double sigma) {
   Footprint f;
   f.x = x;
   f.y = y;
@@ -60,7 +60,7 @@ std::vector<double> pdfImage(const TensorNdf& t, const Footprint& fp) {
 
 TEST(TensorNdfSampling, ChiSquareAgainstPdf) {
   for (const TensorNdf* t : {&assets().nonneg, &assets().plain, &assets().exact}) {
-    for (const Footprint& fp : {footprint(20, 30, 6), footprint(61, 2, 10), footprint(40, 40, 40)}) {
+    for (const Footprint& fp : {footprintAt(20, 30, 6), footprintAt(61, 2, 10), footprintAt(40, 40, 40)}) {
       const std::vector<Point> pts = drawChecked(*t, fp, 100000, 41);
       // pdf() integrates to 1: the chi-square total mass is 1.
       const stats::ChiSquareResult r = stats::chiSquareNdfTest(pts, pdfImage(*t, fp), t->resolution(), 1.0);
@@ -72,14 +72,15 @@ TEST(TensorNdfSampling, ChiSquareAgainstPdf) {
 TEST(TensorNdfSampling, ChiSquareDetectsAWrongDensity) {
   // Power check: the same samples against the pdf of another footprint must fail.
   const TensorNdf& t = assets().nonneg;
-  const std::vector<Point> pts = drawChecked(t, footprint(20, 30, 6), 100000, 43);
-  const stats::ChiSquareResult r = stats::chiSquareNdfTest(pts, pdfImage(t, footprint(52, 12, 6)), t.resolution(), 1.0);
+  const std::vector<Point> pts = drawChecked(t, footprintAt(20, 30, 6), 100000, 43);
+  const stats::ChiSquareResult r =
+      stats::chiSquareNdfTest(pts, pdfImage(t, footprintAt(52, 12, 6)), t.resolution(), 1.0);
   EXPECT_LT(r.p_value, 1e-6) << r.message;
 }
 
 TEST(TensorNdfSampling, MillionSampleHistogramMatchesEvalImage) {
   const TensorNdf& t = assets().nonneg;
-  const Footprint fp = footprint(33, 17, 8);
+  const Footprint fp = footprintAt(33, 17, 8);
   const int res = t.resolution();
   std::vector<float> img(size_t(res) * res);
   ASSERT_EQ(t.image(fp, img.data(), img.size()), RuntimeStatus::kOk);
