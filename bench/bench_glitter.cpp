@@ -5,6 +5,7 @@
 // The hierarchy's cost should grow with log N; enumeration's grows with N.
 #include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/format/kinds/glitter_model.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/glitter.h>
 
 #include <benchmark/benchmark.h>
@@ -17,7 +18,7 @@ namespace {
 namespace glitter = glintbake::bake::glitter;
 namespace format = glintbake::format;
 
-constexpr double kPi = 3.14159265358979323846;
+using glintbake::kPi;
 constexpr double kGamma = kPi / 180.0;
 
 const glitter::GlitterModel& model(uint64_t n) {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <glintbake/bake/glitter/glitter.h>
+#include <glintbake/format/numbers.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +12,6 @@ namespace glintbake::bake::glitter {
 namespace {
 
 using format::GlitterVec3;
-
-constexpr double kPi = 3.14159265358979323846;
 
 BakeStatus bad(const std::string& message) { return makeError(ErrorCode::kBadArgument, message); }
 

@@ -4,6 +4,8 @@
 #include "mapgen/generators.h"
 #include "mapgen/random.h"
 
+#include <glintbake/format/numbers.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -24,7 +26,6 @@ NormalMap flakes(const MapParams& params, double cell) {
   const int n = params.size;
   const double nd = double(n);
   const int64_t site_count = std::max<int64_t>(1, std::llround(nd * nd / (cell * cell)));
-  constexpr double kPi = 3.14159265358979323846;
   const double cos_cone = std::cos(params.cone_degrees * kPi / 180.0);
 
   std::vector<double> site_x(static_cast<size_t>(site_count)), site_y(static_cast<size_t>(site_count));

@@ -4,6 +4,8 @@
 // library (std::normal_distribution differs between implementations; this does not).
 #pragma once
 
+#include <glintbake/format/numbers.h>
+
 #include <cmath>
 #include <cstdint>
 
@@ -38,7 +40,6 @@ inline double uniform01(uint64_t seed, uint64_t stream, uint64_t index, uint64_t
 
 // Standard normal by the Box-Muller transform (one of the pair; draws 2k and 2k+1 are consumed).
 inline double gaussian(uint64_t seed, uint64_t stream, uint64_t index, uint64_t k = 0) {
-  constexpr double kTwoPi = 6.283185307179586476925;
   const double u1 = 1.0 - uniform01(seed, stream, index, 2 * k);  // (0, 1]: log is finite
   const double u2 = uniform01(seed, stream, index, 2 * k + 1);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);

@@ -4,6 +4,8 @@
 #include "mapgen/generators.h"
 #include "mapgen/random.h"
 
+#include <glintbake/format/numbers.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -36,7 +38,6 @@ NormalMap scratches(const MapParams& params) {
 
   // Height gradient in image coordinates (d/dx right, d/drow down), summed over grooves.
   std::vector<double> grad_x(texels, 0.0), grad_row(texels, 0.0);
-  constexpr double kPi = 3.14159265358979323846;
   const double inv_samples = 1.0 / double(kSubSamples * kSubSamples);
 
   // Serial in segment order: overlapping grooves add, and the order of additions is fixed.

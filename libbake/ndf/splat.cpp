@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <glintbake/bake/ndf/splat.h>
+#include <glintbake/format/numbers.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,6 @@ namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
 constexpr double kInvSqrt2Pi = 0.39894228040143267794;
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxSubIntervals = 16;
 
 // Lobes whose smallest std is at least this many bins are point-evaluated (see splatWideLobe).

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/glitter.h>
 
 #include <cmath>
@@ -56,7 +57,6 @@ uint64_t countGlitterFacets(const std::vector<GlitterFacet>& facets, const forma
 
 double smoothGlitterCone(format::GlitterDistribution distribution, double alpha, const format::GlitterVec3& axis,
                          double gamma) {
-  constexpr double kPi = 3.14159265358979323846;
   constexpr int kTheta = 64, kPhi = 128;
   double sum = 0.0;
   for (int i = 0; i < kTheta; ++i) {

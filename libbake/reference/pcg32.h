@@ -4,6 +4,8 @@
 // portable uniform and normal variates built on it. Same sequence on every platform.
 #pragma once
 
+#include <glintbake/format/numbers.h>
+
 #include <cmath>
 #include <cstdint>
 
@@ -38,7 +40,7 @@ class Pcg32 {
     const double u1 = 1.0 - uniform();  // (0, 1]: log is finite
     const double u2 = uniform();
     const double r = std::sqrt(-2.0 * std::log(u1));
-    const double theta = 6.283185307179586476925286766559 * u2;
+    const double theta = kTwoPi * u2;
     *z0 = r * std::cos(theta);
     *z1 = r * std::sin(theta);
   }

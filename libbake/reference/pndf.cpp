@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The per-flake closed form and the point evaluation of the reference P-NDF (see pndf.h).
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 
 #include "footprint_flakes.h"
@@ -9,9 +10,7 @@
 #include <cmath>
 
 namespace glintbake::reference {
-namespace {
-constexpr double kTwoPi = 6.283185307179586476925286766559;
-}  // namespace
+namespace {}  // namespace
 
 FlakeLobe flakeLobe(const FlakeSet& set, const Flake& flake, double ux, double uy, const Footprint& fp,
                     double sigma_r) {

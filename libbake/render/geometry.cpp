@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // Camera rays, object intersection and pixel footprints.
 #include <glintbake/bake/render/geometry.h>
+#include <glintbake/format/numbers.h>
 
 #include <cmath>
 
 namespace glintbake::bake::render {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinT = 1e-9;
 
 Vec3 toVec(const Vec3d& v) { return Vec3{v[0], v[1], v[2]}; }

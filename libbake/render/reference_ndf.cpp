@@ -2,6 +2,8 @@
 // The reference P-NDF of one footprint as an NdfSource.
 #include "reference_ndf.h"
 
+#include <glintbake/format/numbers.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -71,7 +73,7 @@ RuntimeStatus ReferencePndf::sample(const runtime::Footprint&, double u1, double
   v1 = std::min(std::max(v1, 1e-300), 1.0 - 1e-16);
   // Box-Muller: two independent normals from (v1, u2).
   const double r = std::sqrt(-2.0 * std::log1p(-v1));
-  const double phi = 2.0 * 3.14159265358979323846 * u2;
+  const double phi = kTwoPi * u2;
   const double z0 = r * std::cos(phi), z1 = r * std::sin(phi);
   // s = mean + L z with L the lower Cholesky factor of the lobe's covariance.
   const reference::FlakeLobe& l = lobes_[k];

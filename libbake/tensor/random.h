@@ -3,6 +3,8 @@
 // range finder): SplitMix64 (Steele et al. 2014), identical on every platform.
 #pragma once
 
+#include <glintbake/format/numbers.h>
+
 #include <cmath>
 #include <cstdint>
 
@@ -27,7 +29,7 @@ class SplitMix64 {
   double normal() {
     const double u1 = 1.0 - uniform();  // (0, 1]
     const double u2 = uniform();
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
   }
 
  private:

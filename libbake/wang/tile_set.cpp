@@ -2,6 +2,7 @@
 // The Wang tile set of an exemplar: edge samples, the four-triangle assembly with minimum-error
 // cuts along the diagonals, and the exact outer rings (see wang/wang.h).
 #include <glintbake/bake/wang/wang.h>
+#include <glintbake/format/numbers.h>
 
 #include <tbb/parallel_for.h>
 
@@ -71,7 +72,7 @@ struct Assembler {
 
 double angleDegrees(const float* a, const float* b) {
   const double d = double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2];
-  return std::acos(std::clamp(d, -1.0, 1.0)) * (180.0 / 3.14159265358979323846);
+  return std::acos(std::clamp(d, -1.0, 1.0)) * (180.0 / kPi);
 }
 
 // The straight cut: the nearest edge of the texel's centre (ties in the order N, E, S, W).
@@ -196,7 +197,8 @@ NormalMap WangTileSet::tile(int t) const {
   m.width = m.height = tile_size;
   m.wrap = Wrap::kClamp;
   const size_t n = size_t(tile_size) * size_t(tile_size) * 3;
-  m.normals.assign(normals.begin() + std::ptrdiff_t(size_t(t) * n), normals.begin() + std::ptrdiff_t(size_t(t + 1) * n));
+  m.normals.assign(normals.begin() + std::ptrdiff_t(size_t(t) * n),
+                   normals.begin() + std::ptrdiff_t(size_t(t + 1) * n));
   return m;
 }
 
@@ -274,7 +276,8 @@ NormalMap wangAtlas(const WangTileSet& set) {
   m.normals.assign(size_t(m.width) * size_t(m.height) * 3, 0.0f);
   for (size_t i = 2; i < m.normals.size(); i += 3) m.normals[i] = 1.0f;
   for (int t = 0; t < set.tile_count; ++t) {
-    for (int y = 0; y < T; ++y) std::copy_n(set.texel(t, 0, y), size_t(T) * 3, m.at((t % cols) * T, (t / cols) * T + y));
+    for (int y = 0; y < T; ++y)
+      std::copy_n(set.texel(t, 0, y), size_t(T) * 3, m.at((t % cols) * T, (t / cols) * T + y));
   }
   return m;
 }

@@ -7,6 +7,7 @@
 #include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/format/kinds/glitter_model.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/glitter.h>
 
 #include <chrono>
@@ -16,7 +17,6 @@
 namespace glintbake::glintref {
 namespace {
 
-constexpr double kGlitterPi = 3.14159265358979323846;
 constexpr uint64_t kMaxEnumerated = 20000000;
 
 }  // namespace
@@ -52,7 +52,7 @@ int runGlitter(cli::Tool& tool, GlitterOptions& o) {
   p.alpha = o.alpha;
   p.seed = o.seed;
   p.max_depth = o.max_depth;
-  p.gamma = o.gamma_deg * kGlitterPi / 180.0;
+  p.gamma = o.gamma_deg * kPi / 180.0;
   if (o.distribution == "beckmann") {
     p.distribution = format::GlitterDistribution::kBeckmann;
   } else if (o.distribution == "ggx") {
@@ -70,7 +70,7 @@ int runGlitter(cli::Tool& tool, GlitterOptions& o) {
   const format::GlitterUvRegion uv = format::GlitterUvRegion::box(u, v, o.extent, o.extent);
   const format::GlitterVec3 axis{sx, sy, std::sqrt(1.0 - sx * sx - sy * sy)};
   const format::GlitterDirRegion cone = format::GlitterDirRegion::cone(axis, p.gamma);
-  const double cone_sr = 2.0 * kGlitterPi * (1.0 - std::cos(p.gamma));
+  const double cone_sr = 2.0 * kPi * (1.0 - std::cos(p.gamma));
   // The paper's rule with this query's own size.
   const format::GlitterTreeShape shape{uv.area, cone_sr};
   format::GlitterCountOptions copt;

@@ -3,6 +3,7 @@
 #include "query.h"
 
 #include <glintbake/cli/ingest_options.h>
+#include <glintbake/format/numbers.h>
 
 #include <cerrno>
 #include <cmath>
@@ -11,8 +12,6 @@
 
 namespace glintbake::glintref {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string formatNumber(double v) {
   std::ostringstream out;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Checks of the glitter records (see kinds/glitter.h).
 #include <glintbake/format/kinds/glitter.h>
+#include <glintbake/format/numbers.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +19,6 @@ const char* glitterDistributionString(GlitterDistribution d) {
 }
 
 const char* checkGlitterRecord(const GlitterRecord& r) {
-  constexpr double kTwoPi = 6.283185307179586;
   if (r.magic != GlitterRecord().magic) return "glitter record: bad magic";
   if (r.version != 1) return "glitter record: unsupported version";
   if (r.distribution > uint32_t(GlitterDistribution::kGgx)) return "glitter record: unknown distribution";

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The discrete stochastic microfacet surface of glitter assets (see kinds/glitter_model.h).
 #include <glintbake/format/kinds/glitter_model.h>
+#include <glintbake/format/numbers.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 namespace glintbake::format {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kExactDraws = 8;         // categorical draws per facet below this count
 constexpr double kFootprintReach = 4;  // Gaussian footprints are cut at this many std
 enum Overlap { kDisjoint = 0, kInside = 1, kPartial = 2 };

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Checks and placement rules of the tiny-example records (see kinds/tiny_example.h).
 #include <glintbake/format/kinds/tiny_example.h>
+#include <glintbake/format/numbers.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,6 @@
 namespace glintbake::format {
 namespace {
 
-constexpr double kHalfTurn = 3.14159265358979323846;
 constexpr int kRangeSamples = 720;  // rotations tried per range when bounding the example's extent
 
 bool finite(double v) { return std::isfinite(v); }
@@ -39,7 +39,7 @@ void multiply(const double a[4], const double b[4], double out[4]) {
 // M = R(theta) H(shear) scale S, with R a counter-clockwise rotation as the image is seen
 // (positions have y down) and S the record's shared matrix.
 void exampleMatrix(const TinyExampleRecord& r, double degrees, double scale, double out[4]) {
-  const double t = degrees * kHalfTurn / 180.0;
+  const double t = degrees * kPi / 180.0;
   const double c = std::cos(t), s = std::sin(t);
   const double rot[4] = {c, s, -s, c};
   const double shear[4] = {scale, scale * r.shear[0], scale * r.shear[1], scale};
@@ -150,7 +150,7 @@ double tinyMinCellSize(const TinyExampleRecord& r) {
     if (r.rotate_range[0] == r.rotate_range[1]) break;
   }
   // Rotations between the samples: the extent's slope is at most |M| n / 2 per radian.
-  const double step = (r.rotate_range[1] - r.rotate_range[0]) * kHalfTurn / 180.0 / kRangeSamples;
+  const double step = (r.rotate_range[1] - r.rotate_range[0]) * kPi / 180.0 / kRangeSamples;
   return 2.0 * ext * (1.0 + 2.0 * step);
 }
 

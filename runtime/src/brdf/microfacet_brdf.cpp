@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Analytic microfacet distributions, Smith shadowing, Fresnel and the P-NDF microfacet BRDF.
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/brdf.h>
 
 #include <cmath>
@@ -7,8 +8,6 @@
 
 namespace glintbake::runtime {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

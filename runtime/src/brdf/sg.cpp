@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Spherical Gaussian lights: evaluation, integral, support, half-vector range and prefiltering.
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/sg.h>
 
 #include <cmath>
@@ -7,7 +8,6 @@
 namespace glintbake::runtime {
 namespace {
 
-constexpr double kSgPi = 3.14159265358979323846;
 constexpr int kBoundaryPoints = 64;
 
 bool finiteVector(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -40,7 +40,7 @@ Rgb evalSg(const SphericalGaussian& sg, const Vec3& v) {
 }
 
 Rgb sgIntegral(const SphericalGaussian& sg) {
-  const double k = 2.0 * kSgPi * oneMinusExp2(sg.sharpness) / sg.sharpness;
+  const double k = 2.0 * kPi * oneMinusExp2(sg.sharpness) / sg.sharpness;
   return {sg.amplitude.r * k, sg.amplitude.g * k, sg.amplitude.b * k};
 }
 
@@ -79,7 +79,7 @@ RuntimeStatus sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Ve
   double gap = 0.0;
   double prev_x = 0.0, prev_y = 0.0;
   for (int i = 0; i <= kBoundaryPoints; ++i) {
-    const double phi = 2.0 * kSgPi * double(i % kBoundaryPoints) / kBoundaryPoints;
+    const double phi = 2.0 * kPi * double(i % kBoundaryPoints) / kBoundaryPoints;
     const Vec3 wi = cos_max * sg.axis + sin_max * (std::cos(phi) * t + std::sin(phi) * b);
     const Vec3 h = normalize(wi + wo);
     x0 = std::fmin(x0, h.x);
@@ -168,7 +168,7 @@ Vec3 sampleSg(const SphericalGaussian& sg, double u1, double u2, double* pdf) {
   double cos_theta = 1.0 + std::log1p(-u1 * oneMinusExp2(lambda)) / lambda;
   cos_theta = std::fmin(1.0, std::fmax(-1.0, cos_theta));
   const double sin_theta = std::sqrt(std::fmax(0.0, 1.0 - cos_theta * cos_theta));
-  const double phi = 2.0 * kSgPi * u2;
+  const double phi = 2.0 * kPi * u2;
   Vec3 t, b;
   basis(sg.axis, &t, &b);
   const Vec3 v = normalize(cos_theta * sg.axis + sin_theta * (std::cos(phi) * t + std::sin(phi) * b));
@@ -178,7 +178,7 @@ Vec3 sampleSg(const SphericalGaussian& sg, double u1, double u2, double* pdf) {
 
 double sgPdf(const SphericalGaussian& sg, const Vec3& v) {
   const double lambda = sg.sharpness;
-  return lambda * std::exp(lambda * (dot(sg.axis, v) - 1.0)) / (2.0 * kSgPi * oneMinusExp2(lambda));
+  return lambda * std::exp(lambda * (dot(sg.axis, v) - 1.0)) / (2.0 * kPi * oneMinusExp2(lambda));
 }
 
 }  // namespace glintbake::runtime

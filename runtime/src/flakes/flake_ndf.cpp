@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The exact small-footprint P-NDF from a normal map's flakes (see flake_ndf.h).
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/flake_ndf.h>
 
 #include "../heap_array.h"
@@ -18,7 +19,6 @@
 namespace glintbake::runtime {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kTile = flakes::kTileFlakes;            // flakes per side of a tile of the hierarchy
 constexpr int kLeafFlakes = 8;                        // flakes per leaf of a tile's k-d tree (one block)
 constexpr int kLeaves = kTile * kTile / kLeafFlakes;  // leaves of a full tile

@@ -4,6 +4,8 @@
 // 8-point Gauss-Legendre in y on panels no wider than the scale on which the integrand changes.
 #pragma once
 
+#include <glintbake/format/numbers.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -20,8 +22,8 @@ struct Lobe {
 // the covariance (how every flake and lobe path samples a lobe it has picked).
 inline void lobePoint(const Lobe& g, double v1, double v2, double* x, double* y) {
   const double radius = std::sqrt(-2.0 * std::log1p(-v1));
-  const double z0 = radius * std::cos(6.283185307179586476925286766559 * v2);
-  const double z1 = radius * std::sin(6.283185307179586476925286766559 * v2);
+  const double z0 = radius * std::cos(kTwoPi * v2);
+  const double z1 = radius * std::sin(kTwoPi * v2);
   const double l11 = std::sqrt(g.cxx), l21 = g.cxy / l11;
   const double l22 = std::sqrt(std::max(g.cyy - l21 * l21, 0.0));
   *x = g.mx + l11 * z0;

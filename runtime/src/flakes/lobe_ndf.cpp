@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Clustered position-normal lobes for mid-size footprints (see lobe_ndf.h).
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/lobe_ndf.h>
 
 #include "../heap_array.h"
@@ -28,9 +29,8 @@ namespace {
 #define GLINTBAKE_LOBE_INLINE inline
 #endif
 
-constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr int kLanes = kMaxLobesPerTile;
-constexpr int kFinestTile = 4;       // flakes per side of a level-0 tile
+constexpr int kFinestTile = 4;  // flakes per side of a level-0 tile
 static_assert(2 * kFinestTile == flakes::kTileFlakes, "level 1's tiles are the exact flakes' tiles");
 constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
 // Where the footprint weight is low the clustered levels take coarser tiles: a tile k levels above
@@ -357,7 +357,7 @@ struct Terms {
   // the lobes' traversal (eval, mass, sample); average and image walk them as level-0 lobes.
   bool inner_exact, skip_inner;
   flakes::TileCut inner_cut;
-  double tile_texels;    // tile side of the finest level
+  double tile_texels;  // tile side of the finest level
   double reach;
 };
 

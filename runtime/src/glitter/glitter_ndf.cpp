@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <glintbake/format/kinds/glitter.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/glitter_ndf.h>
 #include "../format_status.h"
 
@@ -11,8 +12,6 @@
 
 namespace glintbake::runtime {
 namespace {
-
-constexpr double kGlitterPi = 3.14159265358979323846;
 
 bool finiteGlitterPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 
@@ -128,7 +127,7 @@ RuntimeStatus GlitterNdf::eval(const Footprint& footprint, const SPoint& s, doub
     *value = 0.0;
     return RuntimeStatus::kOk;
   }
-  const double cone = 2.0 * kGlitterPi * (1.0 - std::cos(record_.gamma));
+  const double cone = 2.0 * kPi * (1.0 - std::cos(record_.gamma));
   *value = coneWeight(gaussian(footprint), s) / (double(record_.particles) * cone * std::sqrt(1.0 - r2));
   return RuntimeStatus::kOk;
 }
@@ -166,8 +165,7 @@ RuntimeStatus GlitterNdf::sample(const Footprint& footprint, double u1, double u
   uint64_t bits1, bits2;
   std::memcpy(&bits1, &u1, 8);
   std::memcpy(&bits2, &u2, 8);
-  const double phi =
-      2.0 * kGlitterPi * format::glitterUniform(format::glitterMix(bits1 ^ format::glitterMix(bits2)), 0);
+  const double phi = 2.0 * kPi * format::glitterUniform(format::glitterMix(bits1 ^ format::glitterMix(bits2)), 0);
   const double ct = 1.0 - u2 * (1.0 - std::cos(record_.gamma));
   const format::GlitterVec3 h = format::glitterConeDirection(n, ct, phi);
   // The mirror image of a direction below the horizon has the same s.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Runtime-lite LTC polygon integration: transform, clip to the horizon, integrate edge by edge.
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/ltc.h>
 
 #include <algorithm>
@@ -9,7 +10,6 @@ namespace glintbake::runtime {
 
 namespace {
 
-constexpr double kTwoPi = 6.28318530717958647692;
 // Clipping a polygon against a plane emits at most two vertices per input edge.
 constexpr int kClipBuffer = 2 * kLtcMaxPolygonVertices;
 

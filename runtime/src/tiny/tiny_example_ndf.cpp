@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tiny-example assets (formats/SPEC.md 10.8): loading, the tile images, the traversal of the
 // examples a footprint reaches and the NdfSource queries over the tiles it keeps.
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/tiny_example_ndf.h>
 
 #include <glintbake/format/binary16.h>
@@ -1085,7 +1086,7 @@ bool TinyExampleNdf::planeFlakes(const Footprint& fp, F&& lobe) const {
   for (int y = 0; y < win.h; ++y)
     for (int x = 0; x < win.w; ++x) plane.texel(x, y, win.t + (size_t(y) * win.w + x) * 2);
   const double c = h2 / v, spread = sp2 * c, r2 = record_.sigma_r * record_.sigma_r;
-  const double norm = 1.0 / (2.0 * 3.14159265358979323846 * v);
+  const double norm = 1.0 / (kTwoPi * v);
   for (int64_t y = fy0; y <= fy1; ++y) {
     const double dy = fp.y - (double(y) + 0.5);
     for (int64_t x = fx0; x <= fx1; ++x) {
@@ -1113,7 +1114,7 @@ double lobeDensity(const flakes::Lobe& g, double sx, double sy) {
   const double det = g.cxx * g.cyy - g.cxy * g.cxy;
   const double dx = sx - g.mx, dy = sy - g.my;
   const double q = (g.cyy * dx * dx - 2.0 * g.cxy * dx * dy + g.cxx * dy * dy) / det;
-  return std::exp(-0.5 * q) / (2.0 * 3.14159265358979323846 * std::sqrt(det));
+  return std::exp(-0.5 * q) / (kTwoPi * std::sqrt(det));
 }
 
 }  // namespace
@@ -1182,7 +1183,7 @@ RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double total, dou
     acc += w;
   });
   rest = std::clamp(rest, 0.0, 0.99999999999999989);
-  const double radius = std::sqrt(-2.0 * std::log1p(-rest)), phi = 2.0 * 3.14159265358979323846 * u2;
+  const double radius = std::sqrt(-2.0 * std::log1p(-rest)), phi = kTwoPi * u2;
   const double z0 = radius * std::cos(phi), z1 = radius * std::sin(phi);
   const double l00 = std::sqrt(chosen.cxx), l10 = chosen.cxy / l00;
   const double l11 = std::sqrt(std::max(chosen.cyy - l10 * l10, 0.0));

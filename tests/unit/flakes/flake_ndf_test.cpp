@@ -2,6 +2,7 @@
 // FlakeNdf (runtime) against the reference evaluator: eval, image, mass and average equal the
 // reference to float rounding; samples follow their pdf (chi-square) and pdf == eval / mass.
 #include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 
@@ -163,7 +164,7 @@ TEST(FlakeNdf, FlatMapIsTheIntrinsicGaussianAndIntegratesToOne) {
       ASSERT_EQ(f.ndf.eval(fp, s, &v), RuntimeStatus::kOk);
       v /= mass;
       const double d2 = (s.x - nx) * (s.x - nx) + (s.y - ny) * (s.y - ny);
-      const double expected = std::exp(-d2 / (2 * sr * sr)) / (2 * M_PI * sr * sr);
+      const double expected = std::exp(-d2 / (2 * sr * sr)) / (kTwoPi * sr * sr);
       EXPECT_NEAR(v, expected, 1e-5 * expected + 1e-9);
     }
   }

@@ -7,6 +7,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
@@ -156,7 +157,7 @@ TEST(Handover, FlakesLobesAndPyramidBlendConsistently) {
 double bandReference(const reference::FlakeSet& set, const Footprint& fp, SPoint s, double window = 4.0) {
   const reference::Footprint rfp{fp.x, fp.y, fp.sigma};
   const double v = set.sigma_h * set.sigma_h + fp.sigma * fp.sigma;
-  const double peak = set.area / (2.0 * M_PI * v), cut = window * window / 2.0;
+  const double peak = set.area / (kTwoPi * v), cut = window * window / 2.0;
   double sum = 0.0;
   for (const reference::FlakeLobe& lobe : reference::footprintLobes(set, rfp, reference::kDefaultSigmaR)) {
     if (std::log(peak / lobe.weight) <= cut) sum += reference::lobeDensity(lobe, s.x, s.y);

@@ -7,6 +7,7 @@
 #include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
@@ -182,7 +183,7 @@ TEST(LobeNdf, FlatMapIsTheIntrinsicGaussian) {
       double v = 0.0;
       ASSERT_EQ(ndf.eval(fp, s, &v), RuntimeStatus::kOk);
       const double d2 = (s.x - nx) * (s.x - nx) + (s.y - ny) * (s.y - ny);
-      const double expected = std::exp(-d2 / (2 * sr * sr)) / (2 * M_PI * sr * sr);
+      const double expected = std::exp(-d2 / (2 * sr * sr)) / (kTwoPi * sr * sr);
       EXPECT_NEAR(v / mass, expected, 1e-3 * expected + 1e-6);
     }
   }

@@ -4,6 +4,7 @@
 // convergence to the smooth NDF as N grows.
 #include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/format/kinds/glitter_model.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/glitter.h>
 
 #include <gtest/gtest.h>
@@ -19,8 +20,6 @@ namespace {
 using format::GlitterDirRegion;
 using format::GlitterUvRegion;
 using format::GlitterVec3;
-
-constexpr double kPi = 3.14159265358979323846;
 
 bake::glitter::GlitterParams params(uint64_t n, double alpha, uint64_t seed = 7,
                                     format::GlitterDistribution d = format::GlitterDistribution::kBeckmann) {

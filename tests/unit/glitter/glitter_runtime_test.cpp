@@ -5,6 +5,7 @@
 #include <glintbake/bake/glitter/glitter.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/glitter_ndf.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/ndf_source.h>
@@ -181,7 +182,7 @@ TEST(GlitterPyramid, BakedPyramidIntegratesToOneAndSamples) {
     ASSERT_EQ(pyr.mass(f, &m), runtime::RuntimeStatus::kOk);
     // A footprint holds a random number of facets: its mass is 1 within the Poisson noise of the
     // effective count N 4 pi sigma^2 / map area ...
-    const double effective = double(p.particles) * 4.0 * 3.14159265358979 * f.sigma * f.sigma / (64.0 * 64.0);
+    const double effective = double(p.particles) * 4.0 * kPi * f.sigma * f.sigma / (64.0 * 64.0);
     EXPECT_NEAR(m, 1.0, 5.0 / std::sqrt(effective)) << f.x;
     // ... and at a stored centre it is exactly the surface's weighted facets (up to the facets
     // binned outside the unit disk and float rounding).

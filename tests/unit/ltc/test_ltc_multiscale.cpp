@@ -2,6 +2,7 @@
 // Multi-scale roughness relations (Tao et al. 2021): eq. 4 against quadrature, the limits and the
 // clamp of alpha_me(|b|), and the refits against the paper's formula on the same ground truth.
 #include <glintbake/bake/ltc/multiscale.h>
+#include <glintbake/format/numbers.h>
 
 #include <gtest/gtest.h>
 
@@ -13,7 +14,7 @@ namespace {
 // Independent quadrature of eq. 4 in the polar angle: 2 * integral cos^2 sin / sqrt(a^2 sin^2 + cos^2).
 double meanLengthByAngle(double alpha) {
   constexpr int kSteps = 200000;
-  const double h = 0.5 * 3.14159265358979323846 / kSteps;
+  const double h = 0.5 * kPi / kSteps;
   double sum = 0.0;
   for (int i = 0; i < kSteps; ++i) {
     const double theta = (i + 0.5) * h;

@@ -2,6 +2,7 @@
 // Roughness mips: a flat map keeps alpha_micro at every level, a bumpy map gets rougher at coarser
 // levels, the bake is deterministic, and the EXR holds every mip level.
 #include <glintbake/bake/ltc/roughness.h>
+#include <glintbake/format/numbers.h>
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -19,8 +20,8 @@ NormalMap makeMap(int width, int height, double slope) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       // Two crossed sinusoidal ridges of period 8 texels.
-      const double sx = slope * std::sin(2.0 * 3.14159265358979 * (x + 0.5) / 8.0);
-      const double sy = slope * std::cos(2.0 * 3.14159265358979 * (y + 0.5) / 8.0);
+      const double sx = slope * std::sin(kTwoPi * (x + 0.5) / 8.0);
+      const double sy = slope * std::cos(kTwoPi * (y + 0.5) / 8.0);
       const double inv = 1.0 / std::sqrt(1.0 + sx * sx + sy * sy);
       float* p = &pixels[(size_t(y) * width + x) * 3];
       p[0] = float(-sx * inv), p[1] = float(-sy * inv), p[2] = float(inv);

@@ -2,6 +2,7 @@
 // Runtime-lite LTC: polygon integration against quadrature, winding, clipping, lookups, loading
 // from containers (including malformed ones) and the C API.
 #include <glintbake/format/container.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/ltc.h>
 #include <glintbake/runtime/ltc_c.h>
 
@@ -16,8 +17,6 @@
 
 namespace glintbake::runtime {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Form factor from the origin (normal +z) of the rectangle [x0, x1] x [y0, y1] at height h, by a
 // midpoint rule of cos_receiver cos_light / (pi r^2) = h^2 / (pi r^4) over its area.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Procedural maps: determinism, the statistics each kind promises, and parameter validation.
 #include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/format/numbers.h>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -10,8 +11,6 @@
 
 namespace glintbake::bake {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 MapParams params(int size, uint64_t seed) {
   MapParams p;

@@ -3,6 +3,7 @@
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
 #include <gtest/gtest.h>
@@ -154,7 +155,7 @@ TEST(PyramidBuilder, PartitionOfUnityMakesTheLevelMeanTheWholeMap) {
     double sum = 0.0;
     for (int k = -20; k < 20 + n; ++k) {
       const double d = u - (k + 0.5) * stride;
-      sum += std::exp(-0.5 * d * d / var) / std::sqrt(2.0 * 3.14159265358979 * var);
+      sum += std::exp(-0.5 * d * d / var) / std::sqrt(kTwoPi * var);
     }
     EXPECT_NEAR(sum * part.x[size_t(g)] * stride, 1.0, 1e-12) << g;
   }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Bin-averaged NDF images of the reference: the rectangle integral, the flat-map Gaussian,
 // normalisation, orientation under rotation and mirroring, and agreement with point evaluation.
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 
 #include "test_maps.h"
@@ -14,8 +15,6 @@
 
 namespace glintbake::reference {
 namespace {
-
-constexpr double kBinImagePi = 3.14159265358979323846;
 
 // Probability of [a, b] under N(mean, sigma^2), written independently of the library.
 double axisMass(double a, double b, double mean, double sigma) {
@@ -54,7 +53,7 @@ TEST(ReferenceBinImage, RectangleIntegralOfACorrelatedGaussianMatchesBruteForce)
       brute += std::exp(-0.5 * (a * dx * dx - 2 * b * dx * dy + a * dy * dy) / det);
     }
   }
-  brute *= (x1 - x0) * (y1 - y0) / (n * double(n)) / (2 * kBinImagePi * std::sqrt(det));
+  brute *= (x1 - x0) * (y1 - y0) / (n * double(n)) / (2 * kPi * std::sqrt(det));
   EXPECT_NEAR(gaussianRectangleIntegral(mean, cov, x0, x1, y0, y1), brute, 2e-5 * brute);
   // The whole plane holds all the mass.
   EXPECT_NEAR(gaussianRectangleIntegral(mean, cov, -10, 10, -10, 10), 1.0, 1e-12);

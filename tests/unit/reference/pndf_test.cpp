@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The per-flake closed form and the point evaluation of the reference P-NDF.
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 
 #include "test_maps.h"
@@ -10,8 +11,6 @@
 
 namespace glintbake::reference {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double gaussian2d(double dx, double dy, double sigma) {
   return std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)) / (2 * kPi * sigma * sigma);

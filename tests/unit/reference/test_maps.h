@@ -3,6 +3,7 @@
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
+#include <glintbake/format/numbers.h>
 
 #include <cmath>
 #include <vector>
@@ -10,8 +11,7 @@
 namespace glintbake::reference::testing {
 
 // A map with every texel set to the unit normal along (nx, ny, sqrt(1 - nx^2 - ny^2)).
-inline bake::NormalMap constantMap(int width, int height, double nx, double ny,
-                                   bake::Wrap wrap = bake::Wrap::kRepeat) {
+inline bake::NormalMap constantMap(int width, int height, double nx, double ny, bake::Wrap wrap = bake::Wrap::kRepeat) {
   bake::NormalMap map;
   map.width = width;
   map.height = height;
@@ -29,8 +29,7 @@ inline bake::NormalMap constantMap(int width, int height, double nx, double ny,
 // A bumpy, asymmetric, periodic map: normals of a height field that is a sum of sinusoids with
 // integer numbers of periods across the map (so the map tiles seamlessly with wrap=repeat).
 // `roughness` scales the slopes (0.3: slopes up to about 0.5).
-inline bake::NormalMap wavyMap(int width, int height, double roughness = 0.3,
-                               bake::Wrap wrap = bake::Wrap::kRepeat) {
+inline bake::NormalMap wavyMap(int width, int height, double roughness = 0.3, bake::Wrap wrap = bake::Wrap::kRepeat) {
   struct Wave {
     int kx, ky;
     double amplitude, phase;
@@ -41,14 +40,13 @@ inline bake::NormalMap wavyMap(int width, int height, double roughness = 0.3,
   map.height = height;
   map.wrap = wrap;
   map.normals.resize(size_t(width) * size_t(height) * 3);
-  const double two_pi = 6.283185307179586;
   for (int r = 0; r < height; ++r) {
     for (int c = 0; c < width; ++c) {
       const double x = (c + 0.5) / width;
       const double y = (r + 0.5) / height;
       double gx = 0.0, gy = 0.0;  // gradient of the height per unit of x and y (y downwards)
       for (const Wave& w : waves) {
-        const double arg = two_pi * (w.kx * x + w.ky * y) + w.phase;
+        const double arg = kTwoPi * (w.kx * x + w.ky * y) + w.phase;
         gx += w.amplitude * w.kx * std::cos(arg);
         gy += w.amplitude * w.ky * std::cos(arg);
       }

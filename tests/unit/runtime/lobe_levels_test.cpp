@@ -2,6 +2,7 @@
 // The clustered lobes group their levels above the finest on first use (lobe_ndf.h): threads that
 // meet an unbuilt level at once get exactly the answers of a hierarchy grouped up front (run under
 // TSan in CI, which also checks that the lazy build is race-free).
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/lobe_ndf.h>
 #include <glintbake/runtime/texel_source.h>
 
@@ -19,7 +20,7 @@ namespace {
 // lobes differ and the reduction merges for real.
 std::vector<float> bumpyNormals(int n) {
   std::vector<float> v(size_t(n) * size_t(n) * 2);
-  const double k = 6.283185307179586 / n;
+  const double k = kTwoPi / n;
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
       float* p = &v[(size_t(y) * size_t(n) + size_t(x)) * 2];

@@ -3,6 +3,7 @@
 // centres, and the interpolation error between centres measured and printed.
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 
@@ -68,8 +69,7 @@ TEST(NdfPyramidReference, CentresExactAndInterpolationErrorMeasured) {
   rf.x = centre.x;
   rf.y = centre.y;
   rf.sigma = centre.sigma;
-  const double a = std::exp(-2.0 * 3.14159265358979 * 3.14159265358979 * (centre.sigma * centre.sigma) /
-                            (l0->stride_x * l0->stride_x));
+  const double a = std::exp(-2.0 * kPi * kPi * (centre.sigma * centre.sigma) / (l0->stride_x * l0->stride_x));
   const double centre_err = relL1(reference::binAveragedImage(flakes, rf, o.splat.sigma_r, res));
   std::printf("[ measured ] level-0 centre against the Gaussian footprint: relative L1 %.4f (bound %.4f)\n", centre_err,
               4.0 * a);

@@ -22,7 +22,6 @@ namespace glintbake::runtime {
 namespace {
 
 using testing::chiSquare;
-using testing::kPi;
 using testing::Rng;
 using testing::sphericalDirection;
 

@@ -15,7 +15,6 @@ namespace glintbake::runtime {
 namespace {
 
 using testing::chiSquare;
-using testing::kPi;
 using testing::Rng;
 using testing::sphericalDirection;
 

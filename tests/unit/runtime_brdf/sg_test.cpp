@@ -12,7 +12,6 @@
 namespace glintbake::runtime {
 namespace {
 
-using testing::kPi;
 using testing::Rng;
 using testing::sphericalDirection;
 

@@ -3,6 +3,7 @@
 // direction sampler against its density on the sphere (Mitsuba 3's ChiSquareTest, simplified).
 #pragma once
 
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/brdf.h>
 
 #include <algorithm>
@@ -28,8 +29,6 @@ class Rng {
  private:
   uint64_t state_;
 };
-
-constexpr double kPi = 3.14159265358979323846;
 
 inline Vec3 sphericalDirection(double z, double phi) {
   const double r = std::sqrt(std::fmax(0.0, 1.0 - z * z));

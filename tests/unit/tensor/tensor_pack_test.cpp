@@ -6,6 +6,7 @@
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/bake/tensor/tensor_pack.h>
 #include <glintbake/format/container.h>
+#include <glintbake/format/numbers.h>
 #include <glintbake/runtime/cp_block.h>
 #include <glintbake/runtime/ndf_pyramid.h>
 #include <glintbake/runtime/tensor_ndf.h>
@@ -639,7 +640,7 @@ NormalMap oneAxisMap(int size, bool along_x) {
   map.width = map.height = size;
   map.normals.resize(size_t(size) * size * 3);
   auto profile = [size](double t, double k1, double k2, double phase) {
-    const double w = 2.0 * 3.14159265358979 / size;
+    const double w = kTwoPi / size;
     return (std::sin(k1 * w * t + phase) + 0.5 * std::sin(k2 * w * t + 2.0 * phase)) / 1.5;
   };
   for (int y = 0; y < size; ++y) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <glintbake/cli/exit_codes.h>
 #include <glintbake/cli/glitter_options.h>
+#include <glintbake/format/numbers.h>
 
 #include <cmath>
 #include <cstdio>
@@ -25,7 +26,7 @@ bake::glitter::GlitterParams resolveGlitterOptions(const GlitterCliOptions& o, i
   p.particles = uint64_t(o.particles);
   p.alpha = o.alpha;
   p.seed = o.seed;
-  p.gamma = o.gamma_deg * 3.14159265358979323846 / 180.0;
+  p.gamma = o.gamma_deg * kPi / 180.0;
   p.ndf_res = ndf_res;
   if (o.distribution == "beckmann") {
     p.distribution = format::GlitterDistribution::kBeckmann;

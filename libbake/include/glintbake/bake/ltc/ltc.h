@@ -6,13 +6,13 @@
 // V lies in the x-z half plane with V.x >= 0. All functions are pure and thread-safe.
 #pragma once
 
+#include <glintbake/format/numbers.h>
+
 #include <cmath>
 #include <cstdint>
 #include <string>
 
 namespace glintbake::bake::ltc {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct Vec3 {
   double x = 0.0, y = 0.0, z = 0.0;
