@@ -26,20 +26,21 @@ export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/sanitizers/lsan.supp
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
 
-if [[ ! -f build-tsan/CMakeCache.txt ]]; then
-  cmake -S . -B build-tsan "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug -DGLINTBAKE_SANITIZE=thread \
-    -DGLINTBAKE_RUNTIME_ONLY=ON -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-fi
+# Both trees are configured on every run (seconds when nothing changed), so that a tree left by an
+# earlier version of this script takes today's settings; the generator is kept from its first run.
+tsan_generator=() asan_generator=()
+[[ -f build-tsan/CMakeCache.txt ]] || tsan_generator=("${generator[@]}")
+[[ -f build-asan/CMakeCache.txt ]] || asan_generator=("${generator[@]}")
+cmake -S . -B build-tsan "${tsan_generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug -DGLINTBAKE_SANITIZE=thread \
+  -DGLINTBAKE_RUNTIME_ONLY=ON -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build-tsan -j "$jobs" --target test_runtime_ndf >/dev/null
 ctest --test-dir build-tsan --output-on-failure -R Concurrent
 
 # A unity build (several sources of a target compiled as one): the headers are parsed and
 # instrumented once per batch instead of once per source (on two cores about 520 s instead of 900 s).
-if [[ ! -f build-asan/CMakeCache.txt ]]; then
-  cmake -S . -B build-asan "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_UNITY_BUILD=ON \
-    -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_C_FLAGS_DEBUG="-O1 -g1" \
-    -DGLINTBAKE_SANITIZE=address,undefined -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-fi
+cmake -S . -B build-asan "${asan_generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_UNITY_BUILD=ON \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_C_FLAGS_DEBUG="-O1 -g1" \
+  -DGLINTBAKE_SANITIZE=address,undefined -DGLINTBAKE_BUILD_BENCH=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build-asan -j "$jobs" >/dev/null
 # Not run under ASan (all of them run in the normal build):
 #  - install.*: the consumer projects are built without the sanitizer runtime, so they cannot link

@@ -16,7 +16,7 @@ namespace {
 bool finiteGlitterPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 
 // Reads one raw section into a caller buffer of exactly `size` bytes.
-RuntimeStatus readExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
+RuntimeStatus readSectionExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
   const int idx = reader.find(type, 0);
   if (idx < 0) return RuntimeStatus::kInvalidAsset;
   if (reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
@@ -57,14 +57,15 @@ RuntimeStatus GlitterNdf::load(const format::Reader& reader) {
   }
   if (format::checkGlitterLayout(infos, tables)) return RuntimeStatus::kInvalidAsset;
   format::GlitterRecord rec;
-  if (RuntimeStatus s = readExact(reader, format::kSectionGlitterInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
+  if (RuntimeStatus s = readSectionExact(reader, format::kSectionGlitterInfo, &rec, sizeof rec);
+      s != RuntimeStatus::kOk)
     return s;
   if (rec.magic == format::GlitterRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkGlitterRecord(rec)) return RuntimeStatus::kInvalidAsset;
   std::unique_ptr<format::GlitterIntegral[]> table(new (std::nothrow) format::GlitterIntegral[rec.integral_count]);
   if (!table) return RuntimeStatus::kOutOfMemory;
-  if (RuntimeStatus s = readExact(reader, format::kSectionGlitterIntegrals, table.get(),
-                                  size_t(rec.integral_count) * sizeof(format::GlitterIntegral));
+  if (RuntimeStatus s = readSectionExact(reader, format::kSectionGlitterIntegrals, table.get(),
+                                         size_t(rec.integral_count) * sizeof(format::GlitterIntegral));
       s != RuntimeStatus::kOk)
     return s;
   if (format::checkGlitterIntegrals(table.get(), rec.integral_count)) return RuntimeStatus::kInvalidAsset;
