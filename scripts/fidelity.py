@@ -41,8 +41,9 @@ non-interlaced 8/16-bit PNG and wrap repeat; other maps use glintref at every si
 
 Caching (--cache, default build/fidelity-cache under the repository): reference images are keyed by
 (map content hash, x, y, sigma, R, sigma_r, and any non-default ingest option); baked assets by
-(map hash, tool binary hash, tool arguments); the assets' images by (asset file, size, mtime, x, y,
-sigma); so a rerun only computes what is new. Footprints are
+(map hash, tool binary hash, tool arguments); the assets' images by (asset file, size, mtime, the
+glintquery binary's hash, x, y, sigma); so a rerun only computes what is new, and a rebuilt tool
+whose binary is unchanged reuses every result. Footprints are
 drawn from Random((seed, map hash, sigma)), so the same seed gives the same footprints on every run
 and for every asset, and a new asset reuses all references.
 
