@@ -10,8 +10,6 @@
 #include <cmath>
 
 namespace glintbake::reference {
-namespace {}  // namespace
-
 FlakeLobe flakeLobe(const FlakeSet& set, const Flake& flake, double ux, double uy, const Footprint& fp,
                     double sigma_r) {
   // Yan et al. 2016: the product of the footprint Gaussian and the flake's 4D Gaussian, integrated

@@ -7,6 +7,9 @@
 #include <glintbake/format/records.h>
 #include <glintbake/runtime/runtime.h>
 
+#include <cstddef>
+#include <cstdint>
+
 namespace glintbake::runtime {
 
 inline RuntimeStatus fromFormatStatus(format::ContainerStatus s) {
@@ -32,6 +35,14 @@ inline RuntimeStatus fromRecordCheck(const format::RecordCheck& check) {
     default:
       return RuntimeStatus::kInvalidAsset;
   }
+}
+
+// Reads section (type, key 0) into a caller buffer of exactly `size` bytes: an asset whose section
+// is missing or of another size is invalid.
+inline RuntimeStatus readSectionExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
+  const int idx = reader.find(type, 0);
+  if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
+  return fromFormatStatus(reader.readSectionInto(size_t(idx), out, size));
 }
 
 }  // namespace glintbake::runtime

@@ -7,18 +7,14 @@
 #include <glintbake/format/kinds/ndf_pyramid_blend.h>
 #include <glintbake/runtime/runtime.h>
 
+#include "query_args.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 namespace glintbake::runtime {
-
-// Footprint arguments every query accepts: finite, sigma >= 0, position within +-1e15 texels.
-inline bool validFootprint(const Footprint& fp) {
-  return std::isfinite(fp.x) && std::isfinite(fp.y) && std::isfinite(fp.sigma) && fp.sigma >= 0.0 &&
-         std::fabs(fp.x) < 1e15 && std::fabs(fp.y) < 1e15;
-}
 
 // Column i and row j of the bin of an R x R NDF image (bin side 2 / res, inv_bin = res / 2)
 // holding s (row 0 at s_y = +1), false outside [-1, 1]^2; ndfBinOf gives the index j * res + i, or

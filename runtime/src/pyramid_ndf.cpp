@@ -11,17 +11,6 @@
 #include <cmath>
 
 namespace glintbake::runtime {
-namespace {
-
-bool finitePoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
-
-bool validRect(const SRect& r) {
-  return std::isfinite(r.x0) && std::isfinite(r.x1) && std::isfinite(r.y0) && std::isfinite(r.y1) && r.x1 > r.x0 &&
-         r.y1 > r.y0;
-}
-
-}  // namespace
-
 RuntimeStatus PyramidNdf::load(const format::Reader& reader) {
   reset();
   if (reader.kind() == format::AssetKind::kPartial) return RuntimeStatus::kPartialBake;

@@ -2,13 +2,13 @@
 // Two microfacet layers, f = f_base (1 - F_coat) + f_coat (see layered_brdf.h).
 #include <glintbake/runtime/layered_brdf.h>
 
+#include "../query_args.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace glintbake::runtime {
 namespace {
-
-bool finiteDirection(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 double mean(const Rgb& c) { return (c.r + c.g + c.b) / 3.0; }
 
@@ -19,7 +19,7 @@ double LayeredBrdf::coatProbability(const Vec3& wo) const {
 }
 
 RuntimeStatus LayeredBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const {
-  if (!f || !finiteDirection(wi) || !finiteDirection(wo)) return RuntimeStatus::kInvalidArgument;
+  if (!f || !finiteVec3(wi) || !finiteVec3(wo)) return RuntimeStatus::kInvalidArgument;
   Rgb fb, fc;
   if (RuntimeStatus s = base_.eval(wi, wo, &fb); s != RuntimeStatus::kOk) return s;
   if (RuntimeStatus s = coat_.eval(wi, wo, &fc); s != RuntimeStatus::kOk) return s;
@@ -30,7 +30,7 @@ RuntimeStatus LayeredBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const {
 }
 
 RuntimeStatus LayeredBrdf::pdf(const Vec3& wi, const Vec3& wo, double* value) const {
-  if (!value || !finiteDirection(wi) || !finiteDirection(wo)) return RuntimeStatus::kInvalidArgument;
+  if (!value || !finiteVec3(wi) || !finiteVec3(wo)) return RuntimeStatus::kInvalidArgument;
   double pb = 0.0, pc = 0.0;
   if (RuntimeStatus s = base_.pdf(wi, wo, &pb); s != RuntimeStatus::kOk) return s;
   if (RuntimeStatus s = coat_.pdf(wi, wo, &pc); s != RuntimeStatus::kOk) return s;
@@ -40,7 +40,7 @@ RuntimeStatus LayeredBrdf::pdf(const Vec3& wi, const Vec3& wo, double* value) co
 }
 
 RuntimeStatus LayeredBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const {
-  if (!out || !finiteDirection(wo) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+  if (!out || !finiteVec3(wo) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
   const double q = coatProbability(wo);
   // The first uniform chooses the layer and is rescaled for that layer's sampler.

@@ -3,13 +3,13 @@
 #include <glintbake/format/numbers.h>
 #include <glintbake/runtime/brdf.h>
 
+#include "../query_args.h"
+
 #include <cmath>
 #include <complex>
 
 namespace glintbake::runtime {
 namespace {
-
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // tan^2(theta) of a unit direction, from its z component.
 double tan2Theta(const Vec3& w) {
@@ -119,7 +119,7 @@ MicrofacetBrdf MicrofacetBrdf::glinty(const NdfSource* source, const Footprint& 
 }
 
 RuntimeStatus MicrofacetBrdf::ndf(const Vec3& h, double* value) const {
-  if (!finite(h)) return RuntimeStatus::kInvalidArgument;
+  if (!finiteVec3(h)) return RuntimeStatus::kInvalidArgument;
   if (!(h.z > 0.0)) {
     *value = 0.0;
     return RuntimeStatus::kOk;
@@ -133,7 +133,7 @@ RuntimeStatus MicrofacetBrdf::ndf(const Vec3& h, double* value) const {
 }
 
 RuntimeStatus MicrofacetBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const {
-  if (!finite(wi) || !finite(wo)) return RuntimeStatus::kInvalidArgument;
+  if (!finiteVec3(wi) || !finiteVec3(wo)) return RuntimeStatus::kInvalidArgument;
   if (!(wi.z > 0.0) || !(wo.z > 0.0)) {
     *f = Rgb{};
     return RuntimeStatus::kOk;
@@ -150,7 +150,7 @@ RuntimeStatus MicrofacetBrdf::eval(const Vec3& wi, const Vec3& wo, Rgb* f) const
 }
 
 RuntimeStatus MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfSample* out) const {
-  if (!finite(wo) || !std::isfinite(u1) || !std::isfinite(u2)) return RuntimeStatus::kInvalidArgument;
+  if (!finiteVec3(wo) || !std::isfinite(u1) || !std::isfinite(u2)) return RuntimeStatus::kInvalidArgument;
   BrdfSample result;
   if (!(wo.z > 0.0)) {
     *out = result;
@@ -199,7 +199,7 @@ RuntimeStatus MicrofacetBrdf::sample(const Vec3& wo, double u1, double u2, BrdfS
 }
 
 RuntimeStatus MicrofacetBrdf::pdf(const Vec3& wi, const Vec3& wo, double* value) const {
-  if (!finite(wi) || !finite(wo)) return RuntimeStatus::kInvalidArgument;
+  if (!finiteVec3(wi) || !finiteVec3(wo)) return RuntimeStatus::kInvalidArgument;
   const Vec3 sum = wi + wo;
   if (!(wo.z > 0.0) || !(dot(sum, sum) > 0.0)) {
     *value = 0.0;

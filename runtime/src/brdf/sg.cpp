@@ -3,14 +3,14 @@
 #include <glintbake/format/numbers.h>
 #include <glintbake/runtime/sg.h>
 
+#include "../query_args.h"
+
 #include <cmath>
 
 namespace glintbake::runtime {
 namespace {
 
 constexpr int kBoundaryPoints = 64;
-
-bool finiteVector(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 double maxChannel(const Rgb& c) { return std::fmax(c.r, std::fmax(c.g, c.b)); }
 
@@ -28,7 +28,7 @@ void basis(const Vec3& n, Vec3* t, Vec3* b) {
 double oneMinusExp2(double lambda) { return -std::expm1(-2.0 * lambda); }
 
 bool validSg(const SphericalGaussian& sg) {
-  return finiteVector(sg.axis) && std::isfinite(sg.sharpness) && sg.sharpness > 0.0 && std::isfinite(sg.amplitude.r) &&
+  return finiteVec3(sg.axis) && std::isfinite(sg.sharpness) && sg.sharpness > 0.0 && std::isfinite(sg.amplitude.r) &&
          std::isfinite(sg.amplitude.g) && std::isfinite(sg.amplitude.b);
 }
 
@@ -58,7 +58,7 @@ SgSupport sgSupport(const SphericalGaussian& sg, double eps) {
 
 RuntimeStatus sgHalfVectorRect(const SphericalGaussian& sg, double eps, const Vec3& wo, SRect* rect,
                                bool* has_support) {
-  if (!validSg(sg) || !finiteVector(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
+  if (!validSg(sg) || !finiteVec3(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
   const SgSupport support = sgSupport(sg, eps);
   if (support.empty) {
     *has_support = false;
@@ -146,7 +146,7 @@ RuntimeStatus sgAveragedNdf(const MicrofacetBrdf& brdf, const SphericalGaussian&
 
 RuntimeStatus prefilteredSgShading(const MicrofacetBrdf& brdf, const SphericalGaussian& sg, double eps, const Vec3& wo,
                                    Rgb* radiance) {
-  if (!validSg(sg) || !finiteVector(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
+  if (!validSg(sg) || !finiteVec3(wo) || !std::isfinite(eps) || !(eps > 0.0)) return RuntimeStatus::kInvalidArgument;
   if (!(wo.z > 0.0) || !(sg.axis.z > 0.0)) {
     *radiance = Rgb{};
     return RuntimeStatus::kOk;

@@ -7,6 +7,8 @@
 
 #include <glintbake/runtime/runtime.h>
 
+#include "../query_args.h"
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -84,10 +86,5 @@ inline void tileGap(double ux, double uy, int64_t tx, int64_t ty, double side, d
 
 // Query arguments shared by the flake and lobe evaluators.
 inline bool inSquare(const SPoint& s) { return s.x >= -1.0 && s.x <= 1.0 && s.y >= -1.0 && s.y <= 1.0; }
-inline bool validPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
-inline bool validRect(const SRect& r) {
-  return std::isfinite(r.x0) && std::isfinite(r.x1) && std::isfinite(r.y0) && std::isfinite(r.y1) && r.x1 > r.x0 &&
-         r.y1 > r.y0;
-}
 
 }  // namespace glintbake::runtime::flakes

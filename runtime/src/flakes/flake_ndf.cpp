@@ -738,7 +738,7 @@ std::atomic<bool>& portableKernelsOnly() {
 
 RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
                                            double window_sigmas, double* value, const flakes::TileCut* cut) {
-  if (!f.impl_ || !value || !validFootprint(fp) || !flakes::validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!f.impl_ || !value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
   if (!f.impl_->terms(fp, &t, window_sigmas)) return RuntimeStatus::kInvalidArgument;
   t.cut = cut;
@@ -749,7 +749,7 @@ RuntimeStatus FlakeNdfAccess::windowedEval(const FlakeNdf& f, const Footprint& f
 RuntimeStatus FlakeNdfAccess::evalWithInnerWindow(const FlakeNdf& f, const Footprint& fp, const SPoint& s,
                                                   double inner_window_sigmas, double outer_window_sigmas, double* value,
                                                   double* inner) {
-  if (!f.impl_ || !value || !inner || !validFootprint(fp) || !flakes::validPoint(s) ||
+  if (!f.impl_ || !value || !inner || !validFootprint(fp) || !finitePoint(s) ||
       !(inner_window_sigmas > 0.0 && inner_window_sigmas <= outer_window_sigmas &&
         outer_window_sigmas <= kWindowSigmas))
     return RuntimeStatus::kInvalidArgument;
@@ -910,11 +910,9 @@ FootprintRange FlakeNdf::footprintRange() const {
 double FlakeNdf::sigmaR() const { return impl_ ? impl_->sigma_r : 0.0; }
 
 using flakes::inSquare;
-using flakes::validPoint;
-using flakes::validRect;
 
 RuntimeStatus FlakeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
   if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
@@ -930,7 +928,7 @@ RuntimeStatus FlakeNdf::mass(const Footprint& footprint, double* value) const {
 }
 
 RuntimeStatus FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   FootprintTerms t;
   if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double m = impl_->mass(t);

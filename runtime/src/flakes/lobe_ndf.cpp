@@ -924,11 +924,9 @@ FootprintRange LobeNdf::footprintRange() const {
 }
 
 using flakes::inSquare;
-using flakes::validPoint;
-using flakes::validRect;
 
 RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   Terms t;
   if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
@@ -955,7 +953,7 @@ RuntimeStatus LobeNdf::mass(const Footprint& footprint, double* value) const {
 }
 
 RuntimeStatus LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !validPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   Terms t;
   if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
   const double m = impl_->massOf(t);

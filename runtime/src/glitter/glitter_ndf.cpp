@@ -3,31 +3,14 @@
 #include <glintbake/format/numbers.h>
 #include <glintbake/runtime/glitter_ndf.h>
 #include "../format_status.h"
+#include "../query_args.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <new>
-#include <vector>
 
 namespace glintbake::runtime {
-namespace {
-
-bool finiteGlitterPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
-
-// Reads one raw section into a caller buffer of exactly `size` bytes.
-RuntimeStatus readSectionExact(const format::Reader& reader, uint32_t type, void* out, size_t size) {
-  const int idx = reader.find(type, 0);
-  if (idx < 0) return RuntimeStatus::kInvalidAsset;
-  if (reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
-  std::vector<uint8_t> bytes;
-  if (format::ContainerStatus st = reader.readSection(size_t(idx), &bytes); st != format::ContainerStatus::kOk)
-    return fromFormatStatus(st);
-  std::memcpy(out, bytes.data(), size);
-  return RuntimeStatus::kOk;
-}
-
-}  // namespace
 
 RuntimeStatus GlitterNdf::open(const char* path) {
   if (!path) return RuntimeStatus::kInvalidArgument;
@@ -122,7 +105,7 @@ double GlitterNdf::coneWeight(const format::GlitterGaussian& g, const SPoint& s)
 }
 
 RuntimeStatus GlitterNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!validFootprint(footprint) || !finiteGlitterPoint(s) || !value) return RuntimeStatus::kInvalidArgument;
+  if (!validFootprint(footprint) || !finitePoint(s) || !value) return RuntimeStatus::kInvalidArgument;
   const double r2 = s.x * s.x + s.y * s.y;
   if (!(r2 < 1.0)) {
     *value = 0.0;
@@ -142,7 +125,7 @@ RuntimeStatus GlitterNdf::mass(const Footprint& footprint, double* value) const 
 }
 
 RuntimeStatus GlitterNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!validFootprint(footprint) || !finiteGlitterPoint(s) || !value) return RuntimeStatus::kInvalidArgument;
+  if (!validFootprint(footprint) || !finitePoint(s) || !value) return RuntimeStatus::kInvalidArgument;
   double m = 0.0, e = 0.0;
   mass(footprint, &m);
   if (!(m > 0.0)) {

@@ -10,6 +10,7 @@
 #include "../flakes/flake_model.h"
 #include "../flakes/gaussian_rect.h"
 #include "../format_status.h"
+#include "../query_args.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,8 +28,6 @@ namespace {
 constexpr double kSigmaH = 1.5 / 3.4641016151377544;  // flake spatial std at rate 1 (SPEC.md 10.5)
 constexpr double kMinSigma = 1e-3;                    // tile path: smaller footprints are points
 constexpr double kNegligible = 1e-15;                 // tiles with less probability are skipped
-
-bool finiteTinyPoint(const SPoint& s) { return std::isfinite(s.x) && std::isfinite(s.y); }
 
 // Whether the window [c - r, c + r] in units of `unit` stays well inside the int64 range (false
 // for NaN and infinities too).
@@ -1198,7 +1197,7 @@ RuntimeStatus TinyExampleNdf::flakeSample(const Footprint& fp, double total, dou
 // linearly in log(sigma) between.
 
 RuntimeStatus TinyExampleNdf::eval(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finiteTinyPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   const double a = tinyFlakeShare(fp.sigma);
   double f = 0.0, t = 0.0;
   if (a > 0.0)
@@ -1222,7 +1221,7 @@ RuntimeStatus TinyExampleNdf::mass(const Footprint& fp, double* value) const {
 }
 
 RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* value) const {
-  if (!value || !validFootprint(fp) || !finiteTinyPoint(s)) return RuntimeStatus::kInvalidArgument;
+  if (!value || !validFootprint(fp) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
   double e = 0.0, m = 0.0;
   if (RuntimeStatus st = eval(fp, s, &e); st != RuntimeStatus::kOk) return st;
   if (RuntimeStatus st = mass(fp, &m); st != RuntimeStatus::kOk) return st;
@@ -1231,7 +1230,7 @@ RuntimeStatus TinyExampleNdf::pdf(const Footprint& fp, const SPoint& s, double* 
 }
 
 RuntimeStatus TinyExampleNdf::average(const Footprint& fp, const SRect& rect, double* value) const {
-  if (!value || !validFootprint(fp) || !flakes::validRect(rect)) return RuntimeStatus::kInvalidArgument;
+  if (!value || !validFootprint(fp) || !validRect(rect)) return RuntimeStatus::kInvalidArgument;
   const double a = tinyFlakeShare(fp.sigma);
   double f = 0.0, t = 0.0;
   if (a > 0.0)

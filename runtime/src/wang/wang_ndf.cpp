@@ -18,19 +18,13 @@ namespace {
 constexpr double kMaxPosition = 1e15;  // texels; beyond, cell and local coordinates lose precision
 constexpr int kMaxTerms = 18;          // 3 x 3 tiles, on two paths in the hand-over band
 
-// Reads section (type, key 0) into a caller buffer of exactly `size` bytes.
-RuntimeStatus readWangSection(const format::Reader& reader, uint32_t type, void* out, size_t size) {
-  const int idx = reader.find(type, 0);
-  if (idx < 0 || reader.sections()[size_t(idx)].raw_size != size) return RuntimeStatus::kInvalidAsset;
-  return fromFormatStatus(reader.readSectionInto(size_t(idx), out, size));
-}
-
 bool sectionHasSize(const format::Reader& reader, uint32_t type, size_t size) {
   const int idx = reader.find(type, 0);
   return idx >= 0 && reader.sections()[size_t(idx)].raw_size == size;
 }
 
-bool validFootprint(const Footprint& f) {
+// Footprints a Wang-tile query accepts (positions up to kMaxPosition inclusive).
+bool validWangFootprint(const Footprint& f) {
   return std::isfinite(f.x) && std::isfinite(f.y) && std::fabs(f.x) <= kMaxPosition && std::fabs(f.y) <= kMaxPosition &&
          std::isfinite(f.sigma) && f.sigma >= 0.0;
 }
@@ -91,7 +85,7 @@ struct WangNdf::Impl {
 
   template <typename Query>
   RuntimeStatus sum(const Footprint& f, double* value, Query&& query) const {
-    if (!validFootprint(f)) return RuntimeStatus::kInvalidArgument;
+    if (!validWangFootprint(f)) return RuntimeStatus::kInvalidArgument;
     Term terms_[kMaxTerms];
     const int n = terms(f, terms_);
     double total = 0.0;
@@ -129,7 +123,7 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
   std::unique_ptr<Impl> impl(new (std::nothrow) Impl());
   if (!impl) return RuntimeStatus::kOutOfMemory;
   format::WangRecord& rec = impl->rec;
-  if (RuntimeStatus s = readWangSection(reader, format::kSectionWangInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
+  if (RuntimeStatus s = readSectionExact(reader, format::kSectionWangInfo, &rec, sizeof rec); s != RuntimeStatus::kOk)
     return s;
   if (rec.magic == format::WangRecord().magic && rec.version > 1) return RuntimeStatus::kUnsupportedVersion;
   if (format::checkWangRecord(rec)) return RuntimeStatus::kInvalidAsset;
@@ -145,13 +139,13 @@ RuntimeStatus WangNdf::load(const format::Reader& reader) {
   impl->texels.reset(new (std::nothrow) float[texel_floats]);
   impl->assets.reset(new (std::nothrow) std::unique_ptr<NdfSource>[rec.tile_count]);
   if (!edges || !impl->code_to_tile || !impl->texels || !impl->assets) return RuntimeStatus::kOutOfMemory;
-  if (RuntimeStatus s = readWangSection(reader, format::kSectionWangEdges, edges.get(), edge_bytes);
+  if (RuntimeStatus s = readSectionExact(reader, format::kSectionWangEdges, edges.get(), edge_bytes);
       s != RuntimeStatus::kOk)
     return s;
   if (format::checkWangEdges(rec, edges.get(), edge_bytes)) return RuntimeStatus::kInvalidAsset;
   std::memcpy(impl->code_to_tile.get(), edges.get(), size_t(rec.tile_count) * 4);
   if (RuntimeStatus s =
-          readWangSection(reader, format::kSectionWangTexels, impl->texels.get(), texel_floats * sizeof(float));
+          readSectionExact(reader, format::kSectionWangTexels, impl->texels.get(), texel_floats * sizeof(float));
       s != RuntimeStatus::kOk)
     return s;
   for (size_t i = 0; i < texel_floats; ++i) {
@@ -236,7 +230,7 @@ uint32_t WangNdf::cellTile(int64_t i, int64_t j) const {
 const float* WangNdf::tileTexels() const { return impl_ ? impl_->texels.get() : nullptr; }
 
 int WangNdf::coveredTiles(const Footprint& f) const {
-  if (!impl_ || !validFootprint(f)) return 0;
+  if (!impl_ || !validWangFootprint(f)) return 0;
   Impl::Term terms[kMaxTerms];
   const int n = impl_->terms(f, terms);
   int exact = 0;
@@ -266,7 +260,7 @@ RuntimeStatus WangNdf::pdf(const Footprint& f, const SPoint& s, double* value) c
 }
 
 RuntimeStatus WangNdf::sample(const Footprint& f, double u1, double u2, NdfSample* out) const {
-  if (!impl_ || !out || !validFootprint(f) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
+  if (!impl_ || !out || !validWangFootprint(f) || !(u1 >= 0.0 && u1 < 1.0) || !(u2 >= 0.0 && u2 < 1.0))
     return RuntimeStatus::kInvalidArgument;
   Impl::Term terms[kMaxTerms];
   double masses[kMaxTerms];
@@ -300,7 +294,7 @@ RuntimeStatus WangNdf::sample(const Footprint& f, double u1, double u2, NdfSampl
 }
 
 RuntimeStatus WangNdf::image(const Footprint& f, float* out, size_t out_count) const {
-  if (!impl_ || !out || !validFootprint(f)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_ || !out || !validWangFootprint(f)) return RuntimeStatus::kInvalidArgument;
   const size_t n = size_t(impl_->rec.ndf_res) * size_t(impl_->rec.ndf_res);
   if (out_count < n) return RuntimeStatus::kInvalidArgument;
   thread_local std::unique_ptr<float[]> scratch;
