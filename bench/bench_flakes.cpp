@@ -7,7 +7,9 @@
 // GLINTBAKE_BENCH_ASSETS=a.gbk,b.gbk adds `asset_eval` and `asset_sample`: the same queries through
 // baked NDF assets (openNdfAsset: flakes, lobes, pyramid and the blends between them) at footprints
 // from 1 texel to past the pyramid's hand-over, so that every path and band of an asset is timed;
-// `asset_eval_raster` the same evals over a block of neighbouring pixels' footprints.
+// `asset_eval_raster` the same evals over a block of neighbouring pixels' footprints;
+// `asset_eval_each` and `asset_sample_each` the random queries timed one by one, with the median,
+// 90th percentile and mean over the queries as counters.
 // `lobe_build` times the lobe hierarchy a reader builds at load (16 lobes per tile).
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
@@ -19,6 +21,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -168,6 +171,56 @@ void assetBench(benchmark::State& state, size_t index, double sigma, bool sample
   }
 }
 
+// The same random queries, each timed on its own (the clock read's own cost, measured alike,
+// taken off): the counters give the median, 90th percentile and mean over every query of every
+// iteration, as the targets are stated (a median over random queries); the reported time is the
+// mean. One pass over the 1024 queries is an iteration.
+void assetQueryBench(benchmark::State& state, size_t index, double sigma, bool sample) {
+  using Clock = std::chrono::steady_clock;
+  const rt::NdfSource& src = *assets()[index].source;
+  const rt::MapSize size = src.mapSize();
+  const std::vector<Query> q = queries(src, int(size.width), int(size.height), sigma);
+  std::vector<double> overhead(4096);
+  for (double& o : overhead) {
+    const auto t0 = Clock::now();
+    const auto t1 = Clock::now();
+    o = std::chrono::duration<double>(t1 - t0).count();
+  }
+  std::nth_element(overhead.begin(), overhead.begin() + overhead.size() / 2, overhead.end());
+  const double clock_cost = overhead[overhead.size() / 2];
+  std::vector<double> times;
+  size_t i = 0;
+  for (auto _ : state) {
+    const Query& x = q[i];
+    const auto t0 = Clock::now();
+    if (sample) {
+      rt::NdfSample smp;
+      src.sample(x.fp, x.u1, x.u2, &smp);
+      benchmark::DoNotOptimize(smp);
+    } else {
+      double v;
+      src.eval(x.fp, x.s, &v);
+      benchmark::DoNotOptimize(v);
+    }
+    const auto t1 = Clock::now();
+    const double t = std::max(std::chrono::duration<double>(t1 - t0).count() - clock_cost, 0.0);
+    times.push_back(t);
+    state.SetIterationTime(t);
+    i = (i + 1) & 1023;
+  }
+  if (times.empty()) return;
+  auto quantile = [&times](double p) {
+    const auto k = times.begin() + std::ptrdiff_t(p * double(times.size() - 1));
+    std::nth_element(times.begin(), k, times.end());
+    return *k;
+  };
+  double sum = 0.0;
+  for (double t : times) sum += t;
+  state.counters["mean_us"] = 1e6 * sum / double(times.size());
+  state.counters["median_us"] = 1e6 * quantile(0.5);
+  state.counters["p90_us"] = 1e6 * quantile(0.9);
+}
+
 // One untimed pass over the queries: the lobe evaluator builds a level on its first query there
 // (hundreds of milliseconds), which a timed run of few iterations would otherwise count.
 void warmUp(const rt::NdfSource& src, const std::vector<Query>& q) {
@@ -266,6 +319,12 @@ const int registered = [] {
           ->Unit(benchmark::kMicrosecond);
       benchmark::RegisterBenchmark(("asset_eval_raster/" + tag).c_str(), assetBench, k, sigma, false, true)
           ->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("asset_eval_each/" + tag).c_str(), assetQueryBench, k, sigma, false)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseManualTime();
+      benchmark::RegisterBenchmark(("asset_sample_each/" + tag).c_str(), assetQueryBench, k, sigma, true)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseManualTime();
     }
   }
   return 0;
