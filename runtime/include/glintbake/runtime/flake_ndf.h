@@ -15,9 +15,9 @@
 // along each axis (a square window; the reference's disk of the same radius differs by less than
 // 1e-7 of the mass). With a repeating map every periodic image of a flake inside the window counts.
 //
-// Cost: the flakes are stored in tiles of 8 x 8, each split into 8 leaves of 8 flakes by a k-d
-// tree over n and |J|; every tile keeps its normal box and largest |J_k|, every leaf its normal
-// box, largest |J_k| and box of positions. A point query tests the tiles of the window, then four
+// Cost: the flakes are stored in tiles of 8 x 8, each split into 8 leaves of 2 x 4 neighbouring
+// flakes; every tile keeps its normal box and largest |J_k|, every leaf its normal box, largest
+// |J_k| and box of positions. A point query tests the tiles of the window, then four
 // leaves at a time, and evaluates only the leaves whose lobes can reach s (spatial plus lobe
 // exponent below 18); the leaves of a batch of tiles are prefetched together. Their flakes go
 // through a two-pass kernel (a division-free test, then exp and sqrt on the kept flakes only), in
