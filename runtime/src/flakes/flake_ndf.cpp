@@ -10,6 +10,7 @@
 #include "float4.h"
 #include "float8.h"
 #include "gaussian_rect.h"
+#include "point_queries.h"
 
 #include <algorithm>
 #include <cmath>
@@ -265,7 +266,7 @@ struct FlakeNdf::Impl {
     return x1 < x0 ? 0.0 : prefix[x1 + 1 - t.x0] - prefix[x0 - t.x0];
   }
   double weightSum(const FootprintTerms& t, bool along_x) const;
-  double mass(const FootprintTerms& t) const { return t.wnorm * weightSum(t, true) * weightSum(t, false); }
+  double massOf(const FootprintTerms& t) const { return t.wnorm * weightSum(t, true) * weightSum(t, false); }
 };
 
 // The flakes of tile (tx, ty): position, n_k by interpolation and J_k by central differences of the
@@ -915,28 +916,15 @@ double FlakeNdf::sigmaR() const { return impl_ ? impl_->sigma_r : 0.0; }
 using flakes::inSquare;
 
 RuntimeStatus FlakeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
-  return RuntimeStatus::kOk;
+  return flakes::pointEval<FootprintTerms>(impl_.get(), footprint, s, value);
 }
 
 RuntimeStatus FlakeNdf::mass(const Footprint& footprint, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
-  FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  *value = impl_->mass(t);
-  return RuntimeStatus::kOk;
+  return flakes::pointMass<FootprintTerms>(impl_.get(), footprint, value);
 }
 
 RuntimeStatus FlakeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  FootprintTerms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  const double m = impl_->mass(t);
-  *value = (inSquare(s) && m > 0.0) ? impl_->evalAt(t, s.x, s.y) / m : 0.0;
-  return RuntimeStatus::kOk;
+  return flakes::pointPdf<FootprintTerms>(impl_.get(), footprint, s, value);
 }
 
 RuntimeStatus FlakeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {

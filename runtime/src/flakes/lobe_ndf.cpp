@@ -10,6 +10,7 @@
 #include "float4.h"
 #include "float8.h"
 #include "gaussian_rect.h"
+#include "point_queries.h"
 
 #include <algorithm>
 #include <cmath>
@@ -926,11 +927,7 @@ FootprintRange LobeNdf::footprintRange() const {
 using flakes::inSquare;
 
 RuntimeStatus LobeNdf::eval(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  Terms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  *value = inSquare(s) ? impl_->evalAt(t, s.x, s.y) : 0.0;
-  return RuntimeStatus::kOk;
+  return flakes::pointEval<Terms>(impl_.get(), footprint, s, value);
 }
 
 bool LobeNdfAccess::exactWindow(const LobeNdf& lobes, double sigma, double* window_sigmas, double* norm) {
@@ -945,20 +942,11 @@ bool LobeNdfAccess::exactWindow(const LobeNdf& lobes, double sigma, double* wind
 }
 
 RuntimeStatus LobeNdf::mass(const Footprint& footprint, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint)) return RuntimeStatus::kInvalidArgument;
-  Terms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  *value = impl_->massOf(t);
-  return RuntimeStatus::kOk;
+  return flakes::pointMass<Terms>(impl_.get(), footprint, value);
 }
 
 RuntimeStatus LobeNdf::pdf(const Footprint& footprint, const SPoint& s, double* value) const {
-  if (!impl_ || !value || !validFootprint(footprint) || !finitePoint(s)) return RuntimeStatus::kInvalidArgument;
-  Terms t;
-  if (!impl_->terms(footprint, &t)) return RuntimeStatus::kInvalidArgument;
-  const double m = impl_->massOf(t);
-  *value = (inSquare(s) && m > 0.0) ? impl_->evalAt(t, s.x, s.y) / m : 0.0;
-  return RuntimeStatus::kOk;
+  return flakes::pointPdf<Terms>(impl_.get(), footprint, s, value);
 }
 
 RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, double* value) const {
