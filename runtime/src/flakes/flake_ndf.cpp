@@ -373,20 +373,14 @@ RuntimeStatus FlakeNdf::Impl::build(const TexelSource& src, int rate_in, double 
 // leaves grouped by a k-d tree over n and |J| within the tile: 0.63 / 0.67 / 0.88x the leaves at
 // 1 texel, 0.95 / 0.90 / 1.09x at 4 and 0.94 / 0.89 / 1.09x at 8 (the same flakes kept).
 void FlakeNdf::Impl::buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int tx, int ty, uint32_t* next_leaf) {
-  float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f}, jmax = 0.0f;
-  uint32_t flo[2] = {~0u, ~0u}, fhi[2] = {0u, 0u};
-  for (uint32_t i = 0; i < count; ++i) {
-    for (int a = 0; a < 2; ++a) {
-      lo[a] = std::min(lo[a], f[i].n[a]);
-      hi[a] = std::max(hi[a], f[i].n[a]);
-    }
-    jmax = std::max(jmax, f[i].jnorm);
-    flo[0] = std::min(flo[0], f[i].fx);
-    fhi[0] = std::max(fhi[0], f[i].fx);
-    flo[1] = std::min(flo[1], f[i].fy);
-    fhi[1] = std::max(fhi[1], f[i].fy);
-  }
   if (count > uint32_t(kLeafFlakes)) {
+    uint32_t flo[2] = {~0u, ~0u}, fhi[2] = {0u, 0u};
+    for (uint32_t i = 0; i < count; ++i) {
+      flo[0] = std::min(flo[0], f[i].fx);
+      fhi[0] = std::max(fhi[0], f[i].fx);
+      flo[1] = std::min(flo[1], f[i].fy);
+      fhi[1] = std::max(fhi[1], f[i].fy);
+    }
     const bool along_x = fhi[0] - flo[0] >= fhi[1] - flo[1];
     const uint32_t half = count / 2;
     std::nth_element(f, f + half, f + count, [along_x](const FlakeRec& p, const FlakeRec& q) {
@@ -395,6 +389,14 @@ void FlakeNdf::Impl::buildLeaves(size_t tile, FlakeRec* f, uint32_t count, int t
     buildLeaves(tile, f, half, tx, ty, next_leaf);
     buildLeaves(tile, f + half, count - half, tx, ty, next_leaf);
     return;
+  }
+  float lo[2] = {1e30f, 1e30f}, hi[2] = {-1e30f, -1e30f}, jmax = 0.0f;
+  for (uint32_t i = 0; i < count; ++i) {
+    for (int a = 0; a < 2; ++a) {
+      lo[a] = std::min(lo[a], f[i].n[a]);
+      hi[a] = std::max(hi[a], f[i].n[a]);
+    }
+    jmax = std::max(jmax, f[i].jnorm);
   }
   const uint32_t leaf = (*next_leaf)++;
   const uint32_t block = uint32_t(tile * kLeaves) + leaf;
