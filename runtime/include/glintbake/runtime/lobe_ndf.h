@@ -28,17 +28,18 @@
 // level whose tiles are at most 0.35 times its std (so the footprint weight varies little across
 // a tile), farther out coarser ones, a tile k levels up (k <= 3) where its nearest point lies at
 // least sqrt(2 k) standard deviations from the centre, where the weight has fallen below e^-k of
-// its peak; every lobe within 3 standard deviations of the centre counts, and tiles whose lobes
-// cannot reach s are skipped. The cut depends on the footprint only, so eval, mass, sample and
-// the images see the same lobes. It visits about 140-370 tiles where the answering level alone
-// spans 300-1200 (a disk of 3 sigma on tiles of 0.175-0.35 sigma), at a cost in image relative
-// L1 against the reference of at most 0.024 on the README's maps (sharp flakes at 24 texels,
-// 0.032 -> 0.056; leather at 32, 0.070 -> 0.077; the smooth maps unchanged); coarser tiles from
-// 1 standard deviation on doubled that error. Each query gathers the tiles of its cut by their
-// geometry, tests their bounds, and prefetches the blocks of those that pass a few tiles ahead
-// of the kernel (the blocks, about a kilobyte each, are scattered over the levels): 0.6-0.7
-// times the time of the cut without it. The kernel has two passes (a division-free test, then exp and sqrt
-// on the kept lobes only; AVX2 where the processor has it, with the same bits as the SSE2
+// its peak; every lobe within 3 standard deviations of the centre counts. The cut depends on the
+// footprint only, so eval, mass, sample and the images see the same lobes. It visits about
+// 140-370 tiles where the answering level alone spans 300-1200 (a disk of 3 sigma on tiles of
+// 0.175-0.35 sigma), at a cost in image relative L1 against the reference of at most 0.024 on the
+// README's maps (sharp flakes at 24 texels, 0.032 -> 0.056; leather at 32, 0.070 -> 0.077; the
+// smooth maps unchanged); coarser tiles from 1 standard deviation on doubled that error. Each
+// query gathers the tiles of its cut by their geometry and prefetches their blocks a few tiles
+// ahead of the kernel (the blocks, about a kilobyte each, are scattered over the levels): 0.6-0.7
+// times the time of the cut without it. Every tile of the cut goes to the kernel: a test of each
+// tile's box of lobe means skipped few and cost more than it saved (eval 0.76-0.86x the time
+// without it at 24-48 texels). The kernel has two passes (a division-free test, then exp and
+// sqrt on the kept lobes only; AVX2 where the processor has it, with the same bits as the SSE2
 // kernel). With lobes_per_tile = 16, level 0 keeps every flake as its own lobe. Below 0.35 x
 // sigma_p = 4 flakes (11.4 texels at one flake per texel) its eval, mass and sampling are those of
 // the exact flakes (flake_ndf.h, which prunes by normal within tiles) with the 3-sigma window,
