@@ -217,11 +217,10 @@ struct FlakeNdf::Impl {
     g->cyy = sigma_r2 + t.b * (j2 * j2 + j3 * j3);
   }
   // Calls visit(LeafVisit) for every leaf of the window's tiles that passes both tests:
-  // tile(bound, dmax, budget) on the tile's bounds (dmax bounds |u_Q - u_k| over the tile, budget
-  // is kMaxExponent less the smallest spatial exponent of the tile), then leaves(bounds, base_x,
-  // base_y), a mask of the tile's leaves to visit (base = u_Q - the origin of the tile's periodic
-  // image). Tiles beyond the truncation disk are skipped. The tiles of a batch are tested before
-  // their leaves are visited, in the order of the window.
+  // tile(bound, dmax2) on the tile's bounds (dmax2 bounds |u_Q - u_k|^2 over the tile), then
+  // leaves(bounds, base_x, base_y), a mask of the tile's leaves to visit (base = u_Q - the origin
+  // of the tile's periodic image). Tiles beyond the truncation disk are skipped. The tiles of a
+  // batch are tested before their leaves are visited, in the order of the window.
   template <typename TileTest, typename LeafTest, typename Visit>
   void forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafTest&& leaves, Visit&& visit) const;
   // Calls visit(WindowTile) for every tile that overlaps the window's box, in the order of the
@@ -556,12 +555,12 @@ void FlakeNdf::Impl::forEachLeaf(const FootprintTerms& t, TileTest&& tile, LeafT
     double dx, dx_min, dy, dy_min;
     span(t.uy, offy + flakePosition(w.fy0), offy + flakePosition(w.fy1), &dy, &dy_min);
     span(t.ux, offx + flakePosition(w.fx0), offx + flakePosition(w.fx1), &dx, &dx_min);
-    // What the spatial weight leaves of the exponent budget for the nearest flake of the tile.
+    // Skip the tile when its nearest flake lies beyond the truncation disk or has a spatial
+    // exponent above the whole budget.
     const double spatial_min = (dx_min * dx_min + dy_min * dy_min) * t.inv2v;
-    const double budget = kMaxExponent - spatial_min;
-    if (budget < 0.0 || spatial_min > t.spatial_cut) return;
+    if (spatial_min > t.spatial_cut || spatial_min > kMaxExponent) return;
     const size_t index = size_t(w.ty) * size_t(tiles_x) + size_t(w.tx);
-    if (!tile(tile_bounds.data[index], std::sqrt(dx * dx + dy * dy), budget)) return;
+    if (!tile(tile_bounds.data[index], dx * dx + dy * dy)) return;
     const char* bytes = reinterpret_cast<const char*>(&leaf_bounds.data[index]);
     for (size_t o = 0; o < sizeof(LeafBounds); o += 64) flakes::prefetch(bytes + o);
     flakes::prefetch(bytes + sizeof(LeafBounds) - 1);
@@ -588,7 +587,7 @@ double FlakeNdf::Impl::evalAt(const FootprintTerms& t, double sx, double sy, flo
   // too few tiles to pay for itself (eval 0.85-0.96x the time without it at 4-8 texels on the
   // README's leather, curved scratches and sharp flakes, the same lanes kept in the same order).
   // The tiles beyond the truncation disk are still skipped by forEachLeaf.
-  auto tile = [](const TileBound&, double, double) { return true; };
+  auto tile = [](const TileBound&, double) { return true; };
   // The reach test per leaf (reachMask), in float from each leaf's box of positions, normals,
   // largest |J| and variances; the budget and variance widened against float rounding.
   LeafTerms lt;
@@ -948,8 +947,8 @@ RuntimeStatus FlakeNdfAccess::windowedAverage(const FlakeNdf& f, const Footprint
       const double sd = std::sqrt(m.sigma_r2 + t.b * jmax * jmax) * 8.5;
       return hi_x + shift + sd > x0 && lo_x - shift - sd < x1 && hi_y + shift + sd > y0 && lo_y - shift - sd < y1;
     };
-    auto tile = [&](const TileBound& b, double dmax, double) {
-      return overlaps(b.lo[0], b.lo[1], b.hi[0], b.hi[1], b.jmax, dmax);
+    auto tile = [&](const TileBound& b, double dmax2) {
+      return overlaps(b.lo[0], b.lo[1], b.hi[0], b.hi[1], b.jmax, std::sqrt(dmax2));
     };
     auto leaves = [&](const LeafBounds& lb, const TileBound& tb, double base_x, double base_y) {
       uint32_t mask = 0;
@@ -993,7 +992,7 @@ RuntimeStatus FlakeNdfAccess::windowedAddImage(const FlakeNdf& f, const Footprin
   // Each lobe adds its probability over the bins, scaled to a density (divided by the bin area),
   // in the fixed order of the traversal.
   const double to_density = weight * t.wnorm / (bin * bin);
-  auto tile = [](const TileBound&, double, double) { return true; };
+  auto tile = [](const TileBound&, double) { return true; };
   auto leaves = [](const LeafBounds&, const TileBound& tb, double, double) { return leafMask(tb.leaves); };
   m.forEachLeaf(t, tile, leaves, [&](const LeafVisit& leaf) {
     m.forEachFlakeOf(leaf, t, [&](const Block& k, int i, double dx, double dy, double spatial) {

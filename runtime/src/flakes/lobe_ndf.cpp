@@ -397,7 +397,7 @@ struct LobeNdf::Impl {
   // Squared distance from the footprint centre beyond which the cut takes a tile of level li.
   static double cutLimit(const Terms& t, int li) { return 2.0 * kCoarsenStep * double(li - t.finest) * t.sp2; }
   bool terms(const Footprint& fp, Terms* t) const;
-  // Calls visit(block, bound, base_x, base_y, spatial_min, inv_a) for every tile of the footprint's
+  // Calls visit(block, bound, base_x, base_y) for every tile of the footprint's
   // cut within the spatial truncation (tiles of the answering level near the centre, of up to
   // kMaxCoarser levels above it farther out; the same tiles in the same order for every query of
   // a footprint), base = u_Q - the origin of the tile's periodic image.
@@ -653,12 +653,10 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   struct TileRef {
     size_t index;
     double bx, by, d2;
-    double spatial_min;  // set once the tile's bounds are read
   };
   constexpr int kBatch = 64, kAhead = 4;
   TileRef batch[kBatch];
   int n = 0;
-  const double inv_a = 1.0 / (t.sp2 + sigma_h2);
   auto fetch = [&](const void* p, size_t size) {
     const char* bytes = static_cast<const char*>(p);
     for (size_t o = 0; o < size; o += 64) flakes::prefetch(bytes + o);
@@ -675,18 +673,17 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
       const double spatial_min = 0.5 * r.d2 / (t.sp2 + double(bound.uu));
       if (spatial_min > kMaxSpatial) continue;
       if (kept < kAhead) fetch(blocks.data + r.index, sizeof(Block));
-      batch[kept] = r;
-      batch[kept++].spatial_min = spatial_min;
+      batch[kept++] = r;
     }
     for (int i = 0; i < kept; ++i) {
       if (i + kAhead < kept) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
       const TileRef& r = batch[i];
-      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by, r.spatial_min, inv_a);
+      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by);
     }
     n = 0;
   };
   auto accept = [&](size_t index, double bx, double by, double d2) {
-    batch[n++] = {index, bx, by, d2, 0.0};
+    batch[n++] = {index, bx, by, d2};
     if (n == kBatch) flush();
   };
   const Level& top = levels[t.coarsest];
@@ -826,7 +823,7 @@ double LobeNdf::Impl::evalAt(const Terms& t, double sx, double sy) const {
   // saved: without it eval takes 0.69-0.96x the time at 12-40 texels on the README's maps (leather
   // and curved scratches 0.73-0.78x at 24-40, sharp flakes 0.69-0.85x at 24, brushed and bumps
   // 0.90-0.96x), the same lanes kept and summed in the same order.
-  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
     n = keepLanes(wide, b, int(bound.count), c, float(bx), float(by), &list, n);
     if (n > kLaneList - kLanes) drain();
   });
@@ -855,7 +852,7 @@ double LobeNdf::Impl::massOf(const Terms& t) const {
   }
   double sum = 0.0;
   float lanes[kLanes];
-  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+  forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
     sum += laneWeights(b, bound, bx, by, t.sp2, lanes);
   });
   return t.inner_exact ? sum + innerMass(t) : sum;
@@ -938,7 +935,7 @@ RuntimeStatus LobeNdf::average(const Footprint& footprint, const SRect& rect, do
   const double y0 = std::max(rect.y0, -1.0), y1 = std::min(rect.y1, 1.0);
   double integral = 0.0;
   if (x1 > x0 && y1 > y0) {
-    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
       m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double weight) {
         integral += weight * flakes::lobeRectProbability(g, x0, x1, y0, y1, flakes::LobeAccuracy::kImage);
       });
@@ -959,7 +956,7 @@ RuntimeStatus LobeNdf::addImage(const Footprint& footprint, double weight, float
   t.skip_inner = false;  // as average
   const double bin = 2.0 / m.res;
   const double to_density = weight / (bin * bin);
-  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
     m.forEachLobe(b, bound, bx, by, t.sp2, [&](const flakes::Lobe& g, double w) {
       flakes::splatLobe(g, to_density * w, m.res, out, flakes::LobeAccuracy::kImage);
     });
@@ -991,7 +988,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
   } else if (t.exact_mode) {
     total = m.massOf(t);
   } else {
-    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+    m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
       const double w = m.laneWeights(b, bound, bx, by, t.sp2, lanes);
       total += w;
       if (tiles < kMaxSampleTiles) tile_mass[tiles] = w;
@@ -1068,7 +1065,7 @@ RuntimeStatus LobeNdfAccess::sample(const LobeNdf& lobes, const Footprint& footp
     }
   }
   int ordinal = 0;
-  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by, double, double) {
+  m.forEachTile(t, [&](const Block& b, const Bound& bound, double bx, double by) {
     if (found) return;
     if (chosen >= 0) {
       if (ordinal++ == chosen) pickIn(b, bound, bx, by);
