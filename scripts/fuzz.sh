@@ -6,12 +6,17 @@
 # the tiny PNG/EXR/TIFF maps of tests/fuzz/images/ for the ingest target (OIIO and TBB needed;
 # it runs for INGEST_SECONDS, default 15, since each input is decoded through a temporary file).
 # Corpora grow in build-fuzz/corpus/<target>/ across runs; a crash leaves its input in
-# build-fuzz/artifacts/ and fails the script. Prints "target: N execs" per target.
+# build-fuzz/artifacts/, prints it in base64 and fails the script. Prints "target: N execs" per
+# target. The mutations follow a fixed seed (GLINTBAKE_FUZZ_SEED, default 1; 0 draws a new one), so
+# that a run from the same corpus repeats the same inputs: a failure can be replayed, and a run
+# here tells what a CI run of the same length will meet. Longer runs with other seeds are how new
+# bugs are looked for.
 #   scripts/fuzz.sh [SECONDS [INGEST_SECONDS]]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
 ingest_seconds=${2:-15}
+seed=${GLINTBAKE_FUZZ_SEED:-1}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 if [[ ! -f build-fuzz/CMakeCache.txt ]]; then
@@ -49,10 +54,19 @@ for target in "${targets[@]}"; do
     cp tests/format/*.gbk tests/fuzz/assets/*.gbk "$corpus"/
   fi
   log=build-fuzz/$target.log
-  if ! "${runner[@]}" build-fuzz/bin/$target "$corpus" -max_total_time="$run_seconds" -rss_limit_mb=2048 -timeout=10 \
+  touch "build-fuzz/$target.started"
+  if ! "${runner[@]}" build-fuzz/bin/$target "$corpus" -max_total_time="$run_seconds" -seed="$seed" -rss_limit_mb=2048 -timeout=10 \
        -max_len=262144 -artifact_prefix=build-fuzz/artifacts/ -print_final_stats=1 "${extra[@]}" >"$log" 2>&1; then
     echo "$target: FAILED (see $log and build-fuzz/artifacts/)" >&2
+    grep -m1 '^INFO: Seed:' "$log" >&2 || true
     tail -30 "$log" >&2
+    # The inputs that failed, in the log itself, so that a failure on another machine can be
+    # replayed: `base64 -d > input; build-fuzz/bin/TARGET input`.
+    for artifact in build-fuzz/artifacts/*; do
+      [[ -f $artifact && $artifact -nt build-fuzz/$target.started ]] || continue
+      echo "--- $artifact ($(stat -c %s "$artifact") bytes), base64:" >&2
+      head -c 65536 "$artifact" | base64 -w 120 >&2
+    done
     status=1
   fi
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)

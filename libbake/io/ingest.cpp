@@ -35,10 +35,15 @@ namespace {
 // Some decoders behind OIIO (libpng's default error handler, for one) print their complaints on
 // stderr before OIIO turns them into an error string. Tools promise a single error line, so the
 // decoder's own output is discarded while a file is decoded; OIIO's error string carries the reason.
+// Not in fuzzing builds: there a sanitizer's or libFuzzer's report of a crash, a timeout or an
+// out-of-memory inside a decoder must reach the log.
+#if !defined(_WIN32) && !defined(FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION)
+#define GLINTBAKE_QUIET_DECODERS 1
+#endif
 class QuietStderr {
  public:
   QuietStderr() {
-#ifndef _WIN32
+#ifdef GLINTBAKE_QUIET_DECODERS
     std::fflush(stderr);
     saved_ = ::dup(STDERR_FILENO);
     const int null_fd = ::open("/dev/null", O_WRONLY);
@@ -47,7 +52,7 @@ class QuietStderr {
 #endif
   }
   ~QuietStderr() {
-#ifndef _WIN32
+#ifdef GLINTBAKE_QUIET_DECODERS
     std::fflush(stderr);
     if (saved_ >= 0) {
       ::dup2(saved_, STDERR_FILENO);
@@ -59,7 +64,7 @@ class QuietStderr {
   QuietStderr& operator=(const QuietStderr&) = delete;
 
  private:
-  int saved_ = -1;
+  [[maybe_unused]] int saved_ = -1;  // unused where decoders are not silenced
 };
 
 // Reading hints: values exactly as stored (no alpha association, which would scale RGB by alpha).
@@ -144,6 +149,14 @@ bool fileReadable(const std::string& path) {
   return f.good();
 }
 
+// The one-line reason a header walk gives for a record that claims more bytes than the file has
+// left. The name comes from the file: only its printable ASCII reaches the message.
+std::string claimsTooMuch(const std::string& what, std::string name, int64_t declared, uint64_t left) {
+  for (char& c : name) c = c >= 0x20 && c < 0x7f ? c : '?';
+  return what + " '" + name + "' declares " + std::to_string(declared) + " bytes, more than the " +
+         std::to_string(left) + " left in the file";
+}
+
 // OpenEXR (3.1) allocates every header attribute at the size the file declares before reading it,
 // so a 1 KB file can cost gigabytes before OIIO returns. The attributes of every header are walked
 // here first, skipping their values: each must lie inside the file. False (and *why) otherwise.
@@ -182,10 +195,7 @@ bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
           int32_t(uint32_t(bytes[0]) | uint32_t(bytes[1]) << 8 | uint32_t(bytes[2]) << 16 | uint32_t(bytes[3]) << 24);
       const uint64_t at = uint64_t(f.tellg());
       if (value_size < 0 || uint64_t(value_size) > size - std::min(size, at)) {
-        // The name comes from the file: only printable ASCII of it reaches the one-line error.
-        for (char& c : name) c = c >= 0x20 && c < 0x7f ? c : '?';
-        *why = "OpenEXR attribute '" + name + "' declares " + std::to_string(value_size) + " bytes, more than the " +
-               std::to_string(size - std::min(size, at)) + " left in the file";
+        *why = claimsTooMuch("OpenEXR attribute", name, value_size, size - std::min(size, at));
         return false;
       }
       f.seekg(std::streamoff(value_size), std::ios::cur);
@@ -202,6 +212,35 @@ bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
   }
 }
 
+// libpng allocates each chunk at the length the file declares before reading it (up to 2^31 - 1
+// bytes: a 559-byte PNG can ask for 1.9 GB), unless it was built with a chunk size limit. The
+// chunks are walked here first, skipping their data: each must lie inside the file, CRC included.
+// A file that ends between chunks, before IEND, is left to libpng to refuse.
+bool pngChunksFitTheFile(const std::string& path, std::string* why) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  std::ifstream f(path, std::ios::binary);
+  unsigned char start[8] = {};
+  if (!f.read(reinterpret_cast<char*>(start), 8) || !std::equal(start, start + 8, kSignature)) return true;
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return true;
+  for (uint64_t at = 8; at + 8 <= size;) {
+    unsigned char head[8] = {};
+    if (!f.seekg(std::streamoff(at)) || !f.read(reinterpret_cast<char*>(head), 8)) return true;
+    const uint64_t length =
+        uint64_t(head[0]) << 24 | uint64_t(head[1]) << 16 | uint64_t(head[2]) << 8 | uint64_t(head[3]);
+    const std::string type(reinterpret_cast<const char*>(head + 4), 4);
+    const uint64_t left = size - (at + 8);
+    if (length + 4 > left) {
+      *why = claimsTooMuch("PNG chunk", type, int64_t(length), left < 4 ? 0 : left - 4);
+      return false;
+    }
+    if (type == "IEND") return true;
+    at += 12 + length;
+  }
+  return true;
+}
+
 // Opens the image (and the requested part) after the checks that need no decoding.
 Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
@@ -214,7 +253,7 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
   if (!fileReadable(path)) {
     return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
   }
-  if (std::string why; !exrHeadersFitTheFile(path, &why)) {
+  if (std::string why; !exrHeadersFitTheFile(path, &why) || !pngChunksFitTheFile(path, &why)) {
     return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + why + ")");
   }
   const OIIO::ImageSpec config = readConfig();

@@ -555,6 +555,39 @@ TEST(Ingest, ExrAttributeLargerThanTheFileIsInvalid) {
       << map.error().message;
 }
 
+// libpng allocates a chunk at its declared length before reading it: a PNG whose chunk claims more
+// bytes than the file holds is refused before OIIO opens it (found by fuzz_ingest: a 559-byte file
+// whose tEXt chunk declared 1.9 GB).
+TEST(Ingest, PngChunkLargerThanTheFileIsInvalid) {
+  ScratchDir dir;
+  const std::string path = dir.file("chunk.png");
+  writeFloats(path, 4, 4, 3, OIIO::TypeDesc::UINT8, std::vector<float>(4 * 4 * 3, 0.5f));
+  std::string bytes = test::readBytes(path);
+  ASSERT_EQ(bytes.substr(12, 4), "IHDR");
+  // After IHDR (8 signature + 12 framing + 13 data bytes): a tEXt chunk declaring 0x6f660000.
+  std::string chunk("\x6f\x66\x00\x00tE\nt", 8);
+  chunk += std::string(64, 'x');
+  bytes.insert(33, chunk);
+  test::writeBytes(path, bytes);
+  auto map = load(path, nullptr);
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.error().code, ErrorCode::kInvalidInput);
+  expectOneLineNaming(map.error(), "chunk.png");
+  EXPECT_NE(map.error().message.find("PNG chunk 'tE?t' declares 1868955648 bytes"), std::string::npos)
+      << map.error().message;
+
+  // A PNG cut inside a chunk is refused the same way, naming the chunk it ends in.
+  writeFloats(path, 4, 4, 3, OIIO::TypeDesc::UINT8, std::vector<float>(4 * 4 * 3, 0.5f));
+  const std::string cut = test::readBytes(path);
+  const size_t idat = cut.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  test::writeBytes(path, cut.substr(0, idat + 6));
+  map = load(path, nullptr);
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.error().code, ErrorCode::kInvalidInput);
+  EXPECT_NE(map.error().message.find("PNG chunk 'IDAT' declares"), std::string::npos) << map.error().message;
+}
+
 TEST(Ingest, GarbageFileIsInvalid) {
   ScratchDir dir;
   const std::string path = dir.file("garbage.png");
