@@ -158,29 +158,22 @@ using V = flakes::F8;
 #include "flake_kernel.inc"
 }  // namespace avx2
 GLINTBAKE_FLAKES_AVX2_END
+#else
+namespace avx2 = sse;  // no AVX2 copy: both names are the SSE2 kernels
 #endif
 
 // The kernels of the processor: AVX2 where it has it (the same bits), else SSE2 or scalar.
 int keepLanes(bool wide, const Block& k, const KernelTerms& c, float bx, float by, LaneList* list, int n) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::keepLanes(k, c, bx, by, list, n);
-#endif
-  (void)wide;
-  return sse::keepLanes(k, c, bx, by, list, n);
+  return wide ? avx2::keepLanes(k, c, bx, by, list, n) : sse::keepLanes(k, c, bx, by, list, n);
 }
 void laneValues(bool wide, LaneList* list, int n, float cutoff) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::laneValues(list, n, cutoff);
-#endif
-  (void)wide;
-  sse::laneValues(list, n, cutoff);
+  if (wide)
+    avx2::laneValues(list, n, cutoff);
+  else
+    sse::laneValues(list, n, cutoff);
 }
 uint32_t reachMask(bool wide, const LeafBounds& lb, const LeafTerms& c, float bx, float by) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::reachMask(lb, c, bx, by);
-#endif
-  (void)wide;
-  return sse::reachMask(lb, c, bx, by);
+  return wide ? avx2::reachMask(lb, c, bx, by) : sse::reachMask(lb, c, bx, by);
 }
 
 }  // namespace

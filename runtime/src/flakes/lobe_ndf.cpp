@@ -319,31 +319,27 @@ using V = flakes::F8;
 #include "lobe_kernel.inc"
 }  // namespace avx2
 GLINTBAKE_FLAKES_AVX2_END
+#else
+namespace avx2 = sse;  // no AVX2 copy: both names are the SSE2 kernels
 #endif
 
 // The kernels of the processor: AVX2 where it has it (the same bits), else SSE2 or scalar.
 int keepLanes(bool wide, const Block& b, int count, const KernelTerms& c, float bx, float by, LaneList* list, int n) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::keepLanes(b, count, c, bx, by, list, n);
-#endif
-  (void)wide;
-  return sse::keepLanes(b, count, c, bx, by, list, n);
+  return wide ? avx2::keepLanes(b, count, c, bx, by, list, n) : sse::keepLanes(b, count, c, bx, by, list, n);
 }
 void laneValues(bool wide, LaneList* list, int n, float cutoff) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::laneValues(list, n, cutoff);
-#endif
-  (void)wide;
-  sse::laneValues(list, n, cutoff);
+  if (wide)
+    avx2::laneValues(list, n, cutoff);
+  else
+    sse::laneValues(list, n, cutoff);
 }
 
 void laneWeightKernel(bool wide, const Block& b, int count, float sp2, float bx, float by, float scale, float cut,
                       float* lanes) {
-#if GLINTBAKE_FLAKES_AVX2
-  if (wide) return avx2::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
-#endif
-  (void)wide;
-  sse::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
+  if (wide)
+    avx2::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
+  else
+    sse::laneWeights(b, count, sp2, bx, by, scale, cut, lanes);
 }
 
 // The footprint terms of one query: centre (reduced into the map for repeating maps), sigma_p^2,
