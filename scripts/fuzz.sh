@@ -3,8 +3,9 @@
 # Builds the libFuzzer targets (clang, runtime-only configuration, in build-fuzz/) and runs each for
 # SECONDS (default 20), seeded from valid files of every kind: the frozen containers of
 # tests/format/ for the container and runtime targets, tests/fuzz/json/ for the JSON target and
-# the tiny PNG/EXR/TIFF maps of tests/fuzz/images/ for the ingest target (OIIO and TBB needed;
-# it runs for INGEST_SECONDS, default 15, since each input is decoded through a temporary file).
+# the tiny PNG/EXR/TIFF/JPEG/WebP maps of tests/fuzz/images/ for the ingest target (OIIO and TBB
+# needed; it runs for INGEST_SECONDS, default 15, since each input is decoded through a temporary
+# file).
 # Corpora grow in build-fuzz/corpus/<target>/ across runs; a crash leaves its input in
 # build-fuzz/artifacts/, prints it in base64 and fails the script. Prints "target: N execs" per
 # target. The mutations follow a fixed seed (GLINTBAKE_FUZZ_SEED, default 1; 0 draws a new one), so
