@@ -47,6 +47,14 @@ whose binary is unchanged reuses every result. Footprints are
 drawn from Random((seed, map hash, sigma)), so the same seed gives the same footprints on every run
 and for every asset, and a new asset reuses all references.
 
+Targets (--targets MEDIAN:P90:RATIO, default 0.12:0.25:0.35, the quality targets of the NDF
+paths): every cell (map, sigma, asset) must have a median error <= MEDIAN, a 90th percentile
+<= P90, and a median <= RATIO times the baseline's median. Where the baseline's median is below
+--floor (default 1e-4) the footprint sees the whole map's NDF and both images are equal up to float
+rounding: the ratio is not taken there, and the cell meets it if the asset's median is below the
+floor too. The markdown ends with the worst cell of each test per asset and every cell that misses;
+the JSON carries the same under "targets"; --check exits 1 when a cell misses.
+
 Usage:
   # bake the current defaults and score them (the "before" run of bench/fidelity-survey.md)
   python3 scripts/fidelity.py /path/maps/*.png \\
@@ -563,11 +571,22 @@ def parse_args(argv):
     ap.add_argument("--bin", default=os.path.join(REPO, "build", "bin"))
     ap.add_argument("--cache", default=os.path.join(REPO, "build", "fidelity-cache"))
     ap.add_argument("--jobs", type=int, default=2, help="tool processes at a time (default 2)")
+    ap.add_argument("--targets", default="0.12:0.25:0.35", metavar="MEDIAN:P90:RATIO",
+                    help="quality targets per cell (default 0.12:0.25:0.35; see the module help)")
+    ap.add_argument("--floor", type=float, default=1e-4,
+                    help="baseline median below which the ratio target is not taken (default 1e-4)")
+    ap.add_argument("--check", action="store_true", help="exit 1 when a cell misses a target")
     ap.add_argument("--markdown", help="write the markdown tables here (always printed)")
     ap.add_argument("--json", dest="json_out", help="write every measurement as JSON here")
     args = ap.parse_args(argv)
     if args.splat_above is not None and args.splat_above < 0:
         args.splat_above = None
+    try:
+        args.targets = tuple(float(v) for v in args.targets.split(":"))
+    except ValueError:
+        args.targets = ()
+    if len(args.targets) != 3 or not all(v > 0 for v in args.targets):
+        ap.error("--targets must be MEDIAN:P90:RATIO, three numbers > 0")
     if not args.asset and not args.bake and args.baseline == "none":
         ap.error("nothing to measure: give --asset, --bake or a baseline")
     return args
@@ -648,6 +667,7 @@ def main(argv):
     pool.shutdown()
 
     results["bands"] = args.band
+    results["targets"] = check_targets(results, labels, args.targets, args.floor)
     md = render_markdown(results, labels)
     print(md)
     if args.markdown:
@@ -656,7 +676,38 @@ def main(argv):
     if args.json_out:
         with open(args.json_out, "w") as f:
             json.dump(results, f, indent=1)
-    return 0
+    return 1 if args.check and any(t["misses"] for t in results["targets"]["assets"].values()) else 0
+
+
+def check_targets(results, labels, targets, floor):
+    """Each asset's worst cell for each target, and the cells that miss one (see the module help)."""
+    median_max, p90_max, ratio_max = targets
+    summary = {"median": median_max, "p90": p90_max, "ratio": ratio_max, "floor": floor, "assets": {}}
+    for label in labels:
+        worst = {"median": None, "p90": None, "ratio": None}
+        misses = []
+        for entry in results["maps"]:
+            for row in entry["sigmas"]:
+                errors = row["errors"].get(label)
+                if not errors:
+                    continue
+                where = {"map": entry["map"]["name"], "sigma": row["sigma"]}
+                median, p90 = statistics.median(errors), _percentile(errors, 90)
+                base = row["errors"].get("baseline")
+                base_median = statistics.median(base) if base else None
+                ratio = median / base_median if base_median is not None and base_median >= floor else None
+                for name, value in (("median", median), ("p90", p90), ("ratio", ratio)):
+                    if value is not None and (worst[name] is None or value > worst[name]["value"]):
+                        worst[name] = dict(where, value=value)
+                missed = [name for name, value, bound in (("median", median, median_max), ("p90", p90, p90_max),
+                                                          ("ratio", ratio, ratio_max))
+                          if value is not None and not value <= bound]
+                if base_median is not None and base_median < floor and not median < floor:
+                    missed.append("floor")
+                if missed:
+                    misses.append(dict(where, missed=missed, median=median, p90=p90, baseline=base_median))
+        summary["assets"][label] = {"worst": worst, "misses": misses}
+    return summary
 
 
 def render_markdown(results, labels):
@@ -686,6 +737,21 @@ def render_markdown(results, labels):
                 cells.append("**%.3f / %.3f**" % (statistics.median(v), _percentile(v, 90)) if v else "-")
             count = sum(len(r["footprints"]) for r in rows)
             out.append("| **%s to %s** | %d | %s |" % (_fmt_num(lo), _fmt_num(hi), count, " | ".join(cells)))
+    t = results.get("targets")
+    if t and t["assets"]:
+        bounds = (_fmt_num(t["median"]), _fmt_num(t["p90"]), _fmt_num(t["ratio"]), t["floor"])
+        out.append("\nTargets: median <= %s, 90th percentile <= %s, median <= %s x the baseline's (not taken "
+                   "where the baseline is below %s). Worst cell of each:\n" % bounds)
+        out.append("| asset | median | 90th percentile | ratio to the baseline | cells missing a target |")
+        out.append("|---|---|---|---|---|")
+        for label, a in t["assets"].items():
+            cells = []
+            for name in ("median", "p90", "ratio"):
+                w = a["worst"][name]
+                cells.append("-" if w is None else "%.3f (%s, %s)" % (w["value"], w["map"], _fmt_num(w["sigma"])))
+            missed = "; ".join("%s %s: %s" % (m["map"], _fmt_num(m["sigma"]), ", ".join(m["missed"]))
+                               for m in a["misses"]) or "none"
+            out.append("| %s | %s | %s |" % (label, " | ".join(cells), missed))
     out.append("\nBakes:\n")
     out.append("| map | asset | command | bake wall (s) | bake CPU (s) | size (MB) | level sigmas |")
     out.append("|---|---|---|---|---|---|---|")

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """scripts/fidelity.py: its splatted references of large footprints (one footprint baked by ndfgen
 on a shifted copy of the map) are the images the exact reference evaluator gives, on axes that the
-footprint is flat over, and on axes repeated over 2 and 6 periods."""
+footprint is flat over, and on axes repeated over 2 and 6 periods; its target check finds the worst
+cells and every miss, and leaves the ratio out where the baseline is at float rounding."""
 
 import os
 import struct
@@ -36,6 +37,39 @@ class SplatReference(clitest.ToolTestCase):
                             "--res", params["res"], "--sigma-r", params["sigma_r"], "-o", exact)
                 error = fidelity._rel_l1(fidelity._read_exr(splat)[2], fidelity._read_exr(exact)[2])
                 self.assertLess(error, 2e-3)
+
+
+class Targets(clitest.ToolTestCase):
+    @staticmethod
+    def results(cells):
+        """One map; cells: (sigma, asset errors, baseline errors)."""
+        rows = [{"sigma": sigma, "footprints": [{}] * len(errors), "errors": {"a": errors, "baseline": base}}
+                for sigma, errors, base in cells]
+        return {"baseline": "splat", "maps": [{"map": {"name": "m.png", "width": 64, "height": 64}, "bakes": {},
+                                               "sigmas": rows}]}
+
+    def test_worst_cells_and_misses(self):
+        results = self.results([
+            (1.0, [0.01, 0.02, 0.03], [1.0, 1.2, 1.4]),      # meets all three
+            (8.0, [0.10, 0.11, 0.40], [0.5, 0.5, 0.5]),      # 90th percentile 0.342 > 0.25
+            (32.0, [0.05, 0.06, 0.07], [0.1, 0.1, 0.1]),     # ratio 0.6 > 0.35
+            (256.0, [2e-5, 3e-5, 4e-5], [3e-6, 3e-6, 4e-6]),  # both at float rounding: met
+        ])
+        t = fidelity.check_targets(results, ["a"], (0.12, 0.25, 0.35), 1e-4)["assets"]["a"]
+        self.assertEqual([(m["sigma"], m["missed"]) for m in t["misses"]], [(8.0, ["p90"]), (32.0, ["ratio"])])
+        self.assertEqual(t["worst"]["median"]["sigma"], 8.0)
+        self.assertAlmostEqual(t["worst"]["median"]["value"], 0.11)
+        self.assertAlmostEqual(t["worst"]["p90"]["value"], 0.342)
+        self.assertEqual(t["worst"]["ratio"]["sigma"], 32.0)
+        self.assertAlmostEqual(t["worst"]["ratio"]["value"], 0.6)
+        # Below the floor the baseline is not a ratio's denominator, but the asset must be there too.
+        results = self.results([(256.0, [5e-4, 6e-4, 7e-4], [3e-6, 3e-6, 4e-6])])
+        t = fidelity.check_targets(results, ["a"], (0.12, 0.25, 0.35), 1e-4)["assets"]["a"]
+        self.assertEqual([m["missed"] for m in t["misses"]], [["floor"]])
+        self.assertIsNone(t["worst"]["ratio"])
+        md = fidelity.render_markdown(dict(results, targets=fidelity.check_targets(
+            results, ["a"], (0.12, 0.25, 0.35), 1e-4)), ["a"])
+        self.assertIn("m.png 256: floor", md)
 
 
 if __name__ == "__main__":
