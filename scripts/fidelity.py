@@ -53,7 +53,8 @@ paths): every cell (map, sigma, asset) must have a median error <= MEDIAN, a 90t
 --floor (default 1e-4) the footprint sees the whole map's NDF and both images are equal up to float
 rounding: the ratio is not taken there, and the cell meets it if the asset's median is below the
 floor too. The markdown ends with the worst cell of each test per asset and every cell that misses;
-the JSON carries the same under "targets"; --check exits 1 when a cell misses.
+the JSON carries the same under "targets"; --check exits 1 when a cell misses (or an asset
+has no measurement on a map, when its bake failed).
 
 Usage:
   # bake the current defaults and score them (the "before" run of bench/fidelity-survey.md)
@@ -687,6 +688,8 @@ def check_targets(results, labels, targets, floor):
         worst = {"median": None, "p90": None, "ratio": None}
         misses = []
         for entry in results["maps"]:
+            if not any(row["errors"].get(label) for row in entry["sigmas"]):  # its bake failed
+                misses.append({"map": entry["map"]["name"], "sigma": None, "missed": ["not measured"]})
             for row in entry["sigmas"]:
                 errors = row["errors"].get(label)
                 if not errors:
@@ -749,8 +752,8 @@ def render_markdown(results, labels):
             for name in ("median", "p90", "ratio"):
                 w = a["worst"][name]
                 cells.append("-" if w is None else "%.3f (%s, %s)" % (w["value"], w["map"], _fmt_num(w["sigma"])))
-            missed = "; ".join("%s %s: %s" % (m["map"], _fmt_num(m["sigma"]), ", ".join(m["missed"]))
-                               for m in a["misses"]) or "none"
+            missed = "; ".join("%s%s: %s" % (m["map"], "" if m["sigma"] is None else " " + _fmt_num(m["sigma"]),
+                                              ", ".join(m["missed"])) for m in a["misses"]) or "none"
             out.append("| %s | %s | %s |" % (label, " | ".join(cells), missed))
     out.append("\nBakes:\n")
     out.append("| map | asset | command | bake wall (s) | bake CPU (s) | size (MB) | level sigmas |")

@@ -70,6 +70,9 @@ class Targets(clitest.ToolTestCase):
         md = fidelity.render_markdown(dict(results, targets=fidelity.check_targets(
             results, ["a"], (0.12, 0.25, 0.35), 1e-4)), ["a"])
         self.assertIn("m.png 256: floor", md)
+        # An asset with no measurement (its bake failed) misses on that map.
+        t = fidelity.check_targets(results, ["a", "b"], (0.12, 0.25, 0.35), 1e-4)["assets"]["b"]
+        self.assertEqual([(m["map"], m["missed"]) for m in t["misses"]], [("m.png", ["not measured"])])
 
 
 if __name__ == "__main__":
