@@ -49,7 +49,8 @@ and for every asset, and a new asset reuses all references.
 
 Targets (--targets MEDIAN:P90:RATIO, default 0.12:0.25:0.35, the quality targets of the NDF
 paths): every cell (map, sigma, asset) must have a median error <= MEDIAN, a 90th percentile
-<= P90, and a median <= RATIO times the baseline's median. Where the baseline's median is below
+<= P90, and a median <= RATIO times the median of the baseline of its own reference parameters
+(one per NDF resolution when the assets differ in it). Where the baseline's median is below
 --floor (default 1e-4) the footprint sees the whole map's NDF and both images are equal up to float
 rounding: the ratio is not taken there, and the cell meets it if the asset's median is below the
 floor too. The markdown ends with the worst cell of each test per asset and every cell that misses;
@@ -638,7 +639,7 @@ def main(argv):
             # distinct reference parameter sets among the assets (R, sigma_r, rate)
             pkeys = {}
             for label, path, params in assets:
-                pkeys.setdefault((params["res"], params["sigma_r"], params["rate"], tuple(params["ingest"])), params)
+                pkeys.setdefault(baseline_key(params), params)
             if not pkeys:
                 pkeys[(args.res, args.sigma_r, 1, ())] = {"res": args.res, "sigma_r": args.sigma_r, "rate": 1, "ingest": []}
             refs = {}
@@ -654,13 +655,16 @@ def main(argv):
                 refs[k] = f.result()
             row = {"sigma": sigma, "footprints": [{"x": x, "y": y} for x, y in fps], "errors": {}}
             for label, path, params in assets:
-                pk = (params["res"], params["sigma_r"], params["rate"], tuple(params["ingest"]))
+                pk = baseline_key(params)
                 row["errors"][label] = [_rel_l1(qfuts[(label, i)].result(), refs[(pk, i)]) for i in range(len(fps))]
             if args.baseline != "none":
+                names = {}
                 for pk, params in pkeys.items():
                     base = h.baseline(map_path, minfo, params, mean_of=[refs[(pk, i)] for i in range(len(fps))])
-                    name = "baseline" if len(pkeys) == 1 else "baseline R%d" % pk[0]
-                    row["errors"][name] = [_rel_l1(base, refs[(pk, i)]) for i in range(len(fps))]
+                    names[pk] = "baseline" if len(pkeys) == 1 else "baseline R%d" % pk[0]
+                    row["errors"][names[pk]] = [_rel_l1(base, refs[(pk, i)]) for i in range(len(fps))]
+                # Each asset's ratio target is taken against the baseline of its own reference parameters.
+                row["baseline_of"] = {label: names[baseline_key(params)] for label, path, params in assets}
             entry["sigmas"].append(row)
             sys.stderr.write("%s sigma %g: %s (%.0f s)\n" % (minfo["name"], sigma, "  ".join(
                 "%s %.3f" % (k, statistics.median(v)) for k, v in row["errors"].items()), time.time() - t_start))
@@ -680,6 +684,12 @@ def main(argv):
     return 1 if args.check and any(t["misses"] for t in results["targets"]["assets"].values()) else 0
 
 
+def baseline_key(params):
+    """The reference parameters an asset is scored with (NDF resolution, sigma_r, rate, ingest): assets
+    that share them share references and a baseline."""
+    return (params["res"], params["sigma_r"], params["rate"], tuple(params["ingest"]))
+
+
 def check_targets(results, labels, targets, floor):
     """Each asset's worst cell for each target, and the cells that miss one (see the module help)."""
     median_max, p90_max, ratio_max = targets
@@ -696,7 +706,7 @@ def check_targets(results, labels, targets, floor):
                     continue
                 where = {"map": entry["map"]["name"], "sigma": row["sigma"]}
                 median, p90 = statistics.median(errors), _percentile(errors, 90)
-                base = row["errors"].get("baseline")
+                base = row["errors"].get(row.get("baseline_of", {}).get(label, "baseline"))
                 base_median = statistics.median(base) if base else None
                 ratio = median / base_median if base_median is not None and base_median >= floor else None
                 for name, value in (("median", median), ("p90", p90), ("ratio", ratio)):

@@ -74,6 +74,19 @@ class Targets(clitest.ToolTestCase):
         t = fidelity.check_targets(results, ["a", "b"], (0.12, 0.25, 0.35), 1e-4)["assets"]["b"]
         self.assertEqual([(m["map"], m["missed"]) for m in t["misses"]], [("m.png", ["not measured"])])
 
+    def test_each_asset_is_measured_against_its_own_baseline(self):
+        # Assets of two NDF resolutions: two references and two baselines, one per resolution.
+        row = {"sigma": 32.0, "footprints": [{}] * 3,
+               "errors": {"a": [0.05, 0.06, 0.07], "b": [0.05, 0.06, 0.07],
+                          "baseline R32": [0.1, 0.1, 0.1], "baseline R64": [0.5, 0.5, 0.5]},
+               "baseline_of": {"a": "baseline R32", "b": "baseline R64"}}
+        results = {"baseline": "splat", "maps": [{"map": {"name": "m.png"}, "bakes": {}, "sigmas": [row]}]}
+        t = fidelity.check_targets(results, ["a", "b"], (0.12, 0.25, 0.35), 1e-4)["assets"]
+        self.assertAlmostEqual(t["a"]["worst"]["ratio"]["value"], 0.6)
+        self.assertEqual([m["missed"] for m in t["a"]["misses"]], [["ratio"]])
+        self.assertAlmostEqual(t["b"]["worst"]["ratio"]["value"], 0.12)
+        self.assertEqual(t["b"]["misses"], [])
+
 
 if __name__ == "__main__":
     clitest.main()
