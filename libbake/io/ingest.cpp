@@ -144,11 +144,6 @@ void heightsToNormals(const std::vector<float>& heights, double k, NormalMap* ma
   });
 }
 
-bool fileReadable(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return f.good();
-}
-
 // The one-line reason a header walk gives for a record that claims more bytes than the file has
 // left. The name comes from the file: only its printable ASCII reaches the message.
 std::string claimsTooMuch(const std::string& what, std::string name, int64_t declared, uint64_t left) {
@@ -160,14 +155,8 @@ std::string claimsTooMuch(const std::string& what, std::string name, int64_t dec
 // OpenEXR (3.1) allocates every header attribute at the size the file declares before reading it,
 // so a 1 KB file can cost gigabytes before OIIO returns. The attributes of every header are walked
 // here first, skipping their values: each must lie inside the file. False (and *why) otherwise.
-bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
-  std::ifstream f(path, std::ios::binary);
-  unsigned char start[8] = {};
-  if (!f.read(reinterpret_cast<char*>(start), 8)) return true;  // not OpenEXR: OIIO decides
-  if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01)) return true;
-  std::error_code ec;
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) return true;
+// f stands after the file's first 8 bytes, `start`; size: the file's.
+bool exrHeadersFitTheFile(std::istream& f, const unsigned char* start, uint64_t size, std::string* why) {
   const bool multipart = (start[5] & 0x10) != 0;  // version flags bit 12
   auto readName = [&](std::string* out) {
     out->clear();
@@ -215,15 +204,8 @@ bool exrHeadersFitTheFile(const std::string& path, std::string* why) {
 // libpng allocates each chunk at the length the file declares before reading it (up to 2^31 - 1
 // bytes: a 559-byte PNG can ask for 1.9 GB), unless it was built with a chunk size limit. The
 // chunks are walked here first, skipping their data: each must lie inside the file, CRC included.
-// A file that ends between chunks, before IEND, is left to libpng to refuse.
-bool pngChunksFitTheFile(const std::string& path, std::string* why) {
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  std::ifstream f(path, std::ios::binary);
-  unsigned char start[8] = {};
-  if (!f.read(reinterpret_cast<char*>(start), 8) || !std::equal(start, start + 8, kSignature)) return true;
-  std::error_code ec;
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) return true;
+// A file that ends between chunks, before IEND, is left to libpng to refuse. size: the file's.
+bool pngChunksFitTheFile(std::istream& f, uint64_t size, std::string* why) {
   for (uint64_t at = 8; at + 8 <= size;) {
     unsigned char head[8] = {};
     if (!f.seekg(std::streamoff(at)) || !f.read(reinterpret_cast<char*>(head), 8)) return true;
@@ -241,6 +223,26 @@ bool pngChunksFitTheFile(const std::string& path, std::string* why) {
   return true;
 }
 
+// The checks on a file before any decoder sees it, from one open: kUnreadable when it cannot be
+// opened, kRefused (and *why) when its OpenEXR headers or PNG chunks claim more bytes than it
+// holds; files of other formats, or too short to tell, are left to OIIO.
+enum class HeaderWalk { kFits, kUnreadable, kRefused };
+HeaderWalk walkHeaders(const std::string& path, std::string* why) {
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  static const unsigned char kExr[4] = {0x76, 0x2f, 0x31, 0x01};
+  std::ifstream f(path, std::ios::binary);
+  if (!f.good()) return HeaderWalk::kUnreadable;
+  unsigned char start[8] = {};
+  if (!f.read(reinterpret_cast<char*>(start), 8)) return HeaderWalk::kFits;
+  const bool exr = std::equal(start, start + 4, kExr), png = std::equal(start, start + 8, kPng);
+  if (!exr && !png) return HeaderWalk::kFits;
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) return HeaderWalk::kFits;
+  const bool fits = exr ? exrHeadersFitTheFile(f, start, size, why) : pngChunksFitTheFile(f, size, why);
+  return fits ? HeaderWalk::kFits : HeaderWalk::kRefused;
+}
+
 // Opens the image (and the requested part) after the checks that need no decoding.
 Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
@@ -250,11 +252,14 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
   if (std::filesystem::is_directory(path, ec)) {
     return makeError(ErrorCode::kIo, path + ": is a directory, not an image file");
   }
-  if (!fileReadable(path)) {
-    return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
-  }
-  if (std::string why; !exrHeadersFitTheFile(path, &why) || !pngChunksFitTheFile(path, &why)) {
-    return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + why + ")");
+  std::string why;
+  switch (walkHeaders(path, &why)) {
+    case HeaderWalk::kUnreadable:
+      return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
+    case HeaderWalk::kRefused:
+      return makeError(ErrorCode::kInvalidInput, path + ": not a readable image (" + why + ")");
+    case HeaderWalk::kFits:
+      break;
   }
   const OIIO::ImageSpec config = readConfig();
   auto input = OIIO::ImageInput::open(path, &config);
