@@ -194,14 +194,25 @@ class HostileContainers(clitest.ToolTestCase):
         self.assertIn("5003", err)
 
 
-def png_file(width, height, idat=b"", colour_type=2, bit_depth=8):
+def png_file(width, height, idat=b"", colour_type=2, bit_depth=8, after_ihdr=b""):
     """A PNG whose header declares width x height and whose IDAT holds `idat` (default: an empty,
-    finished zlib stream), however little that is."""
+    finished zlib stream), however little that is; `after_ihdr`: raw bytes put between IHDR and IDAT."""
     def chunk(kind, data):
         return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
     ihdr = struct.pack(">IIBBBBB", width, height, bit_depth, colour_type, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat or zlib.compress(b"")) +
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + after_ihdr + chunk(b"IDAT", idat or zlib.compress(b"")) +
             chunk(b"IEND", b""))
+
+
+def tiff_file(width, height, extra_tag):
+    """A little-endian 8-bit RGB TIFF of one uncompressed strip, with one more IFD entry
+    (tag, type, count, offset) whose data may lie anywhere, in the file or beyond it."""
+    strip = width * height * 3
+    entries = sorted([(256, 4, 1, width), (257, 4, 1, height), (258, 3, 1, 8), (259, 3, 1, 1), (262, 3, 1, 2),
+                      (273, 4, 1, 300), (277, 3, 1, 3), (278, 4, 1, height), (279, 4, 1, strip), extra_tag])
+    ifd = struct.pack("<H", len(entries)) + b"".join(struct.pack("<HHII", *e) for e in entries) + struct.pack("<I", 0)
+    head = (b"II*\0" + struct.pack("<I", 8) + ifd).ljust(300, b"\0")
+    return head + bytes([128, 128, 255]) * (width * height)
 
 
 def exr_file(width, height, compression, first=b""):
@@ -237,11 +248,14 @@ class HostileImages(clitest.ToolTestCase):
         files["piz.exr"] = exr_file(8192, 8192, 4)  # unbounded ratio: its last row is read first
         # A 64 x 64 file whose first attribute declares a 1.8 GB string (OpenEXR allocates it).
         files["attr.exr"] = exr_file(64, 64, 3, first=b"Software\0string\0" + struct.pack("<i", 0x6E000000))
+        # A 4 x 4 PNG with a chunk declaring 1.9 GB (libpng allocates a chunk at its declared length).
+        files["chunk.png"] = png_file(4, 4, after_ihdr=struct.pack(">I", 0x6F660000) + b"tEXtComment\0" + b"x" * 16)
         return {name: self.write(name, data) for name, data in files.items()}
 
     EXPECTED = {"tiny.png": "cannot hold the declared 8192x8192 image", "cut.png": "1032:1",
                 "zip.exr": "cannot hold the declared 8192x8192 image", "piz.exr": "corrupt or truncated",
-                "attr.exr": "attribute 'Software' declares 1845493760 bytes"}
+                "attr.exr": "attribute 'Software' declares 1845493760 bytes",
+                "chunk.png": "PNG chunk 'tEXt' declares 1868955648 bytes"}
 
     def test_every_ingesting_tool_refuses_before_allocating(self):
         files = self.hostile_files()
@@ -258,6 +272,19 @@ class HostileImages(clitest.ToolTestCase):
                 err = self.assert_fails(INVALID, *args, outputs=[gbk, exr], limits=MEMORY_LIMIT)
                 self.assertIn(name, err)
                 self.assertIn(self.EXPECTED[name], err)
+
+    def test_tiff_tags_beyond_the_file_cost_no_memory(self):
+        # TIFF has no walk of its own before decoding: libtiff checks a tag's data against the file
+        # before allocating it. A 4 x 4 map whose description declares 2 GB (ASCII, or UNDEFINED as an
+        # ICC profile) reads in bounded memory; its pixels are whole, so it bakes.
+        gbk = self.path("out.gbk")
+        for tag in ((270, 2, 0x7FFFFFF0, 200), (34675, 7, 0x7FFFFFF0, 200)):
+            path = self.write("tag%d.tif" % tag[0], tiff_file(4, 4, tag))
+            self.assertLess(os.path.getsize(path), 400)
+            for args in (("ndfgen", path, "-o", gbk, *NDF),
+                         ("glintref", "ndf", path, "--at", "2,2", "--sigma", "1", "--s", "0,0")):
+                code, out, err = clitest.run(*args, limits=MEMORY_LIMIT)
+                self.assertEqual(code, OK, err)
 
     def test_manifest_assets_fail_alike(self):
         files = self.hostile_files()
