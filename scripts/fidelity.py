@@ -641,7 +641,8 @@ def main(argv):
             for label, path, params in assets:
                 pkeys.setdefault(baseline_key(params), params)
             if not pkeys:
-                pkeys[(args.res, args.sigma_r, 1, ())] = {"res": args.res, "sigma_r": args.sigma_r, "rate": 1, "ingest": []}
+                params = {"res": args.res, "sigma_r": args.sigma_r, "rate": 1, "ingest": []}
+                pkeys[baseline_key(params)] = params
             refs = {}
             futs = {}
             for pk, params in pkeys.items():

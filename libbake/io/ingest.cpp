@@ -236,9 +236,11 @@ HeaderWalk walkHeaders(const std::string& path, std::string* why) {
   if (!f.read(reinterpret_cast<char*>(start), 8)) return HeaderWalk::kFits;
   const bool exr = std::equal(start, start + 4, kExr), png = std::equal(start, start + 8, kPng);
   if (!exr && !png) return HeaderWalk::kFits;
-  std::error_code ec;
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) return HeaderWalk::kFits;
+  // The size of the file this stream has open (not a second lookup of the path).
+  if (!f.seekg(0, std::ios::end)) return HeaderWalk::kFits;
+  const std::streamoff end = f.tellg();
+  if (end < 8 || !f.seekg(8)) return HeaderWalk::kFits;
+  const uint64_t size = uint64_t(end);
   const bool fits = exr ? exrHeadersFitTheFile(f, start, size, why) : pngChunksFitTheFile(f, size, why);
   return fits ? HeaderWalk::kFits : HeaderWalk::kRefused;
 }
