@@ -223,30 +223,61 @@ bool pngChunksFitTheFile(std::istream& f, uint64_t size, std::string* why) {
   return true;
 }
 
+// The PNG header's own bits per pixel (IHDR: bit depth x samples of the colour type; a palette
+// index is one sample), or 0 when it cannot be read. f: a PNG file's stream, anywhere.
+uint64_t pngBitsPerPixel(std::istream& f) {
+  unsigned char ihdr[26] = {};
+  if (!f.seekg(0) || !f.read(reinterpret_cast<char*>(ihdr), sizeof(ihdr))) return 0;
+  if (std::string(reinterpret_cast<const char*>(ihdr + 12), 4) != "IHDR") return 0;
+  const unsigned depth = ihdr[24], colour = ihdr[25];
+  const unsigned samples = colour == 0 ? 1 : colour == 2 ? 3 : colour == 3 ? 1 : colour == 4 ? 2 : colour == 6 ? 4 : 0;
+  return uint64_t(depth) * samples;
+}
+
+// What the checks before decoding learn of a file from their one open: its size (known unless the
+// stream could not seek) and, for a PNG, the header's bits per pixel (0 when unreadable).
+struct FileFacts {
+  bool sized = false;
+  uint64_t size = 0;
+  uint64_t png_bits = 0;
+};
+
 // The checks on a file before any decoder sees it, from one open: kUnreadable when it cannot be
 // opened, kRefused (and *why) when its OpenEXR headers or PNG chunks claim more bytes than it
-// holds; files of other formats, or too short to tell, are left to OIIO.
+// holds; files of other formats, or too short to tell, are left to OIIO. *facts: what was read.
 enum class HeaderWalk { kFits, kUnreadable, kRefused };
-HeaderWalk walkHeaders(const std::string& path, std::string* why) {
+HeaderWalk walkHeaders(const std::string& path, std::string* why, FileFacts* facts) {
   static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   static const unsigned char kExr[4] = {0x76, 0x2f, 0x31, 0x01};
+  *facts = FileFacts{};
   std::ifstream f(path, std::ios::binary);
   if (!f.good()) return HeaderWalk::kUnreadable;
+  // The size of the file this stream has open (not a second lookup of the path).
+  if (!f.seekg(0, std::ios::end)) return HeaderWalk::kFits;
+  const std::streamoff end = f.tellg();
+  if (end < 0 || !f.seekg(0)) return HeaderWalk::kFits;
+  facts->sized = true;
+  facts->size = uint64_t(end);
   unsigned char start[8] = {};
   if (!f.read(reinterpret_cast<char*>(start), 8)) return HeaderWalk::kFits;
   const bool exr = std::equal(start, start + 4, kExr), png = std::equal(start, start + 8, kPng);
   if (!exr && !png) return HeaderWalk::kFits;
-  // The size of the file this stream has open (not a second lookup of the path).
-  if (!f.seekg(0, std::ios::end)) return HeaderWalk::kFits;
-  const std::streamoff end = f.tellg();
-  if (end < 8 || !f.seekg(8)) return HeaderWalk::kFits;
-  const uint64_t size = uint64_t(end);
-  const bool fits = exr ? exrHeadersFitTheFile(f, start, size, why) : pngChunksFitTheFile(f, size, why);
+  const bool fits = exr ? exrHeadersFitTheFile(f, start, facts->size, why) : pngChunksFitTheFile(f, facts->size, why);
+  if (png && fits) {
+    f.clear();
+    facts->png_bits = pngBitsPerPixel(f);
+  }
   return fits ? HeaderWalk::kFits : HeaderWalk::kRefused;
 }
 
+// An opened image and what the checks before decoding read of its file.
+struct OpenedImage {
+  std::unique_ptr<OIIO::ImageInput> input;
+  FileFacts facts;
+};
+
 // Opens the image (and the requested part) after the checks that need no decoding.
-Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, const IngestOptions& options) {
+Result<OpenedImage> openImage(const std::string& path, const IngestOptions& options) {
   if (options.height && !(options.height_scale > 0.0 && std::isfinite(options.height_scale))) {
     return makeError(ErrorCode::kBadArgument, "height scale must be a finite value > 0");
   }
@@ -255,7 +286,8 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
     return makeError(ErrorCode::kIo, path + ": is a directory, not an image file");
   }
   std::string why;
-  switch (walkHeaders(path, &why)) {
+  FileFacts facts;
+  switch (walkHeaders(path, &why, &facts)) {
     case HeaderWalk::kUnreadable:
       return makeError(ErrorCode::kIo, path + ": cannot open file for reading");
     case HeaderWalk::kRefused:
@@ -279,7 +311,7 @@ Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path, con
     return makeError(ErrorCode::kBadArgument, path + ": has no part " + std::to_string(options.part) + " (it has " +
                                                   std::to_string(parts) + ")");
   }
-  return std::unique_ptr<OIIO::ImageInput>(std::move(input));
+  return OpenedImage{std::move(input), facts};
 }
 
 // The size and channel checks of the opened part.
@@ -318,18 +350,6 @@ uint64_t storedSampleBytes(const OIIO::ImageSpec& spec) {
   return texels / 8 * bits_per_texel + (texels % 8) * bits_per_texel / 8;
 }
 
-// The PNG header's own bits per pixel (IHDR: bit depth x samples of the colour type; a palette
-// index is one sample), or 0 when the header cannot be read.
-uint64_t pngBitsPerPixel(const std::string& path) {
-  unsigned char ihdr[26] = {};
-  std::ifstream f(path, std::ios::binary);
-  if (!f.read(reinterpret_cast<char*>(ihdr), sizeof(ihdr))) return 0;
-  if (std::string(reinterpret_cast<const char*>(ihdr + 12), 4) != "IHDR") return 0;
-  const unsigned depth = ihdr[24], colour = ihdr[25];
-  const unsigned samples = colour == 0 ? 1 : colour == 2 ? 3 : colour == 3 ? 1 : colour == 4 ? 2 : colour == 6 ? 4 : 0;
-  return uint64_t(depth) * samples;
-}
-
 // How many decoded bytes one byte of the file can produce at most, for the codecs whose ratio is
 // bounded (0: unbounded or unknown). Deflate: at most 1032:1 (zlib's documented limit: a 258-byte
 // match costs at least 2 bits); OpenEXR RLE and TIFF PackBits: 128 bytes from 2 (64:1); TIFF LZW: a
@@ -362,19 +382,20 @@ double maxExpansion(const std::string& format, const OIIO::ImageSpec& spec) {
 // declares (a 74-byte PNG declaring 8192 x 8192 texels): for codecs of bounded ratio, the file must
 // have at least (decoded bytes - 64 KiB) / ratio bytes (the slack covers stream ends and is far
 // below anything worth refusing); for the others the last row is decoded first, into a one-row
-// buffer, so a truncated file or missing chunks fail before the whole image is allocated.
-BakeStatus checkPlausibleSize(const std::string& path, OIIO::ImageInput& input, const IngestOptions& options,
+// buffer, so a truncated file or missing chunks fail before the whole image is allocated. The file's
+// size and PNG header are the ones read before opening (facts), from the same open as the walk.
+BakeStatus checkPlausibleSize(const std::string& path, const OpenedImage& opened, const IngestOptions& options,
                               int used) {
+  OIIO::ImageInput& input = *opened.input;
   const OIIO::ImageSpec& spec = input.spec();
   const std::string format = input.format_name();
-  std::error_code ec;
-  const uintmax_t file_size = std::filesystem::file_size(path, ec);
-  if (ec) return makeError(ErrorCode::kIo, path + ": cannot read the file size");
+  if (!opened.facts.sized) return makeError(ErrorCode::kIo, path + ": cannot read the file size");
+  const uint64_t file_size = opened.facts.size;
   const double ratio = maxExpansion(format, spec);
   if (ratio > 0.0) {
     uint64_t decoded = storedSampleBytes(spec);
     if (format == "png") {
-      const uint64_t bits = pngBitsPerPixel(path);
+      const uint64_t bits = opened.facts.png_bits;
       if (bits == 0) return makeError(ErrorCode::kInvalidInput, path + ": unreadable PNG header");
       const uint64_t texels = uint64_t(spec.width) * uint64_t(spec.height);
       decoded = texels / 8 * bits + (texels % 8) * bits / 8;
@@ -520,9 +541,9 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
   *r = IngestReport{};
 
   QuietStderr quiet;
-  Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path, options);
+  Result<OpenedImage> opened = openImage(path, options);
   if (!opened) return opened.error();
-  OIIO::ImageInput& input = *opened.value();
+  OIIO::ImageInput& input = *opened.value().input;
   const OIIO::ImageSpec spec = input.spec();
   r->file_format = input.format_name();
   r->pixel_type = pixelTypeName(spec.format);
@@ -531,7 +552,7 @@ Result<NormalMap> loadNormalMap(const std::string& path, const IngestOptions& op
 
   // Alpha and any extra channels are never read; height fields use the first channel only.
   const int used = options.height ? 1 : std::min(spec.nchannels, 3);
-  if (BakeStatus s = checkPlausibleSize(path, input, options, used); !s) return s.error();
+  if (BakeStatus s = checkPlausibleSize(path, opened.value(), options, used); !s) return s.error();
   Result<std::vector<float>> read = readPixels(path, input, options, used);
   if (!read) return read.error();
   std::vector<float>& pixels = read.value();
@@ -557,9 +578,9 @@ Result<ImageChannels> loadImageChannels(const std::string& path, int max_side, i
   QuietStderr quiet;
   IngestOptions options;
   options.max_size = max_side;
-  Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path, options);
+  Result<OpenedImage> opened = openImage(path, options);
   if (!opened) return opened.error();
-  OIIO::ImageInput& input = *opened.value();
+  OIIO::ImageInput& input = *opened.value().input;
   const OIIO::ImageSpec spec = input.spec();
   if (spec.deep) return makeError(ErrorCode::kInvalidInput, path + ": deep images are not supported");
   if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1 || spec.width > max_side || spec.height > max_side) {
@@ -571,7 +592,7 @@ Result<ImageChannels> loadImageChannels(const std::string& path, int max_side, i
     return makeError(ErrorCode::kInvalidInput, path + ": " + std::to_string(spec.nchannels) + " channels, at most " +
                                                    std::to_string(max_channels) + " expected");
   }
-  if (BakeStatus st = checkPlausibleSize(path, input, options, spec.nchannels); !st) return st.error();
+  if (BakeStatus st = checkPlausibleSize(path, opened.value(), options, spec.nchannels); !st) return st.error();
   Result<std::vector<float>> read = readPixels(path, input, options, spec.nchannels);
   if (!read) return read.error();
   ImageChannels out;
