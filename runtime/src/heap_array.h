@@ -33,7 +33,6 @@ struct Array {
     return true;
   }
 
- private:
   void release() {
     if (!data) return;
     for (size_t i = 0; i < size; ++i) data[i].~T();

@@ -371,6 +371,12 @@ struct LobeNdf::Impl {
   // Level 0 is built by build(); a level above on its first query (or by prepare()), once, from
   // the level below: std::call_once orders its writes before every reader of that level.
   mutable std::once_flag level_built[kMaxLevels];
+  // Blocks and bounds of the stored levels. With every flake its own lobe on level 0 (lobes ==
+  // kLanes) that level is not stored: its tiles are made from the normals when level 1 is grouped
+  // and when an image or average walks them (level0Tile), the same bits as stored ones, and the
+  // normals (8 bytes a texel) are kept instead of its blocks (60 bytes a flake).
+  bool virtual_level0 = false;
+  Array<float> normals;  // the source's (n_x, n_y) per texel, kept when level 0 is virtual
   Array<Block> blocks;
   Array<Bound> bounds;
   // With every flake its own lobe on level 0 (lobes == kLanes), that level's eval is the exact
@@ -381,11 +387,19 @@ struct LobeNdf::Impl {
 
   RuntimeStatus build(const TexelSource& src, int rate_in, double sigma_r, int lobes_in, int res_in,
                       const FlakeNdf* shared);
+  // One tile's lobes as a block (lanes past count: weight 0, far away) and its bound.
+  static void packTile(const Gauss4* lobes_of_tile, int count, Block* b, Bound* d);
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
+  // The flakes of level-0 tile (tx, ty) as 4D Gaussians (positions relative to its origin): count.
+  int level0Items(int tx, int ty, Gauss4* items) const;
+  // Level-0 tile (tx, ty) as build() stores it (virtual_level0: made from the normals).
+  void level0Tile(int tx, int ty, Block* b, Bound* d) const;
+  // The block and bound of tile (tx, ty) of level li: stored, or made into *scratch.
+  const Block& tileBlock(int li, int tx, int ty, Block* scratch, Bound* scratch_bound, const Bound** bound) const;
   // Levels 1..li built (thread-safe); returns levels[li].
   const Level& levelBuilt(int li) const;
   void buildLevel(int li);
-  void gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const;
+  void gatherChildren(int child, int tx, int ty, Gauss4* out, int* count) const;
   int levelFor(double sigma) const;
   // The levels of a footprint of this sigma and how level 0 is answered (Terms' finest, coarsest,
   // exact_mode, inner_exact, skip_inner, inner_cut).
@@ -439,6 +453,7 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
   fine_w = width * rate;
   fine_h = height * rate;
 
+  virtual_level0 = lobes == kLanes;
   size_t total = 0;
   for (int tile = kFinestTile;; tile *= 2) {
     Level& l = levels[level_count++];
@@ -446,10 +461,9 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
     l.tiles_x = (fine_w + tile - 1) / tile;
     l.tiles_y = (fine_h + tile - 1) / tile;
     l.first = total;
-    total += size_t(l.tiles_x) * size_t(l.tiles_y);
+    if (level_count > 1 || !virtual_level0) total += size_t(l.tiles_x) * size_t(l.tiles_y);
     if (l.tiles_x == 1 && l.tiles_y == 1) break;
   }
-  Array<float> normals;
   if (!normals.allocate(size_t(width) * size_t(height) * 2) || !blocks.allocate(total) || !bounds.allocate(total))
     return RuntimeStatus::kOutOfMemory;
   for (int y = 0; y < height; ++y) {
@@ -459,34 +473,16 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
       if (!std::isfinite(n[0]) || !std::isfinite(n[1])) return RuntimeStatus::kInvalidArgument;
     }
   }
-  // Level 0: the flakes of every tile as 4D Gaussians, grouped.
-  const double area = step * step;
-  Gauss4 items[kMaxItems], grouped[kLanes];
+  // Level 0: the flakes of every tile as 4D Gaussians, grouped (stored unless virtual).
   const Level& l0 = levels[0];
-  for (int ty = 0; ty < l0.tiles_y; ++ty) {
-    for (int tx = 0; tx < l0.tiles_x; ++tx) {
-      int n = 0;
-      for (int fy = ty * kFinestTile; fy < std::min(fine_h, (ty + 1) * kFinestTile); ++fy) {
-        for (int fx = tx * kFinestTile; fx < std::min(fine_w, (tx + 1) * kFinestTile); ++fx) {
-          float nk[2], jk[4];
-          flakes::flakeAt(normals.data, width, height, repeat, (fx + 0.5) * step, (fy + 0.5) * step, nk, jk);
-          Gauss4& g = items[n++];
-          g.w = area;
-          g.c[0] = (fx - tx * kFinestTile + 0.5) * step;
-          g.c[1] = (fy - ty * kFinestTile + 0.5) * step;
-          g.m[0] = nk[0];
-          g.m[1] = nk[1];
-          g.uu[0] = sigma_h2;
-          g.uu[1] = 0.0;
-          g.uu[2] = sigma_h2;
-          for (int a = 0; a < 4; ++a) g.su[a] = sigma_h2 * double(jk[a]);
-          g.ss[0] = sigma_r2 + sigma_h2 * (double(jk[0]) * jk[0] + double(jk[1]) * jk[1]);
-          g.ss[1] = sigma_h2 * (double(jk[0]) * jk[2] + double(jk[1]) * jk[3]);
-          g.ss[2] = sigma_r2 + sigma_h2 * (double(jk[2]) * jk[2] + double(jk[3]) * jk[3]);
-        }
+  if (!virtual_level0) {
+    Gauss4 items[kMaxItems], grouped[kLanes];
+    for (int ty = 0; ty < l0.tiles_y; ++ty) {
+      for (int tx = 0; tx < l0.tiles_x; ++tx) {
+        const int n = level0Items(tx, ty, items);
+        storeTile(l0.first + size_t(ty) * size_t(l0.tiles_x) + size_t(tx), grouped,
+                  clusterLobes(items, n, lobes, grouped));
       }
-      storeTile(l0.first + size_t(ty) * size_t(l0.tiles_x) + size_t(tx), grouped,
-                clusterLobes(items, n, lobes, grouped));
     }
   }
   if (lobes == kLanes) {
@@ -498,7 +494,51 @@ RuntimeStatus LobeNdf::Impl::build(const TexelSource& src, int rate_in, double s
       exact = &own_exact;
     }
   }
+  if (!virtual_level0) normals.release();
   return RuntimeStatus::kOk;
+}
+
+int LobeNdf::Impl::level0Items(int tx, int ty, Gauss4* items) const {
+  const double area = step * step;
+  int n = 0;
+  for (int fy = ty * kFinestTile; fy < std::min(fine_h, (ty + 1) * kFinestTile); ++fy) {
+    for (int fx = tx * kFinestTile; fx < std::min(fine_w, (tx + 1) * kFinestTile); ++fx) {
+      float nk[2], jk[4];
+      flakes::flakeAt(normals.data, width, height, repeat, (fx + 0.5) * step, (fy + 0.5) * step, nk, jk);
+      Gauss4& g = items[n++];
+      g.w = area;
+      g.c[0] = (fx - tx * kFinestTile + 0.5) * step;
+      g.c[1] = (fy - ty * kFinestTile + 0.5) * step;
+      g.m[0] = nk[0];
+      g.m[1] = nk[1];
+      g.uu[0] = sigma_h2;
+      g.uu[1] = 0.0;
+      g.uu[2] = sigma_h2;
+      for (int a = 0; a < 4; ++a) g.su[a] = sigma_h2 * double(jk[a]);
+      g.ss[0] = sigma_r2 + sigma_h2 * (double(jk[0]) * jk[0] + double(jk[1]) * jk[1]);
+      g.ss[1] = sigma_h2 * (double(jk[0]) * jk[2] + double(jk[1]) * jk[3]);
+      g.ss[2] = sigma_r2 + sigma_h2 * (double(jk[2]) * jk[2] + double(jk[3]) * jk[3]);
+    }
+  }
+  return n;
+}
+
+void LobeNdf::Impl::level0Tile(int tx, int ty, Block* b, Bound* d) const {
+  Gauss4 items[kMaxItems], grouped[kLanes];
+  const int n = level0Items(tx, ty, items);
+  packTile(grouped, clusterLobes(items, n, lobes, grouped), b, d);
+}
+
+const Block& LobeNdf::Impl::tileBlock(int li, int tx, int ty, Block* scratch, Bound* scratch_bound,
+                                      const Bound** bound) const {
+  if (li == 0 && virtual_level0) {
+    level0Tile(tx, ty, scratch, scratch_bound);
+    *bound = scratch_bound;
+    return *scratch;
+  }
+  const size_t index = levels[li].first + size_t(ty) * size_t(levels[li].tiles_x) + size_t(tx);
+  *bound = &bounds.data[index];
+  return blocks.data[index];
 }
 
 // A level above 0: the lobes of the four children of every tile, grouped again. Most of the
@@ -509,7 +549,7 @@ void LobeNdf::Impl::buildLevel(int li) {
   for (int ty = 0; ty < l.tiles_y; ++ty) {
     for (int tx = 0; tx < l.tiles_x; ++tx) {
       int n = 0;
-      gatherChildren(levels[li - 1], tx, ty, items, &n);
+      gatherChildren(li - 1, tx, ty, items, &n);
       storeTile(l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx), grouped, clusterLobes(items, n, lobes, grouped));
     }
   }
@@ -528,15 +568,18 @@ const Level& LobeNdf::Impl::levelBuilt(int li) const {
 
 // The lobes of the (up to four) children of tile (tx, ty) of the level above `child`, positions
 // relative to the parent's origin.
-void LobeNdf::Impl::gatherChildren(const Level& child, int tx, int ty, Gauss4* out, int* count) const {
+void LobeNdf::Impl::gatherChildren(int child_level, int tx, int ty, Gauss4* out, int* count) const {
   int n = 0;
+  const Level& child = levels[child_level];
   const double side = child.tile * step;
+  Block scratch;
+  Bound scratch_bound;
   for (int cy = 2 * ty; cy < std::min(child.tiles_y, 2 * ty + 2); ++cy) {
     for (int cx = 2 * tx; cx < std::min(child.tiles_x, 2 * tx + 2); ++cx) {
-      const size_t index = child.first + size_t(cy) * size_t(child.tiles_x) + size_t(cx);
-      const Block& b = blocks.data[index];
+      const Bound* bound = nullptr;
+      const Block& b = tileBlock(child_level, cx, cy, &scratch, &scratch_bound, &bound);
       const double ox = (cx - 2 * tx) * side, oy = (cy - 2 * ty) * side;
-      for (uint32_t i = 0; i < bounds.data[index].count; ++i) {
+      for (uint32_t i = 0; i < bound->count; ++i) {
         Gauss4& g = out[n++];
         g.w = b.w[i];
         g.c[0] = ox + b.cx[i];
@@ -560,8 +603,12 @@ void LobeNdf::Impl::gatherChildren(const Level& child, int tx, int ty, Gauss4* o
 }
 
 void LobeNdf::Impl::storeTile(size_t index, const Gauss4* g, int count) {
-  Block& b = blocks.data[index];
-  Bound& d = bounds.data[index];
+  packTile(g, count, &blocks.data[index], &bounds.data[index]);
+}
+
+void LobeNdf::Impl::packTile(const Gauss4* g, int count, Block* block, Bound* bound) {
+  Block& b = *block;
+  Bound& d = *bound;
   d.uu = 0.0f;
   d.count = uint32_t(count);
   for (int i = 0; i < kLanes; ++i) {
@@ -649,6 +696,8 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   struct TileRef {
     size_t index;
     double bx, by, d2;
+    int tx, ty;
+    bool made;  // a tile of the virtual level 0: made from the normals when visited
   };
   constexpr int kBatch = 64, kAhead = 4;
   TileRef batch[kBatch];
@@ -658,28 +707,38 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
     for (size_t o = 0; o < size; o += 64) flakes::prefetch(bytes + o);
     flakes::prefetch(bytes + size - 1);
   };
+  // The bound of a level-0 tile as packTile gives it: every flake has S_uu = sigma_h^2 I.
+  const Bound made_bound{float((sigma_h2 + sigma_h2) * (1.0 + 1e-6)), 1};
+  Block made;
+  Bound made_exact;
   auto flush = [&] {
-    for (int i = 0; i < n; ++i) fetch(bounds.data + batch[i].index, sizeof(Bound));
+    for (int i = 0; i < n; ++i)
+      if (!batch[i].made) fetch(bounds.data + batch[i].index, sizeof(Bound));
     int kept = 0;
     for (int i = 0; i < n; ++i) {
       const TileRef& r = batch[i];
-      const Bound& bound = bounds.data[r.index];
+      const Bound& bound = r.made ? made_bound : bounds.data[r.index];
       if (bound.count == 0) continue;
       // Smallest spatial exponent of the tile: A <= (sigma_p^2 + tr S_uu) I.
       const double spatial_min = 0.5 * r.d2 / (t.sp2 + double(bound.uu));
       if (spatial_min > kMaxSpatial) continue;
-      if (kept < kAhead) fetch(blocks.data + r.index, sizeof(Block));
+      if (kept < kAhead && !r.made) fetch(blocks.data + r.index, sizeof(Block));
       batch[kept++] = r;
     }
     for (int i = 0; i < kept; ++i) {
-      if (i + kAhead < kept) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
+      if (i + kAhead < kept && !batch[i + kAhead].made) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
       const TileRef& r = batch[i];
-      visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by);
+      if (r.made) {
+        level0Tile(r.tx, r.ty, &made, &made_exact);
+        visit(made, made_exact, r.bx, r.by);
+      } else {
+        visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by);
+      }
     }
     n = 0;
   };
-  auto accept = [&](size_t index, double bx, double by, double d2) {
-    batch[n++] = {index, bx, by, d2};
+  auto accept = [&](int li, int tx, int ty, size_t index, double bx, double by, double d2) {
+    batch[n++] = {index, bx, by, d2, tx, ty, li == 0 && virtual_level0};
     if (n == kBatch) flush();
   };
   const Level& top = levels[t.coarsest];
@@ -726,7 +785,7 @@ void LobeNdf::Impl::visitNode(const Terms& t, int li, int tx, int ty, double ux,
   const size_t index = l.first + size_t(ty) * size_t(l.tiles_x) + size_t(tx);
   const double d2 = dx * dx + dy * dy;
   if (li == t.finest || d2 >= cutLimit(t, li)) {
-    accept(index, bx, by, d2);
+    accept(li, tx, ty, index, bx, by, d2);
     return;
   }
   if (li == 1 && t.skip_inner) return;  // an inner tile: the exact flakes answer it

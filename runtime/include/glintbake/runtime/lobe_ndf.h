@@ -91,11 +91,14 @@ class LobeNdf final : public AccumulatingNdfSource {
 
   // Builds the lobe hierarchy from a texel source with the flake model of flake_ndf.h: rate flakes
   // per texel side (1..16), intrinsic roughness sigma_r in (0, 1], lobes_per_tile in
-  // [1, kMaxLobesPerTile], image resolution R (2..4096). Memory: about 80 bytes per flake, and 35
-  // more at 16 lobes per tile (level 0 keeps every flake, then also as the exact flakes), all of
-  // it allocated here. build() groups the finest level only; each level above is grouped from the
-  // one below on the first query that needs it (thread-safe; concurrent queries of that level wait
-  // for it), so a reader that never asks for mid-size footprints never pays for them. All levels
+  // [1, kMaxLobesPerTile], image resolution R (2..4096). Memory, all of it allocated here: at 16
+  // lobes per tile about 63 bytes per flake at one flake per texel (the levels above the finest 20,
+  // the exact flakes 35, and the normals, 8 bytes a texel, from which the finest level's tiles are
+  // made when they are needed: 60 bytes a flake less than storing them, the same bits); with fewer
+  // lobes per tile about 80 (the finest level stored, grouped). build() groups the finest level
+  // only, when it is stored; each level above is grouped from the one below on the first query
+  // that needs it (thread-safe; concurrent queries of that level wait for it), so a reader that
+  // never asks for mid-size footprints never pays for them. All levels
   // cost about 1.5 s for a 1024^2 map on one core (bench_flakes lobe_build; most of it the merge
   // costs of the reduction, vectorised, and level 1 three quarters of that), a sixteenth of that
   // for 256^2. kInvalidArgument for parameters out of range, non-finite normals or a source larger
