@@ -939,6 +939,12 @@ void LobeNdf::prepare() const {
 int LobeNdf::resolution() const { return impl_ ? impl_->res : 0; }
 MapSize LobeNdf::mapSize() const { return impl_ ? MapSize{impl_->width, impl_->height} : MapSize{}; }
 MapWrap LobeNdf::wrap() const { return impl_ && !impl_->repeat ? MapWrap::kClamp : MapWrap::kRepeat; }
+uint64_t LobeNdf::memoryBytes() const {
+  if (!impl_ || impl_->level_count == 0) return 0;
+  return uint64_t(impl_->blocks.size) * sizeof(Block) + uint64_t(impl_->bounds.size) * sizeof(Bound) +
+         uint64_t(impl_->normals.size) * sizeof(float);
+}
+
 int LobeNdf::tileFor(double sigma) const { return impl_ ? impl_->levels[impl_->levelFor(sigma)].tile : 0; }
 
 FootprintRange LobeNdf::footprintRange() const {

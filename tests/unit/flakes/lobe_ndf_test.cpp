@@ -254,6 +254,31 @@ TEST(LobeNdf, SamplesFollowTheirPdf) {
   }
 }
 
+// At 16 lobes per tile the finest level (every flake its own lobe, a kilobyte a tile of 16) is not
+// stored: its tiles are made from the normals when needed. With fewer lobes it is grouped and kept.
+TEST(LobeNdf, FinestLevelIsMadeNotStoredAtSixteenLobes) {
+  const bake::NormalMap map = lobeMap(bake::MapKind::kFlakes, 128, 5);
+  const auto texels = lobeTexels(map);
+  const double flakes = 128.0 * 128.0;
+  LobeNdf made, stored;
+  EXPECT_EQ(made.memoryBytes(), 0u);
+  ASSERT_EQ(made.build(texels, 1, 0.005, 16, 32), RuntimeStatus::kOk);
+  ASSERT_EQ(stored.build(texels, 1, 0.005, 15, 32), RuntimeStatus::kOk);
+  // Levels above the finest: 1 + 1/4 + ... blocks of 960 bytes per 64 flakes; normals 8 bytes.
+  EXPECT_LT(double(made.memoryBytes()) / flakes, 30.0);
+  EXPECT_GT(double(stored.memoryBytes()) / flakes, 70.0);
+  // The made tiles answer images and averages (which walk them at 11.4-22.9 texels) as the flakes.
+  runtime::FlakeNdf exact;
+  ASSERT_EQ(exact.build(texels, 1, 0.005, 32), RuntimeStatus::kOk);
+  std::vector<float> a(32 * 32), b(32 * 32);
+  for (double sigma : {12.0, 16.0, 20.0}) {
+    const Footprint fp{60.3, 70.9, sigma};
+    ASSERT_EQ(made.image(fp, a.data(), a.size()), RuntimeStatus::kOk);
+    ASSERT_EQ(exact.image(fp, b.data(), b.size()), RuntimeStatus::kOk);
+    EXPECT_LT(relativeL1(a, b), 0.02) << sigma;  // the 3-sigma window against the 6-sigma one
+  }
+}
+
 TEST(LobeNdf, AverageIsTheMeanOfTheImageBins) {
   Pair p(lobeMap(bake::MapKind::kFlakes, 64, 3), 8, 32);
   const Footprint fp{30.0, 12.5, 9.0};

@@ -118,6 +118,9 @@ class LobeNdf final : public AccumulatingNdfSource {
   MapWrap wrap() const override;
   // Tile side (flakes) of the level that answers a footprint of this sigma.
   int tileFor(double sigma) const;
+  // Bytes the hierarchy holds (every level's blocks and bounds, allocated at build, and the normals
+  // the finest level is made from at 16 lobes per tile); not the exact flakes. 0 when not built.
+  uint64_t memoryBytes() const;
 
   RuntimeStatus eval(const Footprint& footprint, const SPoint& s, double* value) const override;
   RuntimeStatus average(const Footprint& footprint, const SRect& rect, double* value) const override;
