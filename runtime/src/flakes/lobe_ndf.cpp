@@ -392,7 +392,7 @@ struct LobeNdf::Impl {
   void storeTile(size_t index, const Gauss4* lobes_of_tile, int count);
   // The flakes of level-0 tile (tx, ty) as 4D Gaussians (positions relative to its origin): count.
   int level0Items(int tx, int ty, Gauss4* items) const;
-  // Level-0 tile (tx, ty) as build() stores it (virtual_level0: made from the normals).
+  // Level-0 tile (tx, ty) made from the normals, as build() would store it (virtual_level0 only).
   void level0Tile(int tx, int ty, Block* b, Bound* d) const;
   // The block and bound of tile (tx, ty) of level li: stored, or made into *scratch.
   const Block& tileBlock(int li, int tx, int ty, Block* scratch, Bound* scratch_bound, const Bound** bound) const;
@@ -524,9 +524,12 @@ int LobeNdf::Impl::level0Items(int tx, int ty, Gauss4* items) const {
 }
 
 void LobeNdf::Impl::level0Tile(int tx, int ty, Block* b, Bound* d) const {
-  Gauss4 items[kMaxItems], grouped[kLanes];
+  // A level-0 tile holds at most kFinestTile^2 = kLanes flakes: as many lobes as a tile keeps when
+  // it is made (clusterLobes would return them unchanged).
+  static_assert(kFinestTile * kFinestTile == kLanes, "a made tile keeps every flake");
+  Gauss4 items[kLanes];
   const int n = level0Items(tx, ty, items);
-  packTile(grouped, clusterLobes(items, n, lobes, grouped), b, d);
+  packTile(items, n, b, d);
 }
 
 const Block& LobeNdf::Impl::tileBlock(int li, int tx, int ty, Block* scratch, Bound* scratch_bound,
