@@ -368,8 +368,9 @@ struct LobeNdf::Impl {
   int res = 128, lobes = kLanes;
   Level levels[kMaxLevels];
   int level_count = 0;
-  // Level 0 is built by build(); a level above on its first query (or by prepare()), once, from
-  // the level below: std::call_once orders its writes before every reader of that level.
+  // Level 0 is built by build() (unless made on demand, below); a level above on its first query
+  // (or by prepare()), once, from the level below: std::call_once orders its writes before every
+  // reader of that level.
   mutable std::once_flag level_built[kMaxLevels];
   // Blocks and bounds of the stored levels. With every flake its own lobe on level 0 (lobes ==
   // kLanes) that level is not stored: its tiles are made from the normals when level 1 is grouped
@@ -713,7 +714,7 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
   // The bound of a level-0 tile as packTile gives it: every flake has S_uu = sigma_h^2 I.
   const Bound made_bound{float((sigma_h2 + sigma_h2) * (1.0 + 1e-6)), 1};
   Block made;
-  Bound made_exact;
+  Bound made_tile_bound;
   auto flush = [&] {
     for (int i = 0; i < n; ++i)
       if (!batch[i].made) fetch(bounds.data + batch[i].index, sizeof(Bound));
@@ -732,8 +733,8 @@ void LobeNdf::Impl::forEachTile(const Terms& t, Visit&& visit) const {
       if (i + kAhead < kept && !batch[i + kAhead].made) fetch(blocks.data + batch[i + kAhead].index, sizeof(Block));
       const TileRef& r = batch[i];
       if (r.made) {
-        level0Tile(r.tx, r.ty, &made, &made_exact);
-        visit(made, made_exact, r.bx, r.by);
+        level0Tile(r.tx, r.ty, &made, &made_tile_bound);
+        visit(made, made_tile_bound, r.bx, r.by);
       } else {
         visit(blocks.data[r.index], bounds.data[r.index], r.bx, r.by);
       }
