@@ -97,7 +97,9 @@ std::vector<Sample> planSamples(const LevelGeometry& geo, const format::NdfLevel
       s.weight[q] = weight;
       ++q;
     };
-    blend.blendLevel(0, 1.0, (i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, emit);
+    format::NdfBlendLevel part;
+    blend.bilinearLevel(0, 1.0, (i + 0.5) * geo.stride_x, (j + 0.5) * geo.stride_y, &part);
+    part.forEach(emit);
     s.prediction.assign(image_floats, 0.0);
   }
   return samples;

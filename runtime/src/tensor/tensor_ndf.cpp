@@ -160,39 +160,51 @@ double TensorNdf::Impl::totalMass(const Blend& b, double* masses) const {
   return total;
 }
 
-double TensorNdf::Impl::mixtureMass(const Blend& b) const {
+double TensorNdf::Impl::mixtureMass(const format::NdfBlendLevel* parts, int count) const {
   double total = 0.0;
-  for (int t = 0; t < b.count; ++t) total += b.weight[t] * b.centre_mass[t];
+  for (int p = 0; p < count; ++p) {
+    const double* centre_mass = levels[parts[p].level].centre_mass.data;
+    parts[p].forEachWeight([&](int a, int b, double w) { total += w * centre_mass[parts[p].centre(a, b)]; });
+  }
   return total;
 }
 
-double TensorNdf::Impl::binValue(const Blend& b, uint64_t block, int bi, int bj) const {
-  // Each term is one rank-R triple product (the CpMix of the block, evaluated at one bin, without
-  // first summing the terms' C rows: a point needs only R products per term); the terms' weighted
-  // lane sums share one final reduction. Exact blocks (one stored value per term; the top levels
-  // blend up to hundreds of them) add into a sum of their own, kept in a register.
-  Dot3Lanes lanes;
-  float exact = 0.0f;
-  for (int t = 0; t < b.count; ++t) {
-    const TensorIndexEntry& e = b.index[t][block];
-    if (e.group == kTensorBlankGroup) continue;
-    const CpGroupView& v = groups.data[e.group].view;
-    const size_t rank = size_t(v.rank);
-    if (v.identity_a) {  // an exact block: one stored value
-      exact += float(b.weight[t]) * (v.c[size_t(e.row) * rank + size_t(bi)] * v.b[size_t(bj) * rank + size_t(bi)]);
+double TensorNdf::Impl::pointValue(const format::NdfBlendLevel* parts, int count, uint64_t block, int bi,
+                                   int bj) const {
+  // sum_c w_c v_c over the blend's centres, v_c the centre's model value at the bin: one load of a
+  // dense level's values (the centres of a bin side by side), else the triple product of the
+  // centre's C row with its group's A and B rows (an exact block: one product).
+  double sum = 0.0;
+  for (int p = 0; p < count; ++p) {
+    const format::NdfBlendLevel& part = parts[p];
+    const PointLevel& pl = point[part.level];
+    if (pl.dense) {
+      const uint64_t cell = (block * uint64_t(bins) + uint64_t(bj)) * uint64_t(bins) + uint64_t(bi);
+      const float* v = pl.values.data + cell * pl.centres;
+      part.forEachWeight([&](int a, int b, double w) { sum += w * double(v[part.centre(a, b)]); });
       continue;
     }
-    lanes.add(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, v.c + size_t(e.row) * rank, v.rank, float(b.weight[t]));
+    const uint64_t first = block * pl.centres;
+    part.forEachWeight([&](int a, int b, double w) {
+      const uint64_t slot = first + part.centre(a, b);
+      const uint32_t g = pl.group.data[slot];
+      if (g == kTensorBlankGroup) return;
+      const CpGroupView& v = groups.data[g].view;
+      const float* row = pl.rows.data + slot * uint64_t(pl.row_stride);
+      const size_t rank = size_t(v.rank);
+      const float value = v.identity_a ? row[bi] * v.b[size_t(bj) * rank + size_t(bi)]
+                                       : laneDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, row, v.rank);
+      sum += w * double(value);
+    });
   }
-  const float sum = lanes.total() + exact;
-  return sum > 0.0f ? double(sum) : 0.0;
+  return sum > 0.0 ? sum : 0.0;
 }
 
-double TensorNdf::Impl::imageBinValue(const Blend& b, int i, int j) const {
+double TensorNdf::Impl::imagePointValue(const format::NdfBlendLevel* parts, int count, int i, int j) const {
   int bx, by, bi, bj;
   splitBin(i, &bx, &bi);
   splitBin(j, &by, &bj);
-  return binValue(b, uint64_t(by) * uint64_t(nb) + uint64_t(bx), bi, bj);
+  return pointValue(parts, count, uint64_t(by) * uint64_t(nb) + uint64_t(bx), bi, bj);
 }
 
 double TensorNdf::Impl::binPdf(const Blend& b, int i, int j) const {
@@ -219,9 +231,9 @@ RuntimeStatus TensorNdf::evalChecked(const Footprint& footprint, const SPoint& s
     *value = 0.0;
     return RuntimeStatus::kOk;
   }
-  Impl::Blend b;
-  m.blend(footprint, &b);
-  *value = m.imageBinValue(b, i, j);
+  format::NdfBlendLevel parts[2];
+  const int n = m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts);
+  *value = m.imagePointValue(parts, n, i, j);
   return RuntimeStatus::kOk;
 }
 
@@ -265,9 +277,15 @@ RuntimeStatus TensorNdf::averageChecked(const Footprint& footprint, const SRect&
 }
 
 RuntimeStatus TensorNdf::massChecked(const Footprint& footprint, double* value) const {
+  const Impl& m = *impl_;
+  if (m.nonneg) {
+    format::NdfBlendLevel parts[2];
+    *value = m.mixtureMass(parts, m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts));
+    return RuntimeStatus::kOk;
+  }
   Impl::Blend b;
-  impl_->blend(footprint, &b);
-  *value = impl_->nonneg ? impl_->mixtureMass(b) : impl_->totalMass(b);
+  m.blend(footprint, &b);
+  *value = m.totalMass(b);
   return RuntimeStatus::kOk;
 }
 
@@ -278,14 +296,16 @@ RuntimeStatus TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s,
     *value = 0.0;
     return RuntimeStatus::kOk;
   }
-  Impl::Blend b;
-  m.blend(footprint, &b);
   if (m.nonneg) {
     // The density sample() reports for the mixture: eval over mass.
-    const double total = m.mixtureMass(b);
-    *value = total > 0.0 ? m.imageBinValue(b, bin % m.res, bin / m.res) / total : 0.0;
+    format::NdfBlendLevel parts[2];
+    const int n = m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts);
+    const double total = m.mixtureMass(parts, n);
+    *value = total > 0.0 ? m.imagePointValue(parts, n, bin % m.res, bin / m.res) / total : 0.0;
     return RuntimeStatus::kOk;
   }
+  Impl::Blend b;
+  m.blend(footprint, &b);
   *value = m.binPdf(b, bin % m.res, bin / m.res);
   return RuntimeStatus::kOk;
 }
@@ -293,23 +313,43 @@ RuntimeStatus TensorNdf::pdfChecked(const Footprint& footprint, const SPoint& s,
 namespace {
 
 // The walk of a discrete pick: the last entry with positive mass whose running sum passes target
-// (rounding may run past the last entry with mass: it is kept); `u` gets the position within the
+// (rounding may run past the last entry with mass: it is kept); u() gives the position within the
 // chosen entry, rescaled to [0, 1).
+class MassWalk {
+ public:
+  explicit MassWalk(double target) : target_(target) {}
+  // Offers the next entry's mass; true when it becomes the chosen one.
+  bool offer(double mass) {
+    if (done_ || !(mass > 0.0)) return false;
+    chosen_mass_ = mass;
+    if (target_ < before_ + mass) {
+      done_ = true;
+    } else {
+      before_ += mass;
+    }
+    return true;
+  }
+  bool done() const { return done_; }
+  double chosenMass() const { return chosen_mass_; }
+  double u() const {
+    const double v = (target_ - before_) / chosen_mass_;
+    return v < kOneMinusEpsilon ? (v > 0.0 ? v : 0.0) : kOneMinusEpsilon;
+  }
+
+ private:
+  double target_, before_ = 0.0, chosen_mass_ = 0.0;
+  bool done_ = false;
+};
+
 template <typename MassOf>
 uint64_t pickByMass(uint64_t count, double target, MassOf&& mass_of, double* chosen_mass, double* u) {
-  double before = 0.0;
+  MassWalk walk(target);
   uint64_t chosen = 0;
-  *chosen_mass = 0.0;
-  for (uint64_t k = 0; k < count; ++k) {
-    const double mk = mass_of(k);
-    if (!(mk > 0.0)) continue;
-    chosen = k;
-    *chosen_mass = mk;
-    if (target < before + mk) break;
-    before += mk;
+  for (uint64_t k = 0; k < count && !walk.done(); ++k) {
+    if (walk.offer(mass_of(k))) chosen = k;
   }
-  const double v = (target - before) / *chosen_mass;
-  *u = v < kOneMinusEpsilon ? (v > 0.0 ? v : 0.0) : kOneMinusEpsilon;
+  *chosen_mass = walk.chosenMass();
+  *u = walk.u();
   return chosen;
 }
 
@@ -342,8 +382,6 @@ void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, 
 
 RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
-  Impl::Blend b;
-  m.blend(footprint, &b);
   CpMix mix;
   SPoint s;
   int bi, bj;
@@ -353,25 +391,56 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
     // weighted mass w_t M_t, a block of that centre by its mass, and a point of that one block.
     // The density is then eval / mass wherever the point lands, whatever path drew it: no
     // per-block blend of every centre's masses (nb^2 x centres) and a one-term CpMix.
-    const double total = m.mixtureMass(b);
+    format::NdfBlendLevel parts[2];
+    const int n = m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts);
+    // The centres' weighted masses, summed as mixtureMass sums them (the same total, bit for bit,
+    // as pdf() and mass() find), then walked for the pick.
+    struct Term {
+      double mass;
+      size_t centre;
+      int level;
+    };
+    Term terms[format::kMaxBlendCentres];
+    int count = 0;
+    double total = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double* centre_mass = m.levels[parts[k].level].centre_mass.data;
+      parts[k].forEachWeight([&](int a, int b, double w) {
+        const size_t c = parts[k].centre(a, b);
+        const double tm = w * centre_mass[c];
+        terms[count++] = Term{tm, c, parts[k].level};
+        total += tm;
+      });
+    }
     if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
-    double term_mass, block_mass;
-    const uint64_t t = pickByMass(
-        uint64_t(b.count), u1 * total, [&](uint64_t k) { return b.weight[k] * b.centre_mass[k]; }, &term_mass, &u1);
-    const double* masses = b.mass[t];
+    MassWalk walk(u1 * total);
+    int level = 0;
+    size_t centre = 0;
+    for (int k = 0; k < count && !walk.done(); ++k) {
+      if (walk.offer(terms[k].mass)) {
+        level = terms[k].level;
+        centre = terms[k].centre;
+      }
+    }
+    u1 = walk.u();
+    const Impl::TLevel& lv = m.levels[level];
+    const double* masses = lv.mass.data + centre * m.nb2;
+    double block_mass;
     const uint64_t block = pickByMass(
-        m.nb2, u1 * b.centre_mass[t], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
+        m.nb2, u1 * lv.centre_mass.data[centre], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
     // A block with positive mass is never blank (blank blocks weigh 0).
-    const TensorIndexEntry& e = b.index[t][block];
+    const TensorIndexEntry& e = lv.index.data[centre * m.nb2 + block];
     const CpBlendTerm one{&m.groups.data[e.group].view, int32_t(e.row), 1.0f, float(block_mass * m.inv_bin_area)};
     mix.init(&one, 1);
     m.pointInBlock(mix, block, u1, u2, &s, &bi, &bj, &p);
     out->s = s;
     // pdf() forms the same quotient. A point whose blended value rounds to 0 (not seen on valid
     // assets) reports density 0, as pdf() does there.
-    out->pdf = m.binValue(b, block, bi, bj) / total;
+    out->pdf = m.pointValue(parts, n, block, bi, bj) / total;
     return RuntimeStatus::kOk;
   }
+  Impl::Blend b;
+  m.blend(footprint, &b);
   double masses[Impl::kMassBlocks];
   const double total = m.totalMass(b, masses);
   if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;

@@ -26,6 +26,22 @@ struct TensorNdf::Impl {
     Array<double> mass;             // raw block integral over its s-plane area (0 for blank blocks)
     Array<double> centre_mass;      // non-negative assets: the sum of each centre's block masses
   };
+  // A level laid out for point queries (eval, pdf, the density of a sample), built at load: the
+  // centres of one block lie side by side, so that a footprint's blend over a few hundred
+  // neighbouring centres reads a few contiguous runs instead of chasing each centre's index
+  // entry into its group. Exact levels (every stored block exact, tensorpack's coarse levels)
+  // within kPointDenseBytes keep their values with the centres innermost; the others a copy of
+  // each block's C row and its group.
+  struct PointLevel {
+    uint64_t centres = 0;
+    bool dense = false;
+    Array<float> values;     // dense: [(block * bins^2 + bj * bins + bi) * centres + centre]
+    Array<float> rows;       // otherwise: [(block * centres + centre) * row_stride + r]
+    Array<uint32_t> group;   // otherwise: [block * centres + centre], kTensorBlankGroup for blank
+    int32_t row_stride = 0;  // the level's largest rank
+  };
+  static constexpr uint64_t kPointDenseBytes = uint64_t(64) << 20;
+
   // The weighted centres of the footprint blend (format::NdfPyramidBlend), as NdfPyramid blends them.
   struct Blend {
     int count = 0;
@@ -50,12 +66,14 @@ struct TensorNdf::Impl {
   uint32_t group_count = 0;
   Array<Group> groups;
   Array<TensorGroupHeader> group_headers;  // as stored, for the index-entry checks
+  PointLevel point[kMaxNdfLevels];
   uint64_t blocks_kept = 0;
   uint64_t memory_bytes = 0;
 
   RuntimeStatus load(const format::Reader& reader);
   RuntimeStatus loadGroup(const format::Reader& reader, uint32_t g, Array<uint8_t>* scratch);
   RuntimeStatus loadIndex(const format::Reader& reader, int l, Array<uint8_t>* scratch);
+  RuntimeStatus buildPointLevel(int l);
 
   void blend(const Footprint& fp, Blend* b) const;
   // The CpMix of block `block` of the blend (blank entries skipped).
@@ -72,12 +90,14 @@ struct TensorNdf::Impl {
   double totalMass(const Blend& b, double* masses = nullptr) const;
   // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf(). Signed models.
   double binPdf(const Blend& b, int i, int j) const;
-  // The clamped blended model value of bin (bi, bj) of block `block` (eval()).
-  double binValue(const Blend& b, uint64_t block, int bi, int bj) const;
+  // Non-negative models: the blend's mass as a mixture, sum_t w_t M_t (M_t the centre's mass),
+  // over its separable form.
+  double mixtureMass(const format::NdfBlendLevel* parts, int count) const;
+  // The clamped blended model value of bin (bi, bj) of block `block` (eval, pdf, a sample's
+  // density), from the point levels.
+  double pointValue(const format::NdfBlendLevel* parts, int count, uint64_t block, int bi, int bj) const;
   // The same for bin (i, j) of the whole R x R image.
-  double imageBinValue(const Blend& b, int i, int j) const;
-  // Non-negative models: the blend's mass as a mixture, sum_t w_t M_t (M_t the centre's mass).
-  double mixtureMass(const Blend& b) const;
+  double imagePointValue(const format::NdfBlendLevel* parts, int count, int i, int j) const;
   // Draws a point of block `block` from `mix` (uniformly when its float mass is 0): the s-plane
   // point, its bin (bi, bj) within the block and the within-block density p (per unit bin area).
   void pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi, int* bj,

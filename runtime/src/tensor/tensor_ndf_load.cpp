@@ -8,6 +8,7 @@
 
 #include <glintbake/format/binary16.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -186,7 +187,66 @@ RuntimeStatus TensorNdf::Impl::load(const format::Reader& reader) {
   }
   for (int l = 0; l < level_count; ++l) {
     if (RuntimeStatus s = loadIndex(reader, l, &scratch); s != RuntimeStatus::kOk) return s;
+    if (RuntimeStatus s = buildPointLevel(l); s != RuntimeStatus::kOk) return s;
   }
+  return RuntimeStatus::kOk;
+}
+
+RuntimeStatus TensorNdf::Impl::buildPointLevel(int l) {
+  const TLevel& lv = levels[l];
+  PointLevel& p = point[l];
+  p.centres = uint64_t(lv.rec.grid_width) * lv.rec.grid_height;
+  // Entries were checked by loadIndex: every group exists and every row lies within it.
+  bool exact = true;
+  int32_t stride = 0;
+  for (uint64_t e = 0; e < p.centres * nb2; ++e) {
+    const TensorIndexEntry& entry = lv.index.data[e];
+    if (entry.group == kTensorBlankGroup) continue;
+    const CpGroupView& v = groups.data[entry.group].view;
+    exact = exact && v.identity_a;
+    stride = std::max(stride, v.rank);
+  }
+  const uint64_t bins2 = uint64_t(bins) * uint64_t(bins);
+  p.dense = exact && p.centres * nb2 * bins2 * sizeof(float) <= kPointDenseBytes;
+  if (p.dense) {
+    if (!p.values.allocate(size_t(p.centres * nb2 * bins2))) return RuntimeStatus::kOutOfMemory;
+    for (uint64_t c = 0; c < p.centres; ++c) {
+      for (uint64_t block = 0; block < nb2; ++block) {
+        const TensorIndexEntry& e = lv.index.data[c * nb2 + block];
+        float* dst = p.values.data + block * bins2 * p.centres + c;
+        if (e.group == kTensorBlankGroup) {
+          for (uint64_t k = 0; k < bins2; ++k) dst[k * p.centres] = 0.0f;
+          continue;
+        }
+        // An exact block's bin (bi, bj) is C[row, bi] B[bj, bi] (A is the identity).
+        const CpGroupView& v = groups.data[e.group].view;
+        const float* crow = v.c + size_t(e.row) * size_t(v.rank);
+        for (int bj = 0; bj < bins; ++bj) {
+          for (int bi = 0; bi < bins; ++bi)
+            dst[(uint64_t(bj) * bins + bi) * p.centres] = crow[bi] * v.b[size_t(bj) * size_t(v.rank) + size_t(bi)];
+        }
+      }
+    }
+    memory_bytes += p.values.size * sizeof(float);
+    return RuntimeStatus::kOk;
+  }
+  p.row_stride = stride;
+  const uint64_t slots = p.centres * nb2;
+  if (!p.group.allocate(size_t(slots)) || !p.rows.allocate(size_t(slots * uint64_t(stride))))
+    return RuntimeStatus::kOutOfMemory;
+  for (uint64_t c = 0; c < p.centres; ++c) {
+    for (uint64_t block = 0; block < nb2; ++block) {
+      const TensorIndexEntry& e = lv.index.data[c * nb2 + block];
+      const uint64_t slot = block * p.centres + c;
+      float* row = p.rows.data + slot * uint64_t(stride);
+      p.group.data[slot] = e.group;
+      std::fill(row, row + stride, 0.0f);
+      if (e.group == kTensorBlankGroup) continue;
+      const CpGroupView& v = groups.data[e.group].view;
+      std::copy(v.c + size_t(e.row) * size_t(v.rank), v.c + size_t(e.row + 1) * size_t(v.rank), row);
+    }
+  }
+  memory_bytes += p.group.size * sizeof(uint32_t) + p.rows.size * sizeof(float);
   return RuntimeStatus::kOk;
 }
 

@@ -396,33 +396,43 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
     worst = std::max(worst, std::fabs(ramp(z) - exact(z)));
   }
   EXPECT_LT(worst, 1e-10);
-  // Weights of one axis (16 centres, repeating, stride 4) at spreads up to the level's limit.
+  // Weights of one axis (16 centres, repeating, stride 4) at spreads up to the level's limit, and
+  // at the wider spreads of a top level (whose window wraps onto the same centres several times).
   format::NdfBlendAxis axis;
   axis.set(64.0, 2.0, 4.0, 16, true, 2.0);
   std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> pos(0.0, 64.0), extra(0.1, 6.0);
+  std::uniform_real_distribution<double> pos(0.0, 64.0);
   double worst_w = 0.0;
-  for (int q = 0; q < 500; ++q) {
-    const double p = pos(rng), sigma_l = 2.0, sigma = std::sqrt(sigma_l * sigma_l + 4.0 * 4.0 / 6.0 + extra(rng));
-    int idx[format::kMaxBlendAxis];
-    double w[format::kMaxBlendAxis];
-    const int n = axis.gaussianWeights(p, sigma, sigma_l, format::NdfPyramidBlend::kMaxSpread, idx, w);
-    // The same weights from the closed form: tau * second differences of F, wrapped and normalised.
-    const double tau = std::min(axis.spread(sigma, sigma_l), format::NdfPyramidBlend::kMaxSpread), g = (p - 2.0) / 4.0;
-    double ref[16] = {}, total = 0.0;
-    for (int i = int(std::floor(g - 3.5 * tau - 1.0)); i <= int(std::floor(g + 3.5 * tau + 1.0)) + 1; ++i) {
-      const double d = (g - i) / tau;
-      const double wi = tau * (exact(d + 1.0 / tau) - 2.0 * exact(d) + exact(d - 1.0 / tau));
-      if (!(wi > 0.0)) continue;
-      ref[((i % 16) + 16) % 16] += wi;
-      total += wi;
+  for (const double max_extra : {6.0, 330.0}) {
+    std::uniform_real_distribution<double> extra(0.1, max_extra);
+    const double max_spread = max_extra > 100.0 ? 1e300 : format::NdfPyramidBlend::kMaxSpread;
+    for (int q = 0; q < 500; ++q) {
+      const double p = pos(rng), sigma_l = 2.0, sigma = std::sqrt(sigma_l * sigma_l + 4.0 * 4.0 / 6.0 + extra(rng));
+      int idx[format::kMaxBlendAxis];
+      double w[format::kMaxBlendAxis];
+      const int n = axis.gaussianWeights(p, sigma, sigma_l, max_spread, idx, w);
+      // The same weights from the closed form: tau * second differences of F, wrapped and normalised.
+      const double tau = std::min(axis.spread(sigma, sigma_l), max_spread), g = (p - 2.0) / 4.0;
+      double ref[16] = {}, total = 0.0;
+      for (int i = int(std::floor(g - 3.5 * tau - 1.0)); i <= int(std::floor(g + 3.5 * tau + 1.0)) + 1; ++i) {
+        const double d = (g - i) / tau;
+        const double wi = tau * (exact(d + 1.0 / tau) - 2.0 * exact(d) + exact(d - 1.0 / tau));
+        if (!(wi > 0.0)) continue;
+        ref[((i % 16) + 16) % 16] += wi;
+        total += wi;
+      }
+      double sum = 0.0;
+      bool seen[16] = {};
+      for (int e = 0; e < n; ++e) {
+        ASSERT_FALSE(seen[idx[e]]) << "centre " << idx[e] << " listed twice";
+        seen[idx[e]] = true;
+        worst_w = std::max(worst_w, std::fabs(w[e] - ref[idx[e]] / total));
+        sum += w[e];
+      }
+      // Only the far tail, below the ramp's precision, may be left out.
+      for (int k = 0; k < 16; ++k) EXPECT_TRUE(seen[k] || ref[k] < 1e-8 * total) << "centre " << k << " left out";
+      EXPECT_NEAR(sum, 1.0, 1e-12);
     }
-    double sum = 0.0;
-    for (int e = 0; e < n; ++e) {
-      worst_w = std::max(worst_w, std::fabs(w[e] - ref[idx[e]] / total));
-      sum += w[e];
-    }
-    EXPECT_NEAR(sum, 1.0, 1e-12);
   }
   EXPECT_LT(worst_w, 1e-8);
   std::printf("[ figures  ] ramp error %.2g, weight error %.2g\n", worst, worst_w);

@@ -79,7 +79,8 @@ class TensorNdf : public PyramidNdf {
   const TensorIndexEntry* indexEntry(int l, int i, int j, int block) const;
   // Non-blank (centre, block) entries over all levels.
   uint64_t blocksKept() const;
-  // Bytes held in memory (factors, prefix sums, index, masses).
+  // Bytes held in memory (factors, prefix sums, index, masses, and every level's layout for point
+  // queries: a copy of its C rows by block, or an exact level's values with the centres innermost).
   uint64_t memoryBytes() const;
 
  protected:

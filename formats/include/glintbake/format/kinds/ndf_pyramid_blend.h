@@ -246,6 +246,35 @@ struct NdfBlendAxis {
     // ramp((g - i) / tau) for centres i - 1, i and i + 1: the second difference of neighbouring
     // centres shares two of its three values, so each centre costs one ramp.
     double r_prev = ramp((g - double(first - 1)) * inv_tau), r_cur = ramp((g - double(first)) * inv_tau);
+    // A repeating axis whose window wraps onto at most kMaxBlendAxis centres: centre i lands on
+    // entry (i - first) mod n, in the order of the window (no search for its entry).
+    const int span = last - first + 1, slots = span < n ? span : n;
+    if (repeat && slots <= kMaxBlendAxis) {
+      const int k0 = ((first % n) + n) % n;
+      for (int e = 0; e < slots; ++e) {
+        idx[e] = k0 + e < n ? k0 + e : k0 + e - n;
+        w[e] = 0.0;
+      }
+      int e = 0;
+      for (int i = first; i <= last; ++i) {
+        const double r_next = ramp((g - double(i + 1)) * inv_tau);
+        const double wi = tau * (r_prev - 2.0 * r_cur + r_next);
+        r_prev = r_cur;
+        r_cur = r_next;
+        if (wi > 0.0) {
+          w[e] += wi;
+          total += wi;
+        }
+        if (++e == slots) e = 0;
+      }
+      for (int k = 0; k < slots; ++k) {  // drop the centres that took no weight
+        if (w[k] > 0.0) {
+          idx[count] = idx[k];
+          w[count++] = w[k] / total;
+        }
+      }
+      return count;
+    }
     for (int i = first; i <= last; ++i) {
       const double r_next = ramp((g - double(i + 1)) * inv_tau);
       const double wi = tau * (r_prev - 2.0 * r_cur + r_next);
@@ -332,6 +361,48 @@ struct NdfBlendAxis {
   }
 };
 
+// One level of a footprint blend in separable form (NdfPyramidBlend::levels): the centre in
+// column xi[a] and row yi[b] of the level's grid weighs weight(a, b), and counts when kept().
+struct NdfBlendLevel {
+  // kProduct: level_weight * (xw * yw), kept when xw * yw > 0 (bilinear and one-centre levels);
+  // kGaussian: (level_weight * yw) * xw, kept above 1e-7 (the spread's far tail is left out).
+  enum Rule { kProduct, kGaussian };
+  static constexpr double kGaussianFloor = 1e-7;
+
+  int level = 0;
+  size_t grid_width = 1;
+  Rule rule = kProduct;
+  double level_weight = 1.0;
+  int nx = 0, ny = 0;
+  int xi[kMaxBlendAxis], yi[kMaxBlendAxis];
+  double xw[kMaxBlendAxis], yw[kMaxBlendAxis];
+
+  size_t centre(int a, int b) const { return size_t(yi[b]) * grid_width + size_t(xi[a]); }
+
+  // Calls f(a, b, weight) for the kept centres, rows then columns (emit order of blend()).
+  template <typename F>
+  void forEachWeight(F&& f) const {
+    for (int b = 0; b < ny; ++b) {
+      if (rule == kGaussian) {
+        const double row = level_weight * yw[b];
+        for (int a = 0; a < nx; ++a) {
+          const double w = row * xw[a];
+          if (w > kGaussianFloor) f(a, b, w);
+        }
+      } else {
+        for (int a = 0; a < nx; ++a) {
+          const double w = xw[a] * yw[b];
+          if (w > 0.0) f(a, b, level_weight * w);
+        }
+      }
+    }
+  }
+  template <typename Emit>
+  void forEach(Emit& emit) const {
+    forEachWeight([&](int a, int b, double w) { emit(level, centre(a, b), w); });
+  }
+};
+
 class NdfPyramidBlend {
  public:
   // Spread (tau' in strides) up to which a level answers, and from which the next level is blended
@@ -376,9 +447,18 @@ class NdfPyramidBlend {
   // weights sum to 1 (up to the truncation, see above).
   template <typename Emit>
   void blend(double x, double y, double sigma, Emit&& emit) const {
+    NdfBlendLevel parts[2];
+    const int n = levels(x, y, sigma, parts);
+    for (int p = 0; p < n; ++p) parts[p].forEach(emit);
+  }
+
+  // The same blend in separable form: the (one or two) levels it mixes, each with its centres'
+  // weights along either axis; parts[p].forEach emits exactly what blend() does, in its order.
+  // Queries that only need sum_c w_c f(c) over a grid can walk the axes instead of the centres.
+  int levels(double x, double y, double sigma, NdfBlendLevel parts[2]) const {
     if (!(sigma > level_[first_].sigma)) {
-      blendLevel(first_, 1.0, x, y, emit);
-      return;
+      bilinearLevel(first_, 1.0, x, y, &parts[0]);
+      return 1;
     }
     int l = first_;
     double q = spread(first_, sigma);
@@ -394,26 +474,34 @@ class NdfPyramidBlend {
       beta = t * t * (3.0 - 2.0 * t);
     }
     if (singleCentre(l)) {
-      singleLevel(l, 1.0 - beta, x, y, sigma, emit);
-      if (beta > 0.0) singleLevel(l + 1, beta, x, y, sigma, emit);
-      return;
+      singleLevel(l, 1.0 - beta, x, y, sigma, &parts[0]);
+      if (!(beta > 0.0)) return 1;
+      singleLevel(l + 1, beta, x, y, sigma, &parts[1]);
+      return 2;
     }
-    gaussianLevel(l, 1.0 - beta, x, y, sigma, emit);
-    if (beta > 0.0) gaussianLevel(l + 1, beta, x, y, sigma, emit);
+    gaussianLevel(l, 1.0 - beta, x, y, sigma, &parts[0]);
+    if (!(beta > 0.0)) return 1;
+    gaussianLevel(l + 1, beta, x, y, sigma, &parts[1]);
+    return 2;
   }
 
   // A level of one centre for a footprint (x, y, sigma): its image, scaled on a clamped map by the
   // footprint's mass over the map over that of the level's own footprint (no centres to mix: the
   // shape is the level's, the mass the footprint's, exactly, wherever it lies and however wide).
-  template <typename Emit>
-  void singleLevel(int l, double level_weight, double x, double y, double sigma, Emit& emit) const {
+  void singleLevel(int l, double level_weight, double x, double y, double sigma, NdfBlendLevel* out) const {
     const Level& g = level_[l];
     double w = level_weight;
     if (!g.x.repeat) {
       const double s = std::sqrt(sigma * sigma + g.sigma_h2);
       w = g.centre_mass > 0.0 ? w * (g.x.massWithin(x, s) * g.y.massWithin(y, s) / g.centre_mass) : 0.0;
     }
-    if (w > 0.0) emit(l, 0, w);
+    out->level = l;
+    out->grid_width = g.grid_width;
+    out->rule = NdfBlendLevel::kProduct;
+    out->level_weight = w;
+    out->nx = out->ny = w > 0.0 ? 1 : 0;
+    out->xi[0] = out->yi[0] = 0;
+    out->xw[0] = out->yw[0] = 1.0;
   }
 
   // blend() uses the levels from the first whose sigma is at least `sigma` (the top level when
@@ -432,41 +520,32 @@ class NdfPyramidBlend {
   }
 
   // Within level l, the tent-integrated Gaussian weights of the centres around (x, y) for a
-  // footprint of std sigma, each times level_weight (weights below 1e-7 skipped), rows then columns.
-  template <typename Emit>
-  void gaussianLevel(int l, double level_weight, double x, double y, double sigma, Emit& emit) const {
+  // footprint of std sigma, each times level_weight (weights below 1e-7 skipped, rows then columns).
+  void gaussianLevel(int l, double level_weight, double x, double y, double sigma, NdfBlendLevel* out) const {
     const Level& g = level_[l];
-    int xi[kMaxBlendAxis], yi[kMaxBlendAxis];
-    double xw[kMaxBlendAxis], yw[kMaxBlendAxis];
     // The top level spreads as far as the footprint needs when its whole grid fits the weights: on
     // a repeating map a footprint far wider than the map sees the mean of every centre, on a
     // clamped one their Gaussian-weighted sum with the mass the footprint keeps over the map.
     // A level of one centre answers up to the next level's sigma, however far that spreads it.
     auto reach = [&](const NdfBlendAxis& a) { return unboundedAbove(l, a) || singleCentre(l) ? 1e300 : kMaxSpread; };
-    const int nx = g.x.gaussianWeights(x, sigma, g.sigma, reach(g.x), xi, xw);
-    const int ny = g.y.gaussianWeights(y, sigma, g.sigma, reach(g.y), yi, yw);
-    for (int b = 0; b < ny; ++b) {
-      for (int a = 0; a < nx; ++a) {
-        const double w = level_weight * yw[b] * xw[a];
-        if (w > 1e-7) emit(l, size_t(yi[b]) * g.grid_width + size_t(xi[a]), w);
-      }
-    }
+    out->level = l;
+    out->grid_width = g.grid_width;
+    out->rule = NdfBlendLevel::kGaussian;
+    out->level_weight = level_weight;
+    out->nx = g.x.gaussianWeights(x, sigma, g.sigma, reach(g.x), out->xi, out->xw);
+    out->ny = g.y.gaussianWeights(y, sigma, g.sigma, reach(g.y), out->yi, out->yw);
   }
 
   // Within level l, the (up to) 4 nearest centres of (x, y) bilinearly (NdfBlendAxis::bilinear),
   // each weight times level_weight (zero weights skipped), rows then columns.
-  template <typename Emit>
-  void blendLevel(int l, double level_weight, double x, double y, Emit& emit) const {
+  void bilinearLevel(int l, double level_weight, double x, double y, NdfBlendLevel* out) const {
     const Level& g = level_[l];
-    int xi[2], yi[2];
-    double xw[2], yw[2];
-    const int nx = g.x.bilinear(x, xi, xw), ny = g.y.bilinear(y, yi, yw);
-    for (int b = 0; b < ny; ++b) {
-      for (int a = 0; a < nx; ++a) {
-        const double w = xw[a] * yw[b];
-        if (w > 0.0) emit(l, size_t(yi[b]) * g.grid_width + size_t(xi[a]), level_weight * w);
-      }
-    }
+    out->level = l;
+    out->grid_width = g.grid_width;
+    out->rule = NdfBlendLevel::kProduct;
+    out->level_weight = level_weight;
+    out->nx = g.x.bilinear(x, out->xi, out->xw);
+    out->ny = g.y.bilinear(y, out->yi, out->yw);
   }
 
   // Whether level l has one centre (and is not held, NdfBlendAxis::hold): a clamped map's top
