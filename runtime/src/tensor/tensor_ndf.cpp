@@ -160,11 +160,19 @@ double TensorNdf::Impl::totalMass(const Blend& b, double* masses) const {
   return total;
 }
 
-double TensorNdf::Impl::mixtureMass(const format::NdfBlendLevel* parts, int count) const {
+double TensorNdf::Impl::mixtureMass(const format::NdfBlendLevel* parts, int count, double* rows) const {
   double total = 0.0;
+  int r = 0;
   for (int p = 0; p < count; ++p) {
-    const double* centre_mass = levels[parts[p].level].centre_mass.data;
-    parts[p].forEachWeight([&](int a, int b, double w) { total += w * centre_mass[parts[p].centre(a, b)]; });
+    const format::NdfBlendLevel& part = parts[p];
+    const double* centre_mass = levels[part.level].centre_mass.data;
+    for (int b = 0; b < part.ny; ++b) {
+      double row = 0.0;
+      part.forEachInRow(b, [&](int a, double w) { row += w * centre_mass[part.centre(a, b)]; });
+      if (rows) rows[r] = row;
+      ++r;
+      total += row;
+    }
   }
   return total;
 }
@@ -393,35 +401,30 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
     // per-block blend of every centre's masses (nb^2 x centres) and a one-term CpMix.
     format::NdfBlendLevel parts[2];
     const int n = m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts);
-    // The centres' weighted masses, summed as mixtureMass sums them (the same total, bit for bit,
-    // as pdf() and mass() find), then walked for the pick.
-    struct Term {
-      double mass;
-      size_t centre;
-      int level;
-    };
-    Term terms[format::kMaxBlendCentres];
-    int count = 0;
-    double total = 0.0;
-    for (int k = 0; k < n; ++k) {
-      const double* centre_mass = m.levels[parts[k].level].centre_mass.data;
-      parts[k].forEachWeight([&](int a, int b, double w) {
-        const size_t c = parts[k].centre(a, b);
-        const double tm = w * centre_mass[c];
-        terms[count++] = Term{tm, c, parts[k].level};
-        total += tm;
-      });
-    }
+    // A row of centres by its weighted mass (the row sums of mixtureMass, whose total pdf() and
+    // mass() find too), then a centre of that row by its own.
+    double rows[2 * format::kMaxBlendAxis];
+    const double total = m.mixtureMass(parts, n, rows);
     if (!(total > 0.0)) return RuntimeStatus::kInvalidArgument;
-    MassWalk walk(u1 * total);
-    int level = 0;
-    size_t centre = 0;
-    for (int k = 0; k < count && !walk.done(); ++k) {
-      if (walk.offer(terms[k].mass)) {
-        level = terms[k].level;
-        centre = terms[k].centre;
+    MassWalk row_walk(u1 * total);
+    int part = 0, row = 0;
+    for (int k = 0, r = 0; k < n && !row_walk.done(); ++k) {
+      for (int b = 0; b < parts[k].ny && !row_walk.done(); ++b, ++r) {
+        if (row_walk.offer(rows[r])) {
+          part = k;
+          row = b;
+        }
       }
     }
+    const format::NdfBlendLevel& chosen = parts[part];
+    const int level = chosen.level;
+    const double* centre_mass = m.levels[level].centre_mass.data;
+    MassWalk walk(row_walk.u() * row_walk.chosenMass());
+    size_t centre = 0;
+    chosen.forEachInRow(row, [&](int a, double w) {
+      const size_t c = chosen.centre(a, row);
+      if (walk.offer(w * centre_mass[c])) centre = c;
+    });
     u1 = walk.u();
     const Impl::TLevel& lv = m.levels[level];
     const double* masses = lv.mass.data + centre * m.nb2;

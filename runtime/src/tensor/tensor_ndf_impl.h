@@ -91,8 +91,9 @@ struct TensorNdf::Impl {
   // Density of sample() in bin (i, j) of the image (s-plane units); shared by pdf(). Signed models.
   double binPdf(const Blend& b, int i, int j) const;
   // Non-negative models: the blend's mass as a mixture, sum_t w_t M_t (M_t the centre's mass),
-  // over its separable form.
-  double mixtureMass(const format::NdfBlendLevel* parts, int count) const;
+  // over its separable form, summed row by row; `rows`, when not null, gets each row's sum (room
+  // for 2 kMaxBlendAxis, the rows of the parts in order).
+  double mixtureMass(const format::NdfBlendLevel* parts, int count, double* rows = nullptr) const;
   // The clamped blended model value of bin (bi, bj) of block `block` (eval, pdf, a sample's
   // density), from the point levels.
   double pointValue(const format::NdfBlendLevel* parts, int count, uint64_t block, int bi, int bj) const;

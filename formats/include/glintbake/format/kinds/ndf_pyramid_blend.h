@@ -379,23 +379,26 @@ struct NdfBlendLevel {
 
   size_t centre(int a, int b) const { return size_t(yi[b]) * grid_width + size_t(xi[a]); }
 
+  // Calls f(a, weight) for the kept centres of row b, by column.
+  template <typename F>
+  void forEachInRow(int b, F&& f) const {
+    if (rule == kGaussian) {
+      const double row = level_weight * yw[b];
+      for (int a = 0; a < nx; ++a) {
+        const double w = row * xw[a];
+        if (w > kGaussianFloor) f(a, w);
+      }
+      return;
+    }
+    for (int a = 0; a < nx; ++a) {
+      const double w = xw[a] * yw[b];
+      if (w > 0.0) f(a, level_weight * w);
+    }
+  }
   // Calls f(a, b, weight) for the kept centres, rows then columns (emit order of blend()).
   template <typename F>
   void forEachWeight(F&& f) const {
-    for (int b = 0; b < ny; ++b) {
-      if (rule == kGaussian) {
-        const double row = level_weight * yw[b];
-        for (int a = 0; a < nx; ++a) {
-          const double w = row * xw[a];
-          if (w > kGaussianFloor) f(a, b, w);
-        }
-      } else {
-        for (int a = 0; a < nx; ++a) {
-          const double w = xw[a] * yw[b];
-          if (w > 0.0) f(a, b, level_weight * w);
-        }
-      }
-    }
+    for (int b = 0; b < ny; ++b) forEachInRow(b, [&](int a, double w) { f(a, b, w); });
   }
   template <typename Emit>
   void forEach(Emit& emit) const {
