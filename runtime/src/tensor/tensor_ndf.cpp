@@ -349,6 +349,60 @@ class MassWalk {
   bool done_ = false;
 };
 
+// The bin of a prefix-sum column P (P[k * stride], k = 0..bins, non-decreasing) holding the
+// fraction u of its total, and the position within it: the first k with P[k] > u P[bins] gives bin
+// k - 1 (a bin of positive width); rounding past the total lands in the last such bin.
+double invertPrefix(const float* prefix, int32_t stride, int32_t bins, double u) {
+  auto at = [&](int32_t k) { return double(prefix[size_t(k) * size_t(stride)]); };
+  const double t = u * at(bins);
+  int32_t lo = 0, hi = bins;  // at(lo) <= t, the answer k in (lo, hi]
+  if (!(t < at(bins))) {
+    while (hi > 1 && !(at(hi - 1) < at(hi))) --hi;
+    return double(hi - 1) + kOneMinusEpsilon;
+  }
+  while (hi - lo > 1) {
+    const int32_t mid = (lo + hi) / 2;
+    if (at(mid) > t) {
+      hi = mid;
+    } else {
+      lo = mid;
+    }
+  }
+  const double f = (t - at(hi - 1)) / (at(hi) - at(hi - 1));
+  return double(hi - 1) + (f < kOneMinusEpsilon ? (f > 0.0 ? f : 0.0) : kOneMinusEpsilon);
+}
+
+// A point of one stored block of a non-negative asset (C row `row` of group v) drawn from its
+// density: a rank-1 term r by c_r times the sums of its A and B columns (the prefix sums' last
+// rows), then the column of A and the column of B of that term, each by its prefix sums (for
+// an exact block, A's column r is bin r alone). O(R + log B), against the quadtree descent of a
+// blend of blocks. false when no term has positive mass.
+bool drawFromBlock(const CpGroupView& v, int32_t row, double u1, double u2, CpBlockSample* out) {
+  const int32_t rank = v.rank, bins = v.bins;
+  const float* c = v.c + size_t(row) * size_t(rank);
+  const float* a_total = v.a_prefix + size_t(bins) * size_t(rank);
+  const float* b_total = v.b_prefix + size_t(bins) * size_t(rank);
+  double total = 0.0;
+  for (int32_t r = 0; r < rank; ++r) total += double(c[r]) * double(a_total[r]) * double(b_total[r]);
+  if (!(total > 0.0)) return false;
+  MassWalk walk(u1 * total);
+  int32_t term = 0;
+  for (int32_t r = 0; r < rank && !walk.done(); ++r) {
+    if (walk.offer(double(c[r]) * double(a_total[r]) * double(b_total[r]))) term = r;
+  }
+  const double x = invertPrefix(v.a_prefix + term, rank, bins, walk.u());
+  const double y = invertPrefix(v.b_prefix + term, rank, bins, u2);
+  out->x = float(x);
+  out->y = float(y);
+  out->i = std::min(bins - 1, int32_t(x));
+  out->j = std::min(bins - 1, int32_t(y));
+  // Float rounding of the position must not leave the bin.
+  if (int32_t(out->x) != out->i) out->x = float(out->i) + 0.5f;
+  if (int32_t(out->y) != out->j) out->y = float(out->j) + 0.5f;
+  out->pdf = 0.0;  // the caller reports the blend's density
+  return true;
+}
+
 template <typename MassOf>
 uint64_t pickByMass(uint64_t count, double target, MassOf&& mass_of, double* chosen_mass, double* u) {
   MassWalk walk(target);
@@ -363,23 +417,20 @@ uint64_t pickByMass(uint64_t count, double target, MassOf&& mass_of, double* cho
 
 }  // namespace
 
-void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi, int* bj,
-                                   double* p) const {
+void TensorNdf::Impl::pointInBlock(const CpBlockSample* drawn, uint64_t block, double u1, double u2, SPoint* s, int* bi,
+                                   int* bj) const {
   const int bx = int(block % uint64_t(nb)), by = int(block / uint64_t(nb));
   double x, y;
-  CpBlockSample cs;
-  if (mix.blockMass() > 0.0f && mix.sample(u1, u2, &cs)) {
-    x = cs.x;
-    y = cs.y;
-    *bi = cs.i;
-    *bj = cs.j;
-    *p = cs.pdf;
+  if (drawn) {
+    x = drawn->x;
+    y = drawn->y;
+    *bi = drawn->i;
+    *bj = drawn->j;
   } else {
     x = u1 * bins;
     y = u2 * bins;
     *bi = std::min(bins - 1, int(x));
     *bj = std::min(bins - 1, int(y));
-    *p = 1.0 / (double(bins) * bins);
   }
   const int col = bx * bins + *bi, row = by * bins + *bj;
   *s = SPoint{-1.0 + (bx * bins + x) * bin, 1.0 - (by * bins + y) * bin};
@@ -390,15 +441,14 @@ void TensorNdf::Impl::pointInBlock(const CpMix& mix, uint64_t block, double u1, 
 
 RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, double u2, NdfSample* out) const {
   const Impl& m = *impl_;
-  CpMix mix;
   SPoint s;
   int bi, bj;
-  double p;
   if (m.nonneg) {
     // Every term is non-negative, so the blend sum_t w_t NDF_t is a mixture: a centre by its
     // weighted mass w_t M_t, a block of that centre by its mass, and a point of that one block.
     // The density is then eval / mass wherever the point lands, whatever path drew it: no
-    // per-block blend of every centre's masses (nb^2 x centres) and a one-term CpMix.
+    // per-block blend of every centre's masses (nb^2 x centres), and one block's point drawn term
+    // by term (drawFromBlock).
     format::NdfBlendLevel parts[2];
     const int n = m.blender.levels(footprint.x, footprint.y, footprint.sigma, parts);
     // A row of centres by its weighted mass (the row sums of mixtureMass, whose total pdf() and
@@ -433,9 +483,9 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
         m.nb2, u1 * lv.centre_mass.data[centre], [&](uint64_t k) { return masses[k]; }, &block_mass, &u1);
     // A block with positive mass is never blank (blank blocks weigh 0).
     const TensorIndexEntry& e = lv.index.data[centre * m.nb2 + block];
-    const CpBlendTerm one{&m.groups.data[e.group].view, int32_t(e.row), 1.0f, float(block_mass * m.inv_bin_area)};
-    mix.init(&one, 1);
-    m.pointInBlock(mix, block, u1, u2, &s, &bi, &bj, &p);
+    CpBlockSample drawn;
+    const bool ok = drawFromBlock(m.groups.data[e.group].view, int32_t(e.row), u1, u2, &drawn);
+    m.pointInBlock(ok ? &drawn : nullptr, block, u1, u2, &s, &bi, &bj);
     out->s = s;
     // pdf() forms the same quotient. A point whose blended value rounds to 0 (not seen on valid
     // assets) reports density 0, as pdf() does there.
@@ -453,8 +503,14 @@ RuntimeStatus TensorNdf::sampleChecked(const Footprint& footprint, double u1, do
       m.nb2, u1 * total, [&](uint64_t k) { return m.keepsMasses() ? masses[k] : m.blockMass(b, k); }, &chosen_mass,
       &u1);
   // 2. Bin and point inside the block.
+  CpMix mix;
   m.mixBlock(b, chosen, &mix);
-  m.pointInBlock(mix, chosen, u1, u2, &s, &bi, &bj, &p);
+  // A block whose blended raw mass is positive but whose float range sum rounds to <= 0 is
+  // sampled uniformly (binPdf() does the same).
+  CpBlockSample drawn;
+  const bool ok = mix.blockMass() > 0.0f && mix.sample(u1, u2, &drawn);
+  const double p = ok ? drawn.pdf : 1.0 / (double(m.bins) * m.bins);
+  m.pointInBlock(ok ? &drawn : nullptr, chosen, u1, u2, &s, &bi, &bj);
   out->s = s;
   out->pdf = combinePdf(chosen_mass, total, p, m.bin_area);
   return RuntimeStatus::kOk;

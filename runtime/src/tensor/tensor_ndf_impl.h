@@ -99,10 +99,10 @@ struct TensorNdf::Impl {
   double pointValue(const format::NdfBlendLevel* parts, int count, uint64_t block, int bi, int bj) const;
   // The same for bin (i, j) of the whole R x R image.
   double imagePointValue(const format::NdfBlendLevel* parts, int count, int i, int j) const;
-  // Draws a point of block `block` from `mix` (uniformly when its float mass is 0): the s-plane
-  // point, its bin (bi, bj) within the block and the within-block density p (per unit bin area).
-  void pointInBlock(const CpMix& mix, uint64_t block, double u1, double u2, SPoint* s, int* bi, int* bj,
-                    double* p) const;
+  // The s-plane point of a point `drawn` of block `block` (bin units within the block; null: a
+  // uniform point of the block from u1, u2), and its bin (bi, bj) within the block.
+  void pointInBlock(const CpBlockSample* drawn, uint64_t block, double u1, double u2, SPoint* s, int* bi,
+                    int* bj) const;
   // Image bin column (or row) n -> block column `block` and bin within it `local`.
   void splitBin(int n, int* block, int* local) const {
     if (bins_shift >= 0) {
