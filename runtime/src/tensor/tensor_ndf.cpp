@@ -192,13 +192,12 @@ double TensorNdf::Impl::pointValue(const format::NdfBlendLevel* parts, int count
       part.forEachWeight([&](int a, int b, double w) { sum += w * double(v[part.centre(a, b)]); });
       continue;
     }
-    const uint64_t first = block * pl.centres;
+    const PointSlot* slots = pl.slots.data + block * pl.centres;
     part.forEachWeight([&](int a, int b, double w) {
-      const uint64_t slot = first + part.centre(a, b);
-      const uint32_t g = pl.group.data[slot];
-      if (g == kTensorBlankGroup) return;
-      const CpGroupView& v = groups.data[g].view;
-      const float* row = pl.rows.data + slot * uint64_t(pl.row_stride);
+      const PointSlot& slot = slots[part.centre(a, b)];
+      if (slot.group == kTensorBlankGroup) return;
+      const CpGroupView& v = groups.data[slot.group].view;
+      const float* row = pl.rows.data + uint64_t(slot.row) * uint64_t(pl.row_stride);
       const size_t rank = size_t(v.rank);
       const float value = v.identity_a ? row[bi] * v.b[size_t(bj) * rank + size_t(bi)]
                                        : laneDot3(v.a + size_t(bi) * rank, v.b + size_t(bj) * rank, row, v.rank);

@@ -29,15 +29,20 @@ struct TensorNdf::Impl {
   // A level laid out for point queries (eval, pdf, the density of a sample), built at load: the
   // centres of one block lie side by side, so that a footprint's blend over a few hundred
   // neighbouring centres reads a few contiguous runs instead of chasing each centre's index
-  // entry into its group. Exact levels (every stored block exact, tensorpack's coarse levels)
-  // within kPointDenseBytes keep their values with the centres innermost; the others a copy of
-  // each block's C row and its group.
+  // entry into its group. Exact levels (every stored block exact, tensorpack's coarse levels) of
+  // at most kPointDenseBytes whose blocks are mostly stored keep their values with the centres
+  // innermost; the others a copy of their stored blocks' C rows, by block. Either copy is at most
+  // about the size of what the level's groups already hold, whatever the asset claims.
+  struct PointSlot {
+    uint32_t group = kTensorBlankGroup;  // kTensorBlankGroup: a blank block
+    uint32_t row = 0;                    // the row of `rows` holding its C row
+  };
   struct PointLevel {
     uint64_t centres = 0;
     bool dense = false;
     Array<float> values;     // dense: [(block * bins^2 + bj * bins + bi) * centres + centre]
-    Array<float> rows;       // otherwise: [(block * centres + centre) * row_stride + r]
-    Array<uint32_t> group;   // otherwise: [block * centres + centre], kTensorBlankGroup for blank
+    Array<PointSlot> slots;  // otherwise: [block * centres + centre]
+    Array<float> rows;       // otherwise: [row * row_stride + r], the stored blocks' C rows
     int32_t row_stride = 0;  // the level's largest rank
   };
   static constexpr uint64_t kPointDenseBytes = uint64_t(64) << 20;

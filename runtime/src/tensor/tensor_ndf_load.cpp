@@ -196,20 +196,26 @@ RuntimeStatus TensorNdf::Impl::buildPointLevel(int l) {
   const TLevel& lv = levels[l];
   PointLevel& p = point[l];
   p.centres = uint64_t(lv.rec.grid_width) * lv.rec.grid_height;
+  const uint64_t slots = p.centres * nb2;
   // Entries were checked by loadIndex: every group exists and every row lies within it.
   bool exact = true;
+  uint64_t stored = 0;
   int32_t stride = 0;
-  for (uint64_t e = 0; e < p.centres * nb2; ++e) {
+  for (uint64_t e = 0; e < slots; ++e) {
     const TensorIndexEntry& entry = lv.index.data[e];
     if (entry.group == kTensorBlankGroup) continue;
     const CpGroupView& v = groups.data[entry.group].view;
     exact = exact && v.identity_a;
     stride = std::max(stride, v.rank);
+    ++stored;
   }
+  if (stored > uint64_t(UINT32_MAX)) return RuntimeStatus::kOutOfMemory;  // (rows numbered in 32 bits)
   const uint64_t bins2 = uint64_t(bins) * uint64_t(bins);
-  p.dense = exact && p.centres * nb2 * bins2 * sizeof(float) <= kPointDenseBytes;
+  // Dense only when at least half the blocks are stored: its values then take at most twice the
+  // stored blocks' B factors.
+  p.dense = exact && stored > 0 && 2 * stored >= slots && slots * bins2 * sizeof(float) <= kPointDenseBytes;
   if (p.dense) {
-    if (!p.values.allocate(size_t(p.centres * nb2 * bins2))) return RuntimeStatus::kOutOfMemory;
+    if (!p.values.allocate(size_t(slots * bins2))) return RuntimeStatus::kOutOfMemory;
     for (uint64_t c = 0; c < p.centres; ++c) {
       for (uint64_t block = 0; block < nb2; ++block) {
         const TensorIndexEntry& e = lv.index.data[c * nb2 + block];
@@ -231,22 +237,23 @@ RuntimeStatus TensorNdf::Impl::buildPointLevel(int l) {
     return RuntimeStatus::kOk;
   }
   p.row_stride = stride;
-  const uint64_t slots = p.centres * nb2;
-  if (!p.group.allocate(size_t(slots)) || !p.rows.allocate(size_t(slots * uint64_t(stride))))
+  if (!p.slots.allocate(size_t(slots)) || !p.rows.allocate(size_t(stored * uint64_t(stride))))
     return RuntimeStatus::kOutOfMemory;
-  for (uint64_t c = 0; c < p.centres; ++c) {
-    for (uint64_t block = 0; block < nb2; ++block) {
+  uint32_t next = 0;
+  for (uint64_t block = 0; block < nb2; ++block) {
+    for (uint64_t c = 0; c < p.centres; ++c) {
       const TensorIndexEntry& e = lv.index.data[c * nb2 + block];
-      const uint64_t slot = block * p.centres + c;
-      float* row = p.rows.data + slot * uint64_t(stride);
-      p.group.data[slot] = e.group;
-      std::fill(row, row + stride, 0.0f);
+      PointSlot& slot = p.slots.data[block * p.centres + c];
+      slot.group = e.group;
       if (e.group == kTensorBlankGroup) continue;
+      slot.row = next;
+      float* row = p.rows.data + uint64_t(next++) * uint64_t(stride);
       const CpGroupView& v = groups.data[e.group].view;
+      std::fill(row, row + stride, 0.0f);
       std::copy(v.c + size_t(e.row) * size_t(v.rank), v.c + size_t(e.row + 1) * size_t(v.rank), row);
     }
   }
-  memory_bytes += p.group.size * sizeof(uint32_t) + p.rows.size * sizeof(float);
+  memory_bytes += p.slots.size * sizeof(PointSlot) + p.rows.size * sizeof(float);
   return RuntimeStatus::kOk;
 }
 
