@@ -362,7 +362,8 @@ struct NdfBlendAxis {
 };
 
 // One level of a footprint blend in separable form (NdfPyramidBlend::levels): the centre in
-// column xi[a] and row yi[b] of the level's grid weighs weight(a, b), and counts when kept().
+// column xi[a] and row yi[b] of the level's grid weighs what `rule` makes of xw[a] and yw[b], and
+// counts when the rule keeps it (forEachInRow and forEachWeight give the kept centres only).
 struct NdfBlendLevel {
   // kProduct: level_weight * (xw * yw), kept when xw * yw > 0 (bilinear and one-centre levels);
   // kGaussian: (level_weight * yw) * xw, kept above 1e-7 (the spread's far tail is left out).
