@@ -71,7 +71,6 @@ void TensorNdf::Impl::blend(const Footprint& fp, Blend* b) const {
     b->weight[b->count] = weight;
     b->index[b->count] = lv.index.data + first;
     b->mass[b->count] = lv.mass.data + first;
-    b->centre_mass[b->count] = nonneg ? lv.centre_mass.data[centre] : 0.0;
     ++b->count;
   });
 }

@@ -53,7 +53,6 @@ struct TensorNdf::Impl {
     double weight[format::kMaxBlendCentres];
     const TensorIndexEntry* index[format::kMaxBlendCentres];  // the centre's nb2 entries
     const double* mass[format::kMaxBlendCentres];             // the centre's nb2 raw masses
-    double centre_mass[format::kMaxBlendCentres];             // non-negative assets: their sum
   };
 
   TensorInfoRecord info;
