@@ -75,6 +75,7 @@ struct Payload {
   uint64_t size = 0;
   std::vector<uint8_t> head;                   // the first min(size, kHead) bytes
   std::vector<uint8_t> whole;                  // every byte, when keep_whole
+  uint8_t tail[8] = {};                        // the last min(size, 8) bytes, at the end
   uint64_t nonfinite_after_image_header = 0;   // floats at offsets >= 32
   bool nonfinite_after_flakes_record = false;  // floats at offsets >= sizeof(FlakesRecord)
   bool outside_unit = false;                   // !(|v| <= 1) for a float at any offset
@@ -104,6 +105,9 @@ class PayloadSink final : public detail::SectionSink {
     for (; i + 4 <= size; i += 4) noteAt(data + i);
     while (i < size) carry_[carried_++] = data[i++];
     p_->size += size;
+    const size_t keep = std::min<size_t>(size, sizeof(p_->tail));  // the last bytes so far
+    std::memmove(p_->tail, p_->tail + keep, sizeof(p_->tail) - keep);
+    std::memcpy(p_->tail + sizeof(p_->tail) - keep, data + size - keep, keep);
   }
 
  private:
@@ -130,7 +134,8 @@ class PayloadSink final : public detail::SectionSink {
   uint64_t offset_ = 0;
 };
 
-// The flakes section (SPEC.md 10.5): its record passes checkFlakesRecord and its normals are finite.
+// The flakes section (SPEC.md 10.5): its record passes checkFlakesRecord, its normals are finite and
+// a version-3 trailer passes checkFlakesTrailer.
 void checkFlakesPayload(size_t index, const SectionInfo& s, const Payload& raw,
                         std::vector<ValidationMessage>* messages) {
   FlakesRecord rec;
@@ -144,6 +149,11 @@ void checkFlakesPayload(size_t index, const SectionInfo& s, const Payload& raw,
     return;
   }
   if (raw.nonfinite_after_flakes_record) addError(messages, 4008, describe(index, s) + ": non-finite normals");
+  if (rec.version >= 3) {
+    FlakesTrailer trailer;
+    std::memcpy(&trailer, raw.tail, sizeof(trailer));
+    if (const char* why = checkFlakesTrailer(trailer)) addError(messages, 4008, describe(index, s) + ": " + why);
+  }
 }
 
 // The wang-tiles sections (SPEC.md 10.7): the record passes checkWangRecord; the edges section

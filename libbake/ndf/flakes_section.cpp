@@ -6,10 +6,15 @@
 
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/runtime/flake_ndf.h>
+#include <glintbake/runtime/lobe_ndf.h>
+#include <glintbake/runtime/texel_source.h>
+
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -112,6 +117,158 @@ void fitRecord(format::FlakesRecord* rec) {
 }
 }  // namespace
 
+namespace {
+// The L1 distance between two NDFs f and g of one footprint, estimated from points drawn from the
+// mixture m = sum_k n_k h_k / N of the densities the points were drawn from (points[k] from h_k):
+// integral |f - g| = E_m[|f - g| / m]. fv, gv and mv hold f, g and m at every point.
+double mixtureL1(const std::vector<double>& fv, const std::vector<double>& gv, const std::vector<double>& mv) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t k = 0; k < fv.size(); ++k) {
+    if (mv[k] > 0.0) sum += std::fabs(fv[k] - gv[k]) / mv[k];
+    ++n;
+  }
+  return n ? sum / double(n) : 0.0;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+// kSamples points of source's NDF at fp, from a two-dimensional golden-ratio sequence of
+// uniforms; points outside the s-square (density 0) are left out.
+template <typename Source>
+std::vector<runtime::SPoint> drawPoints(const Source& source, const runtime::Footprint& fp, int count) {
+  std::vector<runtime::SPoint> out;
+  for (int k = 0; k < count; ++k) {
+    const double u1 = (k + 0.5) / count, u2 = std::fmod(0.5 + 0.6180339887498949 * (k + 1), 1.0);
+    runtime::NdfSample smp;
+    if (source.sample(fp, u1, u2, &smp) != runtime::RuntimeStatus::kOk) continue;
+    if (std::fabs(smp.s.x) <= 1.0 && std::fabs(smp.s.y) <= 1.0) out.push_back(smp.s);
+  }
+  return out;
+}
+
+template <typename Source>
+double densityAt(const Source& source, const runtime::Footprint& fp, const runtime::SPoint& s) {
+  double v = 0.0;
+  return source.eval(fp, s, &v) == runtime::RuntimeStatus::kOk ? v : 0.0;
+}
+}  // namespace
+
+uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
+                             double pyramid_from) {
+  constexpr size_t kCandidates = std::size(kLobeTileRatioCandidates);
+  const int width = texels.width(), height = texels.height();
+  if (lobes_per_tile <= 0 || width < 1 || height < 1 || rate < 1) return format::kDefaultFlakesTileRatioMilli;
+  const bool repeat = texels.repeats();
+  // The targets are on NDF images of R x R bins, which average out detail finer than a bin: the
+  // densities compared here are those of every lobe widened by a bin's variance (a box of side
+  // 2 / R has variance (2 / R)^2 / 12), the images' blur as a Gaussian.
+  const double bin = 2.0 / kLobeProbeResolution;
+  const double probe_sigma_r = std::min(1.0, std::sqrt(sigma_r * sigma_r + bin * bin / 12.0));
+  runtime::FlakeNdf exact;
+  runtime::LobeNdf lobes;
+  if (exact.build(texels, rate, probe_sigma_r, kLobeProbeResolution) != runtime::RuntimeStatus::kOk ||
+      lobes.build(texels, rate, probe_sigma_r, lobes_per_tile, kLobeProbeResolution) != runtime::RuntimeStatus::kOk)
+    return format::kDefaultFlakesTileRatioMilli;  // the section's own checks report what is wrong
+  // Footprints the lobes can answer on this map: below the flat footprint of a repeating map (the
+  // pyramid answers from there, capAtFlatFootprint), within the lobes' window and the exact
+  // flakes'.
+  const double side = double(std::max(width, height));
+  const double lobes_max = std::min(lobes.footprintRange().clustered_max_sigma,
+                                    repeat ? kFlatAxisSigma * side / kHalfOctave : kClampedFlatSigma * side);
+  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+  bool passes[kCandidates];
+  std::fill(std::begin(passes), std::end(passes), true);
+  constexpr int kPositions = kLobeProbePositions;
+  for (double sigma : kLobeProbeSigmas) {
+    if (!(sigma < pyramid_from && sigma <= lobes_max && sigma <= window_max)) continue;
+    // Positions of a two-dimensional golden-ratio sequence over the map.
+    std::vector<runtime::Footprint> fps;
+    std::vector<double> masses;
+    for (int i = 0; i < kPositions; ++i) {
+      const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
+      const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
+      fps.push_back({fx * width, fy * height, sigma});
+      double m = 0.0;
+      exact.mass(fps.back(), &m);
+      masses.push_back(m);
+    }
+    // Points of every position's exact NDF; at each, every position's exact density.
+    std::vector<std::vector<runtime::SPoint>> drawn(kPositions);
+    std::vector<runtime::SPoint> all;
+    std::vector<size_t> owner;
+    tbb::parallel_for(0, kPositions,
+                      [&](int i) { drawn[size_t(i)] = drawPoints(exact, fps[size_t(i)], kLobeProbeSamples); });
+    for (int i = 0; i < kPositions; ++i) {
+      for (const runtime::SPoint& s : drawn[size_t(i)]) {
+        all.push_back(s);
+        owner.push_back(size_t(i));
+      }
+    }
+    if (all.empty()) continue;
+    std::vector<std::vector<double>> p(kPositions, std::vector<double>(all.size()));
+    tbb::parallel_for(size_t(0), size_t(kPositions) * all.size(), [&](size_t e) {
+      const size_t j = e / all.size(), k = e % all.size();
+      p[j][k] = masses[j] > 0.0 ? densityAt(exact, fps[j], all[k]) / masses[j] : 0.0;
+    });
+    std::vector<double> mean(all.size(), 0.0);
+    for (int j = 0; j < kPositions; ++j)
+      for (size_t k = 0; k < all.size(); ++k) mean[k] += p[size_t(j)][k] / kPositions;
+    // The baseline of each position: its NDF against the mean of them all, from every point (the
+    // mean's own).
+    std::vector<double> spread(kPositions), errors(kPositions);
+    for (int i = 0; i < kPositions; ++i) spread[size_t(i)] = mixtureL1(mean, p[size_t(i)], mean);
+    const double baseline = median(spread);
+    for (size_t c = 0; c < kCandidates; ++c) {
+      if (!passes[c]) continue;
+      lobes.setTileRatio(kLobeTileRatioCandidates[c] / 1000.0);
+      tbb::parallel_for(0, kPositions, [&](int i) {
+        const runtime::Footprint& fp = fps[size_t(i)];
+        double lobes_mass = 0.0;
+        lobes.mass(fp, &lobes_mass);
+        // Points of the exact NDF and of the lobes' alike: their mixture's density at each.
+        std::vector<runtime::SPoint> points = drawn[size_t(i)];
+        const size_t from_exact = points.size();
+        for (const runtime::SPoint& s : drawPoints(lobes, fp, kLobeProbeSamples)) points.push_back(s);
+        std::vector<double> pv(points.size()), qv(points.size()), mv(points.size());
+        for (size_t k = 0; k < points.size(); ++k) {
+          pv[k] = masses[size_t(i)] > 0.0 ? densityAt(exact, fp, points[k]) / masses[size_t(i)] : 0.0;
+          qv[k] = lobes_mass > 0.0 ? densityAt(lobes, fp, points[k]) / lobes_mass : 0.0;
+          mv[k] = (double(from_exact) * pv[k] + double(points.size() - from_exact) * qv[k]) / double(points.size());
+        }
+        errors[size_t(i)] = mixtureL1(qv, pv, mv);
+      });
+      const double error = median(errors);
+      passes[c] = error <= kLobeProbeMaxError && error <= kLobeProbeMaxRatio * baseline;
+    }
+  }
+  for (size_t c = 0; c < kCandidates; ++c)
+    if (passes[c]) return kLobeTileRatioCandidates[c];
+  return kLobeTileRatioCandidates[kCandidates - 1];
+}
+
+namespace {
+// Writes the trailer of a version-3 section whose record and normals are in place: the requested
+// tile ratio, or (0) the one chooseLobeTileRatio picks for its flakes and hand-over.
+void writeTrailer(std::vector<uint8_t>& section, const format::FlakesRecord& rec, uint32_t requested) {
+  if (rec.version < 3 || section.size() < sizeof(rec) + sizeof(format::FlakesTrailer)) return;
+  format::FlakesTrailer trailer;
+  if (requested != 0) {
+    trailer.tile_ratio_milli = requested;
+  } else if (format::hasLobes(rec)) {
+    const runtime::InterleavedTexels texels(int(rec.map_width), int(rec.map_height), rec.wrap == 0,
+                                            reinterpret_cast<const float*>(section.data() + sizeof(rec)), 2);
+    trailer.tile_ratio_milli =
+        chooseLobeTileRatio(texels, int(rec.rate), rec.sigma_r, int(rec.lobes_per_tile), rec.pyramid_from);
+  }
+  std::memcpy(section.data() + (section.size() - sizeof(trailer)), &trailer, sizeof(trailer));
+}
+}  // namespace
+
 Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
                                                 const FlakesHandover& handover) {
   format::FlakesRecord rec;
@@ -140,6 +297,7 @@ Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, 
     normals[t * 2 + 0] = map.normals[t * 3 + 0];
     normals[t * 2 + 1] = map.normals[t * 3 + 1];
   }
+  writeTrailer(section, rec, handover.tile_ratio_milli);
   return section;
 }
 
@@ -147,7 +305,7 @@ BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover
   format::FlakesRecord rec;
   if (section.size() < sizeof(rec)) return makeError(ErrorCode::kInvalidInput, "the flakes section is truncated");
   std::memcpy(&rec, section.data(), sizeof(rec));
-  rec.version = format::FlakesRecord().version;
+  rec.version = std::max(rec.version, 2u);  // (the trailer of version 3 is rewritten below)
   rec.flakes_up_to = handover.flakes_up_to;
   rec.pyramid_from = handover.pyramid_from;
   rec.lobes_per_tile = uint32_t(std::max(handover.lobes_per_tile, 0));
@@ -155,6 +313,7 @@ BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover
   fitRecord(&rec);
   if (const char* why = format::checkFlakesRecord(rec, section.size())) return makeError(ErrorCode::kInvalidInput, why);
   std::memcpy(section.data(), &rec, sizeof(rec));
+  writeTrailer(section, rec, handover.tile_ratio_milli);
   return okStatus();
 }
 

@@ -82,6 +82,7 @@ class GlintinfoTest(clitest.ToolTestCase):
                 self.assertAlmostEqual(fp["clustered_min_sigma"], 4.0 * 2 ** 0.5)
                 self.assertAlmostEqual(fp["clustered_max_sigma"], 4.0 * 2 ** 0.5)
                 self.assertEqual(fp["lobes_per_tile"], 16)
+                self.assertEqual(fp["lobes_tile_ratio"], 0.35)  # the default: no probe footprint on this map
                 self.assertAlmostEqual(fp["handover_max_sigma"], 8.0)
             else:
                 self.assertEqual(fp["clustered_max_sigma"], 0.0)
@@ -90,7 +91,7 @@ class GlintinfoTest(clitest.ToolTestCase):
             out, _ = self.run_ok("glintinfo", "info", asset)
             self.assertIn("exact from the flakes" if flakes else "no flakes", out)
             if flakes and lobes:
-                self.assertIn("clustered lobes (16 per tile)", out)
+                self.assertIn("clustered lobes (16 per tile, tiles of up to 0.35 sigma)", out)
         # Containers without levels have neither.
         doc = self.run_json("glintinfo", "info", self.image_container("c.gbk"), schema="glintinfo-info.schema.json")
         self.assertNotIn("footprints", doc)

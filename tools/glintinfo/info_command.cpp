@@ -68,6 +68,8 @@ cli::Json footprintSummary(const format::Reader& reader, const std::string& path
           fp["clustered_min_sigma"] = rec.flakes_up_to * format::kLobesBand;
           fp["clustered_max_sigma"] = rec.lobes_up_to;
           fp["lobes_per_tile"] = rec.lobes_per_tile;
+          uint32_t milli = format::kDefaultFlakesTileRatioMilli;
+          if (format::flakesTileRatio(rec, bytes.data(), bytes.size(), &milli)) fp["lobes_tile_ratio"] = milli / 1000.0;
         }
       }
     }
@@ -145,10 +147,12 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
                 s["map"]["height"].get<int>(), s["map"]["wrap"].get<std::string>().c_str());
     if (f["exact_max_sigma"].get<double>() > 0.0 && f["clustered_max_sigma"].get<double>() > 0.0) {
       std::printf(
-          "footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile) from %g "
-          "to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
-          f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(), f["clustered_min_sigma"].get<double>(),
-          f["clustered_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());
+          "footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile, tiles of up "
+          "to %g sigma) from %g to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
+          f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(),
+          f.value("lobes_tile_ratio", format::kDefaultFlakesTileRatioMilli / 1000.0),
+          f["clustered_min_sigma"].get<double>(), f["clustered_max_sigma"].get<double>(),
+          f["handover_max_sigma"].get<double>());
     } else if (f["exact_max_sigma"].get<double>() > 0.0) {
       std::printf("footprints:     exact from the flakes for sigma <= %g texels, blended into the pyramid up to %g\n",
                   f["exact_max_sigma"].get<double>(), f["handover_max_sigma"].get<double>());

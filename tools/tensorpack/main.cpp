@@ -231,8 +231,10 @@ int sourceLobesPerTile(const format::Reader& reader, const std::string& input) {
 // until finishTensorAsset sets the one the compression calls for.
 std::vector<uint8_t> mapFlakes(const Options& o, const bake::NormalMap& map) {
   if (!o.pyramid.flakes) return {};
-  return cli::unwrap(bake::ndf::flakesSectionBytes(map, o.pyramid.options.rate, o.pyramid.options.splat.sigma_r,
-                                                   cli::defaultFlakesHandover(o.pyramid, map)));
+  bake::ndf::FlakesHandover provisional = cli::defaultFlakesHandover(o.pyramid, map);
+  provisional.tile_ratio_milli = format::kDefaultFlakesTileRatioMilli;  // (chosen with the final hand-over)
+  return cli::unwrap(
+      bake::ndf::flakesSectionBytes(map, o.pyramid.options.rate, o.pyramid.options.splat.sigma_r, provisional));
 }
 
 // What the end of the bake needs besides the report (the same on one machine and in the merge).

@@ -3,18 +3,38 @@
 #include <glintbake/format/kinds/flakes.h>
 
 #include <cmath>
+#include <cstring>
 
 namespace glintbake::format {
 
 uint64_t flakesSectionSize(const FlakesRecord& r) {
   if (r.map_width < 1 || r.map_height < 1 || r.map_width > kMaxFlakesMapSide || r.map_height > kMaxFlakesMapSide)
     return 0;
-  return sizeof(FlakesRecord) + uint64_t(r.map_width) * uint64_t(r.map_height) * 8u;
+  return sizeof(FlakesRecord) + uint64_t(r.map_width) * uint64_t(r.map_height) * 8u +
+         (r.version >= 3 ? sizeof(FlakesTrailer) : 0u);
+}
+
+const char* checkFlakesTrailer(const FlakesTrailer& t) {
+  if (t.tile_ratio_milli < kMinFlakesTileRatioMilli || t.tile_ratio_milli > kMaxFlakesTileRatioMilli)
+    return "flakes trailer: tile_ratio out of range";
+  if (t.reserved != 0) return "flakes trailer: reserved is not 0";
+  return nullptr;
+}
+
+bool flakesTileRatio(const FlakesRecord& r, const uint8_t* section, uint64_t raw_size, uint32_t* milli) {
+  *milli = kDefaultFlakesTileRatioMilli;
+  if (r.version < 3) return true;
+  if (raw_size < sizeof(FlakesRecord) + sizeof(FlakesTrailer)) return false;
+  FlakesTrailer t;
+  std::memcpy(&t, section + (raw_size - sizeof(t)), sizeof(t));
+  if (checkFlakesTrailer(t)) return false;
+  *milli = t.tile_ratio_milli;
+  return true;
 }
 
 const char* checkFlakesRecord(const FlakesRecord& r, uint64_t section_raw_size) {
   if (r.magic != FlakesRecord().magic) return "flakes record: bad magic";
-  if (r.version != 1 && r.version != 2) return "flakes record: unsupported version";
+  if (r.version < 1 || r.version > 3) return "flakes record: unsupported version";
   if (flakesSectionSize(r) == 0) return "flakes record: map size out of range";
   if (r.wrap > 1) return "flakes record: wrap is neither repeat nor clamp";
   if (r.rate < 1 || r.rate > kMaxFlakesRate) return "flakes record: rate out of range";

@@ -34,6 +34,9 @@ RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resoluti
     return s;
   std::memcpy(&rec, section_bytes.data, sizeof(rec));
   if (format::checkFlakesRecord(rec, info.raw_size) != nullptr) return RuntimeStatus::kInvalidAsset;
+  uint32_t tile_ratio_milli = 0;
+  if (!format::flakesTileRatio(rec, section_bytes.data, info.raw_size, &tile_ratio_milli))
+    return RuntimeStatus::kInvalidAsset;
   const float* normals = reinterpret_cast<const float*>(section_bytes.data + sizeof(rec));
   const InterleavedTexels texels(int(rec.map_width), int(rec.map_height), rec.wrap == 0, normals, 2);
   FlakePaths p;
@@ -46,6 +49,7 @@ RuntimeStatus loadFlakes(const format::Reader& reader, int section, int resoluti
     built = p.lobes ? LobeNdfAccess::build(*p.lobes, texels, int(rec.rate), rec.sigma_r, int(rec.lobes_per_tile),
                                            resolution, p.flakes.get())
                     : RuntimeStatus::kOutOfMemory;
+    if (built == RuntimeStatus::kOk) built = p.lobes->setTileRatio(tile_ratio_milli / 1000.0);
   }
   if (built == RuntimeStatus::kInvalidArgument) return RuntimeStatus::kInvalidAsset;  // non-finite normals
   if (built != RuntimeStatus::kOk) return built;

@@ -33,7 +33,6 @@ namespace {
 constexpr int kLanes = kMaxLobesPerTile;
 constexpr int kFinestTile = 4;  // flakes per side of a level-0 tile
 static_assert(2 * kFinestTile == flakes::kTileFlakes, "level 1's tiles are the exact flakes' tiles");
-constexpr double kTileRatio = 0.35;  // a footprint is answered on tiles of at most this x its std
 // Where the footprint weight is low the clustered levels take coarser tiles: a tile k levels above
 // the footprint's own is taken where its nearest point lies at least sqrt(2 k kCoarsenStep)
 // standard deviations from the centre (1.4, 2 and 2.4 for k = 1..kMaxCoarser), that is where the
@@ -211,7 +210,7 @@ void costRow(const Marginals& p, int i, int from, int count, double* row) {
 // than k remain, the pair of least merge cost (ties to the lower slot) is replaced by its
 // moment-matched union (so every lobe keeps the exact weight, mean and covariance of the items it
 // stands for). The cost is taken on the normal marginals because the footprints a level answers
-// are at least 1 / kTileRatio times its tiles: across a tile the footprint weight changes little
+// are at least 1 / (tile ratio) times its tiles: across a tile the footprint weight changes little
 // and what the image sees is the mixture of the tile's normal distributions. Every row caches its
 // cheapest partner, so a merge costs one new row of costs and a rescan of the rows that pointed at
 // the pair. Writes the lobes to out and returns their count.
@@ -366,6 +365,7 @@ struct LobeNdf::Impl {
   bool repeat = true;
   double step = 1.0, sigma_h2 = 0.0, sigma_r2 = 0.0;
   int res = 128, lobes = kLanes;
+  double tile_ratio = kDefaultLobeTileRatio;  // a footprint is answered on tiles of at most this x its std
   Level levels[kMaxLevels];
   int level_count = 0;
   // Level 0 is built by build() (unless made on demand, below); a level above on its first query
@@ -639,7 +639,7 @@ void LobeNdf::Impl::packTile(const Gauss4* g, int count, Block* block, Bound* bo
 }
 
 int LobeNdf::Impl::levelFor(double sigma) const {
-  const double want = kTileRatio * sigma * rate;
+  const double want = tile_ratio * sigma * rate;
   int l = 0;
   while (l + 1 < level_count && double(levels[l + 1].tile) <= want) ++l;
   return l;
@@ -650,9 +650,9 @@ void LobeNdf::Impl::chooseLevels(double sigma, Terms* t) const {
   t->sp2 = sigma * sigma;
   t->finest = levelFor(sigma);
   // Coarser levels up to kMaxCoarser above the answering one, when its tiles are within
-  // kTileRatio sigma (not when the finest level is answering a footprint narrower than that).
+  // tile_ratio sigma (not when the finest level is answering a footprint narrower than that).
   t->coarsest = t->finest;
-  if (double(levels[t->finest].tile) <= kTileRatio * sigma * rate)
+  if (double(levels[t->finest].tile) <= tile_ratio * sigma * rate)
     t->coarsest = std::min(level_count - 1, t->finest + kMaxCoarser);
   t->exact_mode = t->inner_exact = t->skip_inner = false;
   t->inner_cut = {0.0, 0.0};
@@ -923,6 +923,15 @@ LobeNdf::~LobeNdf() = default;
 RuntimeStatus LobeNdf::build(const TexelSource& source, int rate, double sigma_r, int lobes_per_tile, int resolution) {
   return LobeNdfAccess::build(*this, source, rate, sigma_r, lobes_per_tile, resolution, nullptr);
 }
+
+RuntimeStatus LobeNdf::setTileRatio(double ratio) {
+  if (!(ratio >= kMinLobeTileRatio && ratio <= kMaxLobeTileRatio)) return RuntimeStatus::kInvalidArgument;
+  if (!impl_) return RuntimeStatus::kInvalidArgument;
+  impl_->tile_ratio = ratio;
+  return RuntimeStatus::kOk;
+}
+
+double LobeNdf::tileRatio() const { return impl_ ? impl_->tile_ratio : kDefaultLobeTileRatio; }
 
 RuntimeStatus LobeNdfAccess::build(LobeNdf& lobes, const TexelSource& source, int rate, double sigma_r,
                                    int lobes_per_tile, int resolution, const FlakeNdf* shared) {

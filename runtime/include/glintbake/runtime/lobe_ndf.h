@@ -25,8 +25,9 @@
 // 0.144 -> 0.034, leather 0.087 -> 0.066, on the 1024^2 and 512^2 maps of the README).
 //
 // A footprint is answered from a cut through the hierarchy: near its centre the tiles of the
-// level whose tiles are at most 0.35 times its std (so the footprint weight varies little across
-// a tile), farther out coarser ones, a tile k levels up (k <= 3) where its nearest point lies at
+// level whose tiles are at most the tile ratio (0.35 by default, setTileRatio; an asset's flakes
+// record may ask for less) times its std (so the footprint weight varies little across a tile),
+// farther out coarser ones, a tile k levels up (k <= 3) where its nearest point lies at
 // least sqrt(2 k) standard deviations from the centre, where the weight has fallen below e^-k of
 // its peak; every lobe within 3 standard deviations of the centre counts. The cut depends on the
 // footprint only, so eval, mass, sample and the images see the same lobes. It visits about
@@ -41,17 +42,18 @@
 // without it at 24-48 texels). The kernel has two passes (a division-free test, then exp and
 // sqrt on the kept lobes only; AVX2 where the processor has it, with the same bits as the SSE2
 // kernel). With lobes_per_tile = 16, level 0 keeps every flake as its own lobe. Below 0.35 x
-// sigma_p = 4 flakes (11.4 texels at one flake per texel) its eval, mass and sampling are those of
-// the exact flakes (flake_ndf.h, which prunes by normal within tiles) with the 3-sigma window,
-// without a cut. From there to the first clustered level (22.9 texels) level 0 takes the cut as
-// the others do, and the tiles it would split into level-0 tiles (the level-1 tiles within
-// sqrt(2) sigma_p of the centre, which lie inside the window's disk) are answered by the exact
-// flakes' evaluator restricted to them: their eval prunes by normal, their mass is a product of
-// running sums along the axes, and a sample picks one of them by that mass, then a row, then a
-// flake; average and image walk the same tiles as level-0 lobes (the same flakes). Against the
-// whole window of exact flakes this is 0.6-0.73x the eval time at 16-22 texels and costs 0.01-0.02
-// in image relative L1 on the README's maps (0.003-0.017 -> 0.017-0.027 at 12-20 texels); a cut
-// from 1 standard deviation saved another 12-17% at 0.01-0.017 more. On 1024^2 maps
+// sigma_p = 4 flakes (11.4 texels at one flake per texel, at the default tile ratio) its eval,
+// mass and sampling are those of the exact flakes (flake_ndf.h, which prunes by normal within
+// tiles) with the 3-sigma window, without a cut. From there to the first clustered level (22.9
+// texels) level 0 takes the cut as the others do, and the tiles it would split into level-0 tiles
+// (the level-1 tiles within sqrt(2) sigma_p of the centre, which lie inside the window's disk) are
+// answered by the exact flakes' evaluator restricted to them: their eval prunes by normal, their
+// mass is a product of running sums along the axes, and a sample picks one of them by that mass,
+// then a row, then a flake; average and image walk the same tiles as level-0 lobes (the same
+// flakes). Against the whole window of exact flakes this is 0.6-0.73x the eval time at 16-22
+// texels and costs 0.01-0.02 in image relative L1 on the README's maps (0.003-0.017 ->
+// 0.017-0.027 at 12-20 texels); a cut from 1 standard deviation saved another 12-17% at
+// 0.01-0.017 more. On 1024^2 maps
 // (bench/bench_flakes.cpp) eval costs about 4 us at sigma_p = 6 texels, 14-21 us at 12-16 and
 // 32-34 us at 22 (the costliest band, 44-57 us without the cut) and 8.4-9.7 us on the clustered
 // levels at 24 and 48 (21-25 and 16-17 before the cut). Sample: on level 0 the disk rows' weights
@@ -70,6 +72,7 @@
 // throw and are thread-safe (const).
 #pragma once
 
+#include <glintbake/format/kinds/flakes.h>
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/texel_source.h>
 
@@ -81,6 +84,13 @@ namespace glintbake::runtime {
 
 // Lobes a tile keeps at most (the width of the evaluator's blocks).
 constexpr int kMaxLobesPerTile = 16;
+
+// The cut answers a footprint of std sigma from tiles of at most tile ratio x sigma per side near
+// its centre (coarser ones farther out): the default, and the range setTileRatio accepts
+// (formats/SPEC.md 10.5, the flakes record's tile_ratio).
+constexpr double kDefaultLobeTileRatio = format::kDefaultFlakesTileRatioMilli / 1000.0;
+constexpr double kMinLobeTileRatio = format::kMinFlakesTileRatioMilli / 1000.0;
+constexpr double kMaxLobeTileRatio = format::kMaxFlakesTileRatioMilli / 1000.0;
 
 class LobeNdf final : public AccumulatingNdfSource {
  public:
@@ -118,6 +128,14 @@ class LobeNdf final : public AccumulatingNdfSource {
   MapWrap wrap() const override;
   // Tile side (flakes) of the level that answers a footprint of this sigma.
   int tileFor(double sigma) const;
+  // The largest tile side, as a fraction of the footprint's std, that answers near a footprint's
+  // centre: the default kDefaultLobeTileRatio; smaller ratios answer from finer tiles, closer to
+  // the exact flakes where a map's tiles hold more distinct normals than a tile keeps lobes (a
+  // ratio of one half costs about four times the eval). kInvalidArgument outside
+  // [kMinLobeTileRatio, kMaxLobeTileRatio] or when not built. Not thread-safe: set it before
+  // the hierarchy is shared; build() resets it to the default.
+  RuntimeStatus setTileRatio(double ratio);
+  double tileRatio() const;
   // Bytes the hierarchy holds (every level's blocks and bounds, allocated at build, and the normals
   // the finest level is made from at 16 lobes per tile); not the exact flakes. 0 when not built.
   uint64_t memoryBytes() const;

@@ -9,6 +9,7 @@
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/result.h>
 #include <glintbake/format/container.h>
+#include <glintbake/runtime/texel_source.h>
 
 #include <cstdint>
 
@@ -18,12 +19,43 @@ namespace glintbake::bake::ndf {
 // flakes_up_to to lobes_up_to) and the pyramid alone (from pyramid_from); neighbouring paths are
 // blended linearly in log(sigma) in between. lobes_per_tile 0: no clustered path, the flakes hand
 // over to the pyramid directly.
+// tile_ratio_milli: the clustered path's tile ratio in thousandths (formats/SPEC.md 10.5, the
+// record's trailer); 0 lets chooseLobeTileRatio pick it for the map and this hand-over.
 struct FlakesHandover {
   double flakes_up_to = 0.0;
   int lobes_per_tile = 0;
   double lobes_up_to = 0.0;
   double pyramid_from = 0.0;
+  uint32_t tile_ratio_milli = 0;
 };
+
+// The tile ratios (thousandths) chooseLobeTileRatio tries, largest (cheapest) first: the default,
+// then finer tiles at about twice and four times the clustered path's eval cost.
+constexpr uint32_t kLobeTileRatioCandidates[] = {350, 250, 175};
+
+// The clustered path's tile ratio for a map and hand-over (formats/SPEC.md 10.5, the record's
+// trailer): the largest candidate whose lobes stay close to the exact flakes at the probe
+// footprints the lobes answer (kLobeProbeSigmas below pyramid_from, within the lobes' and the
+// exact flakes' windows and below the flat footprint of a repeating map), measured as the targets
+// of scripts/fidelity.py are, with margins: at kLobeProbePositions positions each, the relative L1
+// distance of the lobes' NDF from the exact flakes' must have a median of at most
+// kLobeProbeMaxError and of at most kLobeProbeMaxRatio times that of the positions' mean NDF (a
+// stand-in for the whole map's, the smooth baseline). Distances are estimated from
+// kLobeProbeSamples points of either NDF at each position, of densities whose lobes are widened
+// by the variance of a bin of an R = kLobeProbeResolution image (the images the targets are on
+// average detail finer than a bin out). Maps whose tiles hold more distinct normals than a tile
+// keeps lobes (dense fine scratches, small flakes) get finer tiles; maps whose NDF varies strongly
+// across them, or whose pyramid answers from below the probes, keep the default. When no candidate
+// passes, the finest. Without lobes (lobes_per_tile 0) or probes, the default. Deterministic for any
+// thread count; a few seconds whatever the map's size.
+constexpr double kLobeProbeSigmas[] = {24.0, 32.0, 48.0};
+constexpr int kLobeProbePositions = 6;
+constexpr int kLobeProbeSamples = 32;
+constexpr int kLobeProbeResolution = 128;
+constexpr double kLobeProbeMaxError = 0.08;
+constexpr double kLobeProbeMaxRatio = 0.2;
+uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
+                             double pyramid_from);
 
 // Lobes per tile of the clustered path: the default and the largest (formats/SPEC.md 10.5).
 constexpr int kDefaultLobesPerTile = 16;
@@ -84,19 +116,21 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
 constexpr double kGlintyVariation = 0.5;
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
-// mode, rate (1..16) and sigma_r, and the hand-over. The record is checked by
+// mode, rate (1..16) and sigma_r, the hand-over, and (with lobes) the tile ratio
+// chooseLobeTileRatio picks for the map. The record is checked by
 // format::checkFlakesRecord before it is written. *bytes (may be null) receives the raw section size.
 // Errors: kBadArgument (a record the check refuses: map too large, rate, sigma_r or hand-over out of
 // range), kIo (the writer failed).
 BakeStatus writeFlakesSection(format::Writer& writer, const NormalMap& map, int rate, double sigma_r,
                               const FlakesHandover& handover, uint64_t* bytes);
-// The raw bytes of that section (record and normals), for writers that place it themselves
+// The raw bytes of that section (record, normals and trailer), for writers that place it themselves
 // (sharded bakes). Same errors, kIo aside.
 Result<std::vector<uint8_t>> flakesSectionBytes(const NormalMap& map, int rate, double sigma_r,
                                                 const FlakesHandover& handover);
 
-// Rewrites the hand-over of a flakes section's record in place (and its version to the current
-// one), as flakesSectionBytes would have written it with `handover`: tools whose hand-over depends
+// Rewrites the hand-over of a flakes section's record in place (a version-1 record becomes version
+// 2; the tile ratio of a version-3 trailer is kept), as flakesSectionBytes would have written it
+// with `handover`: tools whose hand-over depends
 // on the finished pyramid (tensorpack, and the merge of its shards) write the section through this.
 // kInvalidInput when the section is truncated or the record fails format::checkFlakesRecord.
 BakeStatus setFlakesHandover(std::vector<uint8_t>& section, const FlakesHandover& handover);
