@@ -164,6 +164,15 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   const int width = texels.width(), height = texels.height();
   if (lobes_per_tile <= 0 || width < 1 || height < 1 || rate < 1) return format::kDefaultFlakesTileRatioMilli;
   const bool repeat = texels.repeats();
+  // Footprints the lobes can answer on this map: below the pyramid's, below the flat footprint of
+  // a repeating map (the pyramid answers from there, capAtFlatFootprint), within the exact flakes'
+  // window (and the lobes', below). Nothing is built when no probe footprint is left.
+  const double side = double(std::max(width, height));
+  const double flat_max = repeat ? kFlatAxisSigma * side / kHalfOctave : kClampedFlatSigma * side;
+  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+  auto probed = [&](double sigma) { return sigma < pyramid_from && sigma <= flat_max && sigma <= window_max; };
+  if (std::none_of(std::begin(kLobeProbeSigmas), std::end(kLobeProbeSigmas), probed))
+    return format::kDefaultFlakesTileRatioMilli;
   // The targets are on NDF images of R x R bins, which average out detail finer than a bin: the
   // densities compared here are those of every lobe widened by a bin's variance (a box of side
   // 2 / R has variance (2 / R)^2 / 12), the images' blur as a Gaussian.
@@ -174,18 +183,12 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   if (exact.build(texels, rate, probe_sigma_r, kLobeProbeResolution) != runtime::RuntimeStatus::kOk ||
       lobes.build(texels, rate, probe_sigma_r, lobes_per_tile, kLobeProbeResolution) != runtime::RuntimeStatus::kOk)
     return format::kDefaultFlakesTileRatioMilli;  // the section's own checks report what is wrong
-  // Footprints the lobes can answer on this map: below the flat footprint of a repeating map (the
-  // pyramid answers from there, capAtFlatFootprint), within the lobes' window and the exact
-  // flakes'.
-  const double side = double(std::max(width, height));
-  const double lobes_max = std::min(lobes.footprintRange().clustered_max_sigma,
-                                    repeat ? kFlatAxisSigma * side / kHalfOctave : kClampedFlatSigma * side);
-  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+  const double lobes_max = lobes.footprintRange().clustered_max_sigma;
   bool passes[kCandidates];
   std::fill(std::begin(passes), std::end(passes), true);
   constexpr int kPositions = kLobeProbePositions;
   for (double sigma : kLobeProbeSigmas) {
-    if (!(sigma < pyramid_from && sigma <= lobes_max && sigma <= window_max)) continue;
+    if (!(probed(sigma) && sigma <= lobes_max)) continue;
     // Positions of a two-dimensional golden-ratio sequence over the map.
     std::vector<runtime::Footprint> fps;
     std::vector<double> masses;
@@ -200,15 +203,9 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
     // Points of every position's exact NDF; at each, every position's exact density.
     std::vector<std::vector<runtime::SPoint>> drawn(kPositions);
     std::vector<runtime::SPoint> all;
-    std::vector<size_t> owner;
     tbb::parallel_for(0, kPositions,
                       [&](int i) { drawn[size_t(i)] = drawPoints(exact, fps[size_t(i)], kLobeProbeSamples); });
-    for (int i = 0; i < kPositions; ++i) {
-      for (const runtime::SPoint& s : drawn[size_t(i)]) {
-        all.push_back(s);
-        owner.push_back(size_t(i));
-      }
-    }
+    for (int i = 0; i < kPositions; ++i) all.insert(all.end(), drawn[size_t(i)].begin(), drawn[size_t(i)].end());
     if (all.empty()) continue;
     std::vector<std::vector<double>> p(kPositions, std::vector<double>(all.size()));
     tbb::parallel_for(size_t(0), size_t(kPositions) * all.size(), [&](size_t e) {
