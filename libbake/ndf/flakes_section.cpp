@@ -203,9 +203,13 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
     // Points of every position's exact NDF; at each, every position's exact density.
     std::vector<std::vector<runtime::SPoint>> drawn(kPositions);
     std::vector<runtime::SPoint> all;
+    std::vector<size_t> first(kPositions);  // where each position's points start in `all`
     tbb::parallel_for(0, kPositions,
                       [&](int i) { drawn[size_t(i)] = drawPoints(exact, fps[size_t(i)], kLobeProbeSamples); });
-    for (int i = 0; i < kPositions; ++i) all.insert(all.end(), drawn[size_t(i)].begin(), drawn[size_t(i)].end());
+    for (int i = 0; i < kPositions; ++i) {
+      first[size_t(i)] = all.size();
+      all.insert(all.end(), drawn[size_t(i)].begin(), drawn[size_t(i)].end());
+    }
     if (all.empty()) continue;
     std::vector<std::vector<double>> p(kPositions, std::vector<double>(all.size()));
     tbb::parallel_for(size_t(0), size_t(kPositions) * all.size(), [&](size_t e) {
@@ -233,7 +237,11 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
         for (const runtime::SPoint& s : drawPoints(lobes, fp, kLobeProbeSamples)) points.push_back(s);
         std::vector<double> pv(points.size()), qv(points.size()), mv(points.size());
         for (size_t k = 0; k < points.size(); ++k) {
-          pv[k] = masses[size_t(i)] > 0.0 ? densityAt(exact, fp, points[k]) / masses[size_t(i)] : 0.0;
+          // The exact density at its own points is p's; at the lobes' points it is evaluated here.
+          if (k < from_exact)
+            pv[k] = p[size_t(i)][first[size_t(i)] + k];
+          else
+            pv[k] = masses[size_t(i)] > 0.0 ? densityAt(exact, fp, points[k]) / masses[size_t(i)] : 0.0;
           qv[k] = lobes_mass > 0.0 ? densityAt(lobes, fp, points[k]) / lobes_mass : 0.0;
           mv[k] = (double(from_exact) * pv[k] + double(points.size() - from_exact) * qv[k]) / double(points.size());
         }
