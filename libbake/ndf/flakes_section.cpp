@@ -156,10 +156,43 @@ double densityAt(const Source& source, const runtime::Footprint& fp, const runti
   double v = 0.0;
   return source.eval(fp, s, &v) == runtime::RuntimeStatus::kOk ? v : 0.0;
 }
+
+// What the probe builds its flakes and lobes from: the whole map when it holds at most max_flakes
+// flakes, else a window at its centre of at most sqrt(max_flakes) flakes per side, clamped (no
+// texel beyond it stands in for the map's). The window's sides and origin are whole multiples of
+// kLobeProbeCropAlign texels, so that its tiles (the probe's coarsest are 128 flakes) are the map's.
+class ProbeWindow final : public runtime::TexelSource {
+ public:
+  ProbeWindow(const runtime::TexelSource& map, int rate, uint64_t max_flakes) : map_(map) {
+    w_ = map.width();
+    h_ = map.height();
+    const uint64_t flakes = uint64_t(w_) * uint64_t(h_) * uint64_t(rate) * uint64_t(rate);
+    if (flakes <= max_flakes) return;
+    const int align = kLobeProbeCropAlign;
+    const int side = std::max(align, int(std::sqrt(double(max_flakes)) / rate) / align * align);
+    auto fit = [&](int n, int* origin, int* kept) {
+      *kept = std::min(n, side);
+      *origin = (n - *kept) / 2 / align * align;
+    };
+    fit(map.width(), &x0_, &w_);
+    fit(map.height(), &y0_, &h_);
+    cropped_ = true;
+  }
+  bool cropped() const { return cropped_; }
+  int width() const override { return w_; }
+  int height() const override { return h_; }
+  bool repeats() const override { return cropped_ ? false : map_.repeats(); }
+  void normal(int x, int y, float out[2]) const override { map_.normal(x0_ + x, y0_ + y, out); }
+
+ private:
+  const runtime::TexelSource& map_;
+  int x0_ = 0, y0_ = 0, w_ = 0, h_ = 0;
+  bool cropped_ = false;
+};
 }  // namespace
 
 uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
-                             double pyramid_from) {
+                             double pyramid_from, uint64_t max_probe_flakes) {
   constexpr size_t kCandidates = std::size(kLobeTileRatioCandidates);
   const int width = texels.width(), height = texels.height();
   if (lobes_per_tile <= 0 || width < 1 || height < 1 || rate < 1) return format::kDefaultFlakesTileRatioMilli;
@@ -178,10 +211,11 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   // 2 / R has variance (2 / R)^2 / 12), the images' blur as a Gaussian.
   const double bin = 2.0 / kLobeProbeResolution;
   const double probe_sigma_r = std::min(1.0, std::sqrt(sigma_r * sigma_r + bin * bin / 12.0));
+  const ProbeWindow probe(texels, rate, max_probe_flakes);
   runtime::FlakeNdf exact;
   runtime::LobeNdf lobes;
-  if (exact.build(texels, rate, probe_sigma_r, kLobeProbeResolution) != runtime::RuntimeStatus::kOk ||
-      lobes.build(texels, rate, probe_sigma_r, lobes_per_tile, kLobeProbeResolution) != runtime::RuntimeStatus::kOk)
+  if (exact.build(probe, rate, probe_sigma_r, kLobeProbeResolution) != runtime::RuntimeStatus::kOk ||
+      lobes.build(probe, rate, probe_sigma_r, lobes_per_tile, kLobeProbeResolution) != runtime::RuntimeStatus::kOk)
     return format::kDefaultFlakesTileRatioMilli;  // the section's own checks report what is wrong
   const double lobes_max = lobes.footprintRange().clustered_max_sigma;
   bool passes[kCandidates];
@@ -195,7 +229,7 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
     for (int i = 0; i < kPositions; ++i) {
       const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
       const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
-      fps.push_back({fx * width, fy * height, sigma});
+      fps.push_back({fx * probe.width(), fy * probe.height(), sigma});
       double m = 0.0;
       exact.mass(fps.back(), &m);
       masses.push_back(m);

@@ -56,10 +56,12 @@ bake::ndf::FlakesHandover wideLobes() {
   return h;
 }
 
-uint32_t chosenRatio(const bake::NormalMap& map, const bake::ndf::FlakesHandover& h) {
+uint32_t chosenRatio(const bake::NormalMap& map, const bake::ndf::FlakesHandover& h,
+                     uint64_t max_probe_flakes = bake::ndf::kLobeProbeMaxFlakes) {
   const runtime::InterleavedTexels texels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(),
                                           3);
-  return bake::ndf::chooseLobeTileRatio(texels, 1, reference::kDefaultSigmaR, h.lobes_per_tile, h.pyramid_from);
+  return bake::ndf::chooseLobeTileRatio(texels, 1, reference::kDefaultSigmaR, h.lobes_per_tile, h.pyramid_from,
+                                        max_probe_flakes);
 }
 
 TEST(LobeTileRatio, TrailerIsCheckedAndReadWithTheRecord) {
@@ -188,6 +190,26 @@ TEST(LobeTileRatio, SmoothlyVaryingGlintsKeepTheDefault) {
   h.lobes_up_to = 32.0;
   h.pyramid_from = 45.0;
   EXPECT_EQ(chosenRatio(beckmann(192, 0.6, 48.0), h), format::kDefaultFlakesTileRatioMilli);
+}
+
+TEST(LobeTileRatio, LargeMapsAreProbedOnAWindowAtTheirCentre) {
+  // Broad bumps with dense fine scratches in the middle ninth: probed whole, the positions spread
+  // over the map see mostly the bumps and keep the default; probed within a bound of 128^2 flakes,
+  // the window at the centre (texels 128-255 on either axis, on the 128-texel grid) holds only the
+  // scratches, and the choice is that of the window on its own as a clamped map.
+  bake::NormalMap map = beckmann(384, 0.6, 48.0);
+  const bake::NormalMap scratches = denseScratches(128);
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) std::memcpy(map.at(128 + x, 128 + y), scratches.at(x, y), 3 * sizeof(float));
+  bake::NormalMap window = scratches;
+  window.wrap = bake::Wrap::kClamp;
+  bake::ndf::FlakesHandover h = wideLobes();
+  h.lobes_up_to = 32.0;
+  h.pyramid_from = 40.0;
+  const uint32_t cropped = chosenRatio(map, h, 128 * 128);
+  EXPECT_LT(cropped, format::kDefaultFlakesTileRatioMilli);
+  EXPECT_EQ(cropped, chosenRatio(window, h));
+  EXPECT_EQ(chosenRatio(map, h), format::kDefaultFlakesTileRatioMilli);
 }
 
 }  // namespace

@@ -47,15 +47,20 @@ constexpr uint32_t kLobeTileRatioCandidates[] = {350, 250, 175};
 // keeps lobes (dense fine scratches, small flakes) get finer tiles; maps whose NDF varies strongly
 // across them, or whose pyramid answers from below the probes, keep the default. When no candidate
 // passes, the finest. Without lobes (lobes_per_tile 0) or probes, the default. Deterministic for any
-// thread count; a few seconds whatever the map's size.
+// thread count. A map of more than max_probe_flakes flakes is probed on a window at its centre of
+// at most sqrt(max_probe_flakes) flakes per side (sides and origin whole multiples of
+// kLobeProbeCropAlign texels, so that its tiles are the map's; clamped): the probe's memory (about
+// 140 bytes a flake) and time (a few seconds) stay those of a 2048^2 map whatever the map's size.
 constexpr double kLobeProbeSigmas[] = {24.0, 32.0, 48.0};
 constexpr int kLobeProbePositions = 6;
 constexpr int kLobeProbeSamples = 32;
 constexpr int kLobeProbeResolution = 128;
 constexpr double kLobeProbeMaxError = 0.08;
 constexpr double kLobeProbeMaxRatio = 0.2;
+constexpr uint64_t kLobeProbeMaxFlakes = uint64_t(2048) * 2048;
+constexpr int kLobeProbeCropAlign = 128;
 uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
-                             double pyramid_from);
+                             double pyramid_from, uint64_t max_probe_flakes = kLobeProbeMaxFlakes);
 
 // Lobes per tile of the clustered path: the default and the largest (formats/SPEC.md 10.5).
 constexpr int kDefaultLobesPerTile = 16;
