@@ -6,12 +6,15 @@ on the frozen 1.0 files, and on damaged copies."""
 import json
 import os
 import shutil
+import struct
 
 import clitest
 from clitest import BAD_ARGS, DIFFERENCES, INVALID, IO, OK, UNSUPPORTED
-from containers import SECTION_IMAGE, SECTION_METADATA, SECTION_PRIVATE, build_container, image_payload, metadata
+from containers import (CODEC_ZSTD, SECTION_IMAGE, SECTION_METADATA, SECTION_PRIVATE, build_container, image_payload,
+                        metadata, read_sections, zstd_block_frame)
 
 FROZEN_DIR = os.path.join(clitest.SOURCE_DIR, "tests", "format")
+SECTION_FLAKES, KIND_NDF_PYRAMID = 80, 1  # formats/SPEC.md 10.5 and section 4
 
 
 class GlintinfoTest(clitest.ToolTestCase):
@@ -92,6 +95,22 @@ class GlintinfoTest(clitest.ToolTestCase):
             self.assertIn("exact from the flakes" if flakes else "no flakes", out)
             if flakes and lobes:
                 self.assertIn("clustered lobes (16 per tile, tiles of up to 0.35 sigma)", out)
+        # A trailer out of range (a flakes section rebuilt from the spec with a ratio of 5.0, raw
+        # blocks in a zstd frame): the JSON leaves the ratio out, the text says so, validate names it.
+        sections = read_sections(open(asset, "rb").read())
+        sections = [s for s in sections if s[0] != SECTION_FLAKES]
+        record = struct.pack("<8I4d", 0x4B4C4647, 3, 32, 32, 0, 1, 0, 16, 0.005, 4.0, 8.0, 4.0 * 2 ** 0.5)
+        flakes = record + b"\0" * (32 * 32 * 8) + struct.pack("<2I", 5000, 0)
+        sections.append((SECTION_FLAKES, 0, zstd_block_frame(len(flakes), [("raw", flakes)]), CODEC_ZSTD, len(flakes)))
+        bad = self.write("bad_trailer.gbk", build_container(sections, kind=KIND_NDF_PYRAMID))
+        doc = self.run_json("glintinfo", "info", bad, schema="glintinfo-info.schema.json")
+        self.assertNotIn("lobes_tile_ratio", doc["footprints"])
+        self.assertEqual(doc["footprints"]["lobes_per_tile"], 16)
+        out, _ = self.run_ok("glintinfo", "info", bad)
+        self.assertIn("clustered lobes (16 per tile, a tile ratio out of range)", out)
+        code, out, _ = clitest.run("glintinfo", "validate", bad, "--json")
+        self.assertEqual(code, INVALID)
+        self.assertIn(4008, [m["id"] for m in json.loads(out)["messages"]])
         # Containers without levels have neither.
         doc = self.run_json("glintinfo", "info", self.image_container("c.gbk"), schema="glintinfo-info.schema.json")
         self.assertNotIn("footprints", doc)

@@ -146,11 +146,16 @@ int runInfo(cli::Tool& tool, const InfoOptions& options) {
     std::printf("map:            %d x %d texels, wrap %s\n", s["map"]["width"].get<int>(),
                 s["map"]["height"].get<int>(), s["map"]["wrap"].get<std::string>().c_str());
     if (f["exact_max_sigma"].get<double>() > 0.0 && f["clustered_max_sigma"].get<double>() > 0.0) {
+      // (A trailer out of range is left out of the JSON; `validate` names it, error 4008.)
+      char tiles[64];
+      if (f.contains("lobes_tile_ratio"))
+        std::snprintf(tiles, sizeof(tiles), "tiles of up to %g sigma", f["lobes_tile_ratio"].get<double>());
+      else
+        std::snprintf(tiles, sizeof(tiles), "a tile ratio out of range");
       std::printf(
-          "footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile, tiles of up "
-          "to %g sigma) from %g to %g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
-          f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(),
-          f.value("lobes_tile_ratio", format::kDefaultFlakesTileRatioMilli / 1000.0),
+          "footprints:     exact from the flakes for sigma <= %g texels, clustered lobes (%d per tile, %s) from %g to "
+          "%g (the runtime bounds them by their window), blended into the pyramid up to %g\n",
+          f["exact_max_sigma"].get<double>(), f["lobes_per_tile"].get<int>(), tiles,
           f["clustered_min_sigma"].get<double>(), f["clustered_max_sigma"].get<double>(),
           f["handover_max_sigma"].get<double>());
     } else if (f["exact_max_sigma"].get<double>() > 0.0) {
