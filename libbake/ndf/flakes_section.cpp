@@ -176,7 +176,7 @@ class ProbeWindow final : public runtime::TexelSource {
     };
     fit(map.width(), &x0_, &w_);
     fit(map.height(), &y0_, &h_);
-    cropped_ = true;
+    cropped_ = w_ < map.width() || h_ < map.height();  // (a window of the whole map keeps its wrap)
   }
   bool cropped() const { return cropped_; }
   int width() const override { return w_; }
