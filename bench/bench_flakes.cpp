@@ -11,8 +11,10 @@
 // `asset_eval_each` and `asset_sample_each` the random queries timed one by one, with the median
 // and 90th percentile over the queries as counters.
 // `lobe_build` times the lobe hierarchy a reader builds at load (16 lobes per tile).
+// `tile_ratio_probe` times the bake's probe of the tile ratio (bake::ndf::chooseLobeTileRatio).
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/bake/ndf/flakes_section.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
@@ -273,6 +275,16 @@ void lobeBuildBench(benchmark::State& state, size_t subject) {
   }
 }
 
+// The bake's choice of the clustered path's tile ratio (bake::ndf::chooseLobeTileRatio) with the
+// lobes answering up to 45 texels, so that every probe footprint runs: maps of more than
+// kLobeProbeMaxFlakes flakes are probed on a window at their centre (GLINTBAKE_BENCH_MAPS=a 4096^2
+// map shows the bound).
+void tileRatioProbeBench(benchmark::State& state, size_t subject) {
+  const Subject& s = *subjects()[subject];
+  const auto texels = mapTexels(s.map);
+  for (auto _ : state) benchmark::DoNotOptimize(bake::ndf::chooseLobeTileRatio(texels, 1, 0.005, 16, 64.0));
+}
+
 void referenceBench(benchmark::State& state, size_t subject, double sigma) {
   const Subject& s = *subjects()[subject];
   const std::vector<Query> q = queries(s, sigma);
@@ -303,6 +315,9 @@ const int registered = [] {
     benchmark::RegisterBenchmark(("lobe_build/" + name).c_str(), lobeBuildBench, k)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);
+    benchmark::RegisterBenchmark(("tile_ratio_probe/" + name).c_str(), tileRatioProbeBench, k)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)
         ->Unit(benchmark::kMicrosecond);
   }

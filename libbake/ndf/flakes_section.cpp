@@ -178,7 +178,6 @@ class ProbeWindow final : public runtime::TexelSource {
     fit(map.height(), &y0_, &h_);
     cropped_ = w_ < map.width() || h_ < map.height();  // (a window of the whole map keeps its wrap)
   }
-  bool cropped() const { return cropped_; }
   int width() const override { return w_; }
   int height() const override { return h_; }
   bool repeats() const override { return cropped_ ? false : map_.repeats(); }
