@@ -15,7 +15,7 @@
 #include <glintbake/runtime/ndf_source.h>
 
 #include "../../stats/chi_square.h"
-#include "../temp_dir.h"
+#include "flakes_asset.h"
 
 #include <gtest/gtest.h>
 
@@ -37,24 +37,12 @@ using runtime::SPoint;
 // and the default hand-over for `lobes` lobes per tile, or `handover` when given.
 std::string writeAsset(const bake::NormalMap& map, const bake::NormalMap& flakes_map, const std::string& name,
                        bool with_flakes = true, int lobes = 0, const bake::ndf::FlakesHandover* handover = nullptr) {
-  bake::ndf::PyramidOptions o;
-  o.splat.ndf_res = 32;
-  o.stride0 = 8;
-  o.sigma0 = 4;
-  o.levels = 2;
-  const std::string path = glintbake::testing::processTempDir() + name;
-  format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
-  EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
-  if (with_flakes) {
-    EXPECT_TRUE(bake::ndf::writeFlakesSection(w, flakes_map, 1, o.splat.sigma_r,
-                                              handover ? *handover : bake::ndf::defaultHandover(o.sigma0, lobes),
-                                              nullptr)
-                    .ok());
-  }
-  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
-  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
-  return path;
+  const bake::ndf::PyramidOptions o = glintbake::testing::smallPyramid(32, 2);
+  if (!with_flakes) return glintbake::testing::writePyramidAsset(map, o, name, nullptr);
+  auto section = bake::ndf::flakesSectionBytes(flakes_map, 1, o.splat.sigma_r,
+                                               handover ? *handover : bake::ndf::defaultHandover(o.sigma0, lobes));
+  EXPECT_TRUE(section.ok());
+  return glintbake::testing::writePyramidAsset(map, o, name, section.ok() ? &section.value() : nullptr);
 }
 
 bake::NormalMap beckmann(int size, uint64_t seed) {

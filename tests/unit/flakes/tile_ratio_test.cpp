@@ -15,7 +15,7 @@
 #include <glintbake/runtime/ndf_source.h>
 #include <glintbake/runtime/texel_source.h>
 
-#include "../temp_dir.h"
+#include "flakes_asset.h"
 
 #include <gtest/gtest.h>
 
@@ -102,23 +102,12 @@ TEST(LobeTileRatio, TrailerIsCheckedAndReadWithTheRecord) {
 // section's tile ratio as written, out of range if need be.
 std::string assetWith(const bake::NormalMap& map, const bake::ndf::FlakesHandover& handover, const std::string& name,
                       uint32_t trailer = 0) {
-  bake::ndf::PyramidOptions o;
-  o.splat.ndf_res = 16;
-  o.stride0 = 8;
-  o.sigma0 = 4;
-  o.levels = 1;
-  const std::string path = glintbake::testing::processTempDir() + name;
-  format::Writer w;
-  EXPECT_EQ(w.open(path, format::AssetKind::kNdfPyramid, 3), format::ContainerStatus::kOk);
-  EXPECT_TRUE(bake::ndf::buildNdfPyramid(map, o, w, nullptr).ok());
+  const bake::ndf::PyramidOptions o = glintbake::testing::smallPyramid(16, 1);
   auto section = bake::ndf::flakesSectionBytes(map, 1, o.splat.sigma_r, handover);
   EXPECT_TRUE(section.ok());
-  std::vector<uint8_t> bytes = section.value();
-  if (trailer != 0) std::memcpy(bytes.data() + bytes.size() - 8, &trailer, 4);
-  EXPECT_EQ(w.addSection(format::kSectionFlakes, 0, bytes.data(), bytes.size()), format::ContainerStatus::kOk);
-  EXPECT_EQ(w.addMetadata("{}"), format::ContainerStatus::kOk);
-  EXPECT_EQ(w.finish(), format::ContainerStatus::kOk);
-  return path;
+  std::vector<uint8_t> bytes = section.ok() ? section.value() : std::vector<uint8_t>();
+  if (trailer != 0 && bytes.size() >= 8) std::memcpy(bytes.data() + bytes.size() - 8, &trailer, 4);
+  return glintbake::testing::writePyramidAsset(map, o, name, &bytes);
 }
 
 bool hasMessage(const format::ValidationReport& r, int code) {
