@@ -11,10 +11,12 @@
 // `asset_eval_each` and `asset_sample_each` the random queries timed one by one, with the median
 // and 90th percentile over the queries as counters.
 // `lobe_build` times the lobe hierarchy a reader builds at load (16 lobes per tile).
-// `tile_ratio_probe` times the bake's probe of the tile ratio (bake::ndf::chooseLobeTileRatio).
+// `tile_ratio_probe` times the bake's probe of the tile ratio (bake::ndf::chooseLobeTileRatio),
+// `handover_probe` its probe above an exact level (bake::ndf::probeExactLevelHandover).
 #include <glintbake/bake/io/normal_map.h>
 #include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/bake/ndf/flakes_section.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/reference/pndf.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
@@ -285,6 +287,23 @@ void tileRatioProbeBench(benchmark::State& state, size_t subject) {
   for (auto _ : state) benchmark::DoNotOptimize(bake::ndf::chooseLobeTileRatio(texels, 1, 0.005, 16, 64.0));
 }
 
+// The hand-over probe above an exact level of 32 texels, as tensorpack runs it on a 1024^2 map
+// (levels of the default geometry from there up).
+void handoverProbeBench(benchmark::State& state, size_t subject) {
+  const Subject& s = *subjects()[subject];
+  const auto texels = mapTexels(s.map);
+  std::vector<bake::ndf::PyramidLevelShape> levels;
+  for (int l = 2; l < 5; ++l) {
+    const bake::ndf::LevelGeometry g = bake::ndf::levelGeometry(s.map.width, s.map.height, {}, l, true);
+    levels.push_back({g.sigma, g.grid_width, g.grid_height});
+  }
+  for (auto _ : state) {
+    const bake::ndf::HandoverProbe p =
+        bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), int(levels.size()));
+    benchmark::DoNotOptimize(p);
+  }
+}
+
 void referenceBench(benchmark::State& state, size_t subject, double sigma) {
   const Subject& s = *subjects()[subject];
   const std::vector<Query> q = queries(s, sigma);
@@ -316,6 +335,9 @@ const int registered = [] {
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);
     benchmark::RegisterBenchmark(("tile_ratio_probe/" + name).c_str(), tileRatioProbeBench, k)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
+    benchmark::RegisterBenchmark(("handover_probe/" + name).c_str(), handoverProbeBench, k)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(1);
     benchmark::RegisterBenchmark(("reference_eval/" + name + "/sigma:4").c_str(), referenceBench, k, 4.0)

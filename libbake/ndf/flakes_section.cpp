@@ -2,9 +2,12 @@
 // Writing the flakes section of NDF assets (see flakes_section.h).
 #include <glintbake/bake/ndf/flakes_section.h>
 
+#include <glintbake/bake/ndf/flakes.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
+#include <glintbake/bake/ndf/splat.h>
 
 #include <glintbake/format/kinds/flakes.h>
+#include <glintbake/format/kinds/ndf_pyramid_blend.h>
 #include <glintbake/runtime/flake_ndf.h>
 #include <glintbake/runtime/lobe_ndf.h>
 #include <glintbake/runtime/texel_source.h>
@@ -15,6 +18,7 @@
 #include <cmath>
 #include <cstring>
 #include <iterator>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -73,18 +77,18 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile) {
 
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
                                   double max_level_error, int lobes_per_tile, const bool* level_exact,
-                                  const double* level_variation) {
+                                  const std::function<bool(int level)>& blend_loses) {
   if (lobes_per_tile <= 0 || levels <= 0) return defaultHandover(levels > 0 ? level_sigmas[0] : 0.0, lobes_per_tile);
   int first = levels;  // the first level from which every level is faithful
   while (first > 0 && level_errors[first - 1] <= max_level_error) --first;
   FlakesHandover h;
   h.flakes_up_to = kFlakesUpTo;
   h.lobes_per_tile = lobes_per_tile;
-  const bool glinty = first < levels && level_variation && level_variation[first] > kGlintyVariation;
-  if (first < levels && level_exact && level_exact[first] && !glinty) {
-    // An exact level whose images vary little blends closer to the reference from its own sigma up
-    // than the lobes above their finest tiles (kGlintyVariation), so the lobes hand over at that
-    // sigma; above a glinty one they go on as above a compressed level (below).
+  const bool exact = first < levels && level_exact && level_exact[first];
+  if (exact && !(blend_loses && blend_loses(first))) {
+    // The pyramid's blend above an exact level is closer to the reference from its own sigma up
+    // than the lobes (probeExactLevelHandover), so the lobes hand over at that sigma; where it is
+    // not they go on as above a compressed level (below).
     h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, level_sigmas[first]);
     h.pyramid_from = std::max(kHalfOctave * level_sigmas[first], h.lobes_up_to);
     return h;
@@ -287,6 +291,137 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   for (size_t c = 0; c < kCandidates; ++c)
     if (passes[c]) return kLobeTileRatioCandidates[c];
   return kLobeTileRatioCandidates[kCandidates - 1];
+}
+
+HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
+                                      const PyramidLevelShape* levels, int count, uint64_t max_probe_flakes) {
+  HandoverProbe out;
+  if (lobes_per_tile <= 0 || count < 1 || count > format::kMaxNdfLevels || rate < 1 || texels.width() < 1 ||
+      texels.height() < 1 || !(levels[0].sigma > 0.0))
+    return out;
+  out.sigma = kHalfOctave * levels[0].sigma;
+  const ProbeWindow probe(texels, rate, max_probe_flakes);
+  const bool repeat = probe.repeats();
+  const double side = double(std::max(probe.width(), probe.height()));
+  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+  if (out.sigma > window_max || (repeat && !(out.sigma < kFlatAxisSigma * side))) return out;
+  // The levels' records over the probed map: the map's strides, rounded to tile the window.
+  std::vector<format::NdfLevelRecord> recs(static_cast<size_t>(count));
+  for (int l = 0; l < count; ++l) {
+    const PyramidLevelShape& shape = levels[l];
+    if (shape.grid_width < 1 || shape.grid_height < 1 || !(shape.sigma > 0.0) ||
+        (l > 0 && !(shape.sigma > levels[l - 1].sigma)))
+      return out;
+    auto grid = [](int probed, int map, int centres) {
+      if (probed == map) return centres;
+      return std::max(1, int(std::lround(double(probed) * double(centres) / double(map))));
+    };
+    format::NdfLevelRecord& r = recs[size_t(l)];
+    r.level = uint32_t(l);
+    r.ndf_res = uint32_t(kLobeProbeResolution);
+    r.grid_width = uint32_t(grid(probe.width(), texels.width(), shape.grid_width));
+    r.grid_height = uint32_t(grid(probe.height(), texels.height(), shape.grid_height));
+    r.wrap = repeat ? 0u : 1u;
+    r.map_width = uint32_t(probe.width());
+    r.map_height = uint32_t(probe.height());
+    r.rate = uint32_t(rate);
+    r.stride_x = double(probe.width()) / double(r.grid_width);
+    r.stride_y = double(probe.height()) / double(r.grid_height);
+    r.origin_x = 0.5 * r.stride_x;
+    r.origin_y = 0.5 * r.stride_y;
+    r.sigma_texels = shape.sigma;
+    r.sigma_r = sigma_r;
+  }
+  format::NdfPyramidBlend blend;
+  blend.init(recs.data(), count);
+  // The images an exact level stores are splats of the map's flakes (with the level's footprint
+  // partition on repeating maps), and so is the reference here, as in scripts/fidelity.py.
+  NormalMap map;
+  map.width = probe.width();
+  map.height = probe.height();
+  map.wrap = repeat ? Wrap::kRepeat : Wrap::kClamp;
+  try {
+    map.normals.resize(size_t(map.width) * size_t(map.height) * 3);
+  } catch (const std::bad_alloc&) {
+    return out;
+  }
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      float n[2];
+      probe.normal(x, y, n);
+      float* t = map.at(x, y);
+      t[0] = n[0];
+      t[1] = n[1];
+      t[2] = float(std::sqrt(std::max(0.0, 1.0 - double(n[0]) * n[0] - double(n[1]) * n[1])));
+    }
+  }
+  Result<FlakeSet> flakes = buildFlakes(map, rate);
+  runtime::LobeNdf lobes;
+  if (!flakes.ok() ||
+      lobes.build(probe, rate, sigma_r, lobes_per_tile, kLobeProbeResolution) != runtime::RuntimeStatus::kOk ||
+      out.sigma > lobes.footprintRange().clustered_max_sigma)
+    return out;
+  const FlakeSet& set = flakes.value();
+  std::vector<FootprintPartition> partitions;
+  for (const format::NdfLevelRecord& r : recs)
+    partitions.push_back(
+        footprintPartition(set, r.sigma_texels, int(r.grid_width), r.stride_x, int(r.grid_height), r.stride_y));
+  SplatParams params;
+  params.ndf_res = kLobeProbeResolution;
+  params.sigma_r = sigma_r;
+  constexpr int kPositions = kHandoverProbePositions;
+  // Centres the blend weighs less are left out of its image: a splat costs as much whatever its
+  // weight, and on a level of stride 2 sigma about half the centres weigh less than this.
+  constexpr double kMinCentreWeight = 2e-3;
+  const size_t bins = size_t(kLobeProbeResolution) * size_t(kLobeProbeResolution);
+  std::vector<double> blend_errors(kPositions), lobes_errors(kPositions);
+  std::vector<std::vector<float>> refs(kPositions);
+  tbb::parallel_for(0, kPositions, [&](int i) {
+    const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
+    const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
+    const runtime::Footprint fp{fx * probe.width(), fy * probe.height(), out.sigma};
+    Splatter splatter(set, params);
+    std::vector<float> ref(bins, 0.0f), lobe(bins, 0.0f), centre(bins, 0.0f);
+    std::vector<double> mixed(bins, 0.0);
+    splatter.image(fp.x, fp.y, fp.sigma, ref.data());
+    lobes.addImage(fp, 1.0, lobe.data(), bins);
+    // The pyramid's answer: the level images of the centres it weighs, in the order it emits them.
+    blend.blend(fp.x, fp.y, fp.sigma, [&](int l, size_t c, double w) {
+      if (w < kMinCentreWeight) return;
+      const format::NdfLevelRecord& r = recs[size_t(l)];
+      const size_t gi = c % r.grid_width, gj = c / r.grid_width;
+      const FootprintPartition& part = partitions[size_t(l)];
+      splatter.image(r.origin_x + double(gi) * r.stride_x, r.origin_y + double(gj) * r.stride_y, r.sigma_texels,
+                     centre.data(), part.empty() ? nullptr : &part);
+      for (size_t k = 0; k < bins; ++k) mixed[k] += w * double(centre[k]);
+    });
+    double norm = 0.0, db = 0.0, dl = 0.0;
+    for (size_t k = 0; k < bins; ++k) {
+      norm += std::fabs(double(ref[k]));
+      db += std::fabs(mixed[k] - double(ref[k]));
+      dl += std::fabs(double(lobe[k]) - double(ref[k]));
+    }
+    blend_errors[size_t(i)] = norm > 0.0 ? db / norm : 0.0;
+    lobes_errors[size_t(i)] = norm > 0.0 ? dl / norm : 0.0;
+    refs[size_t(i)] = std::move(ref);
+  });
+  // The smooth baseline: each position's image against the mean of them all.
+  std::vector<double> mean(bins, 0.0), spread(kPositions);
+  for (const std::vector<float>& r : refs)
+    for (size_t k = 0; k < bins; ++k) mean[k] += double(r[k]) / kPositions;
+  for (int i = 0; i < kPositions; ++i) {
+    double norm = 0.0, d = 0.0;
+    for (size_t k = 0; k < bins; ++k) {
+      norm += std::fabs(double(refs[size_t(i)][k]));
+      d += std::fabs(mean[k] - double(refs[size_t(i)][k]));
+    }
+    spread[size_t(i)] = norm > 0.0 ? d / norm : 0.0;
+  }
+  out.baseline = median(spread);
+  out.blend_error = median(blend_errors);
+  out.lobes_error = median(lobes_errors);
+  out.ran = true;
+  return out;
 }
 
 namespace {

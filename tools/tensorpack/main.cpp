@@ -364,8 +364,10 @@ cli::ExitCode bakeShard(cli::Tool& t, const Options& o, Input& in, const Json& m
 
 // Stage 5: the warnings, then the --json summary or the one-line summary.
 void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& params,
-                 const tensor::TensorPackReport& report, const GatedError& gated,
-                 const std::vector<std::string>& warnings, uint64_t file_bytes, double seconds) {
+                 const tensor::TensorPackReport& report, const cli::TensorAssetResult& done, uint64_t file_bytes,
+                 double seconds) {
+  const GatedError& gated = done.gated;
+  const std::vector<std::string>& warnings = done.warnings;
   for (const std::string& w : warnings) t.warning(o.input + ": " + w);
   const double ratio = report.raw_bytes > 0 ? double(file_bytes) / double(report.raw_bytes) : 0.0;
   if (!t.common().json) {
@@ -401,6 +403,13 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
   doc["ratio"] = ratio;
   doc["relative_error"] = report.relative_error;
   doc["max_group_error"] = report.max_group_error;
+  const bake::ndf::HandoverProbe& probe = done.probe;
+  doc["handover_probe"] = probe.ran ? Json{{"sigma", probe.sigma},
+                                           {"blend_error", probe.blend_error},
+                                           {"lobes_error", probe.lobes_error},
+                                           {"baseline", probe.baseline},
+                                           {"answers", probe.lobesAnswer() ? "lobes" : "pyramid"}}
+                                    : Json(nullptr);
   doc["negative_mass_fraction"] = report.negative_mass_fraction;
   doc["warnings"] = warnings;
   doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},
@@ -437,7 +446,7 @@ int glintbake::cli::tensorpackMain(int argc, char** argv) {
     const tensor::TensorPackReport report = packAsset(t, o, in, out, &flakes);
     const cli::TensorAssetResult done = writeAsset(o, in, report, flakes, metadata, out);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    printReport(t, o, in, params, report, done.gated, done.warnings, out.bytesWritten(), seconds);
+    printReport(t, o, in, params, report, done, out.bytesWritten(), seconds);
     return cli::kExitOk;
   });
 }

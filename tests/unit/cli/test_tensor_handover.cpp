@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the hand-over tensorpack chooses from its levels' errors (cli/tensor_asset.h).
+#include <glintbake/bake/mapgen/mapgen.h>
+#include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/cli/tensor_asset.h>
+#include <glintbake/runtime/texel_source.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 using namespace glintbake;
 
@@ -56,13 +60,40 @@ TEST(TensorHandover, CompressedLevelsAnswerOnlyWhenTheirImagesAreCloseInL1) {
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 16 * kSqrt2);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0);
 
-  // A first exact level whose images vary as glints do (kGlintyVariation): the lobes answer up to
-  // sqrt(2) times it, the pyramid alone from twice it.
+  // A first exact level without the map's flakes to probe: the pyramid answers from sqrt(2) times
+  // it, whatever its images' variation.
   bake::tensor::TensorPackReport glints = pyramid(0.05, 0.3);
   glints.levels[2].variation = 0.9;
-  const bake::ndf::FlakesHandover g = cli::tensorHandover(glints, 16);
-  EXPECT_DOUBLE_EQ(g.lobes_up_to, 32 * kSqrt2);
-  EXPECT_DOUBLE_EQ(g.pyramid_from, 64.0);
+  const bake::ndf::FlakesHandover unprobed = cli::tensorHandover(glints, 16);
+  EXPECT_DOUBLE_EQ(unprobed.lobes_up_to, 32.0);
+  EXPECT_DOUBLE_EQ(unprobed.pyramid_from, 32 * kSqrt2);
+
+  // With them, as the probe finds: on a repeating strip 3 texels wide the blend above an exact level
+  // of 16 texels is far off and the lobes closer, so they answer up to sqrt(2) times it and the
+  // pyramid from twice it.
+  glints.levels[1] = level(16, 0, 0, 0.4, true);
+  bake::MapParams mp;
+  mp.size = 512;
+  mp.seed = 5;
+  mp.cell = 1.0;
+  const bake::NormalMap noise = bake::generateMap(bake::MapKind::kBeckmann, mp);
+  std::vector<float> strip;
+  for (int y = 0; y < noise.height; ++y)
+    for (int x = 0; x < 3; ++x) strip.insert(strip.end(), noise.at(x, y), noise.at(x, y) + 2);
+  const runtime::InterleavedTexels texels(3, noise.height, true, strip.data(), 2);
+  for (size_t l = 0; l < glints.levels.size(); ++l) {
+    const bake::ndf::LevelGeometry g =
+        bake::ndf::levelGeometry(3, noise.height, bake::ndf::PyramidOptions{}, int(l), true);
+    glints.levels[l].grid_width = g.grid_width;
+    glints.levels[l].grid_height = g.grid_height;
+  }
+  bake::ndf::HandoverProbe probe;
+  const bake::ndf::FlakesHandover g = cli::tensorHandover(glints, 16, &texels, 1, 0.005, &probe);
+  ASSERT_TRUE(probe.ran);
+  EXPECT_DOUBLE_EQ(probe.sigma, 16 * kSqrt2);
+  EXPECT_TRUE(probe.lobesAnswer());
+  EXPECT_DOUBLE_EQ(g.lobes_up_to, 16 * kSqrt2);
+  EXPECT_DOUBLE_EQ(g.pyramid_from, 32.0);
 
   // Without lobes the flakes hand over to the pyramid at its finest level, faithful or not.
   const bake::ndf::FlakesHandover none = cli::tensorHandover(pyramid(0.05, 0.3), 0);

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// Small ndf-pyramid assets with a flakes section (formats/SPEC.md 10.5), shared by the tests of
-// this directory.
+// Small ndf-pyramid assets with a flakes section (formats/SPEC.md 10.5), and the maps they are
+// made of, shared by the tests of this directory.
 #pragma once
 
 #include <glintbake/bake/io/normal_map.h>
+#include <glintbake/bake/mapgen/mapgen.h>
 #include <glintbake/bake/ndf/pyramid_builder.h>
 #include <glintbake/format/container.h>
 
@@ -16,6 +17,16 @@
 #include <vector>
 
 namespace glintbake::testing {
+
+// A Beckmann-like map of the procedural generator (bake/mapgen): roughness alpha, kernel std cell.
+inline bake::NormalMap beckmannMap(int size, double alpha, double cell, uint64_t seed) {
+  bake::MapParams p;
+  p.size = size;
+  p.seed = seed;
+  p.alpha = alpha;
+  p.cell = cell;
+  return bake::generateMap(bake::MapKind::kBeckmann, p);
+}
 
 // The pyramid of these assets: sigma0 4, stride 8, `levels` levels of R x R images.
 inline bake::ndf::PyramidOptions smallPyramid(int res, int levels) {

@@ -244,14 +244,27 @@ TEST(Handover, CompressedPyramidsHandOverAtTheirFirstFaithfulLevel) {
   h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact);
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
-  // An exact level whose images vary strongly (glints) hands over as a compressed one does.
-  const double smooth[4] = {0.6, 0.5, 0.3, 0.1}, glinty[4] = {0.99, 0.97, 0.9, 0.7};
-  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, smooth);
+  // An exact level whose blend the probe finds farther than the lobes hands over as a compressed
+  // one does; the probe is asked once, for that level only.
+  int asked = 0, level_asked = -1;
+  auto probe = [&](bool loses) {
+    return [&asked, &level_asked, loses](int level) {
+      ++asked;
+      level_asked = level;
+      return loses;
+    };
+  };
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(false));
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
-  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, glinty);
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(true));
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0 * std::sqrt(2.0));
   EXPECT_DOUBLE_EQ(h.pyramid_from, 64.0);
+  EXPECT_EQ(asked, 2);
+  EXPECT_EQ(level_asked, 2);
+  // A compressed first faithful level is not probed.
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, nullptr, probe(true));
+  EXPECT_EQ(asked, 2);
   const double none[4] = {2.0, 2.0, 2.0, 2.0};
   h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 16);
   EXPECT_GE(h.lobes_up_to, 1e6);

@@ -38,14 +38,7 @@ bake::NormalMap denseScratches(int size) {
   return bake::generateMap(bake::MapKind::kScratches, p);
 }
 
-bake::NormalMap beckmann(int size, double alpha, double cell) {
-  bake::MapParams p;
-  p.size = size;
-  p.seed = 7;
-  p.alpha = alpha;
-  p.cell = cell;
-  return bake::generateMap(bake::MapKind::kBeckmann, p);
-}
+bake::NormalMap beckmann(int size, double alpha, double cell) { return testing::beckmannMap(size, alpha, cell, 7); }
 
 // A hand-over whose lobes answer every probe footprint (up to the pyramid from 64 texels); the
 // tests narrow it.

@@ -6,6 +6,7 @@
 #include <glintbake/cli/pyramid_options.h>
 #include <glintbake/format/kinds/flakes.h>
 #include <glintbake/format/kinds/tensor_ndf.h>
+#include <glintbake/runtime/texel_source.h>
 
 #include <algorithm>
 #include <cmath>
@@ -123,21 +124,34 @@ Json rankHistogramJson(const tensor::TensorPackReport& r) {
   return h;
 }
 
-bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report, int lobes_per_tile) {
-  std::vector<double> sigmas, errors, variations;
+bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report, int lobes_per_tile,
+                                         const runtime::TexelSource* texels, int rate, double sigma_r,
+                                         bake::ndf::HandoverProbe* probe) {
+  std::vector<double> sigmas, errors;
   std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
   for (size_t l = 0; l < report.levels.size(); ++l) {
     sigmas.push_back(report.levels[l].sigma);
     errors.push_back(unfaithfulness(report.levels[l]));
-    variations.push_back(report.levels[l].variation);
     // A level 0 stored exactly (a map of a few dozen texels) is faithful, but the lobes answer its
     // footprints from single flakes, closer than the blend of its few centres (on a 37 x 23 map
     // 0.11 relative L1 at 12 texels where the lobes give 0.03): it never moves the lobes' bound
     // below the default.
     exact[l] = report.levels[l].exact && l > 0;
   }
+  // Above the first faithful level, when it is exact: whether the lobes or the pyramid's blend is
+  // closer to the exact flakes, measured on the map.
+  auto blend_loses = [&](int first) {
+    if (!texels) return false;
+    std::vector<bake::ndf::PyramidLevelShape> shapes;
+    for (size_t l = size_t(first); l < report.levels.size(); ++l)
+      shapes.push_back({report.levels[l].sigma, report.levels[l].grid_width, report.levels[l].grid_height});
+    const bake::ndf::HandoverProbe p =
+        bake::ndf::probeExactLevelHandover(*texels, rate, sigma_r, lobes_per_tile, shapes.data(), int(shapes.size()));
+    if (probe) *probe = p;
+    return p.lobesAnswer();
+  };
   return bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes_per_tile,
-                                       exact.get(), variations.data());
+                                       exact.get(), blend_loses);
 }
 
 TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::TensorPackReport& report,
@@ -145,12 +159,21 @@ TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::Tensor
   TensorAssetResult out;
   // The hand-over this compression calls for: the pyramid answers only from the first level from
   // which every level is faithful (unfaithfulness), the clustered lobes below it.
-  out.handover = tensorHandover(report, end.lobes_per_tile);
   if (flakes && flakes->size() >= sizeof(format::FlakesRecord)) {
     format::FlakesRecord rec;
     std::memcpy(&rec, flakes->data(), sizeof(rec));
+    const uint64_t normals = uint64_t(rec.map_width) * uint64_t(rec.map_height) * 2 * sizeof(float);
+    if (flakes->size() - sizeof(rec) >= normals) {
+      const runtime::InterleavedTexels texels(int(rec.map_width), int(rec.map_height), rec.wrap == 0,
+                                              reinterpret_cast<const float*>(flakes->data() + sizeof(rec)), 2);
+      out.handover = tensorHandover(report, end.lobes_per_tile, &texels, int(rec.rate), rec.sigma_r, &out.probe);
+    } else {
+      out.handover = tensorHandover(report, end.lobes_per_tile);
+    }
     out.handover = bake::ndf::fitHandoverToMap(out.handover, int(rec.map_width), int(rec.map_height), rec.wrap == 0,
                                                int(rec.rate));
+  } else {
+    out.handover = tensorHandover(report, end.lobes_per_tile);
   }
   // The gate runs before anything more is written: a failure leaves no output.
   out.gated = gatedError(report, out.handover);

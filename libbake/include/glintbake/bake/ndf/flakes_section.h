@@ -12,6 +12,7 @@
 #include <glintbake/runtime/texel_source.h>
 
 #include <cstdint>
+#include <functional>
 
 namespace glintbake::bake::ndf {
 
@@ -101,24 +102,69 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
 // The hand-over for a compressed pyramid: level_sigmas[l] is the footprint std of level l and
 // level_errors[l] the relative error of its compression. The pyramid answers from the first level
 // from which every level's error is at most max_level_error, as defaultHandover places it above
-// an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such level exists the
-// lobes answer every footprint they can (the runtime bounds them by their window) and the pyramid only above.
-// When that first level is stored exactly (level_exact[l], may be null), the lobes answer up to its
-// sigma and the pyramid alone from sqrt(2) times it, unless its images vary across the map by more
-// than kGlintyVariation (level_variation[l], may be null: the relative spread of the level's images
-// about their mean): then the lobes answer up to sqrt(2) times its sigma and the pyramid alone from
-// twice it, as above a compressed level.
+// an uncompressed finest level; the lobes answer below it, down to 4 sqrt(2) texels. When no such
+// level exists the lobes answer every footprint they can (the runtime bounds them by their window)
+// and the pyramid only above. When that first level is stored exactly (level_exact[l], may be
+// null), the lobes answer up to its sigma and the pyramid alone from sqrt(2) times it, unless
+// blend_loses (may be empty; asked at most once, for that level) says that the lobes should
+// answer above it instead (HandoverProbe::lobesAnswer): then the
+// lobes answer up to sqrt(2) times its sigma and the pyramid alone from twice it, as above a
+// compressed level.
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
                                   double max_level_error, int lobes_per_tile, const bool* level_exact = nullptr,
-                                  const double* level_variation = nullptr);
+                                  const std::function<bool(int level)>& blend_loses = {});
 
-// Above an exact level the pyramid blends the images of its centres and of the next level. Where
-// those images differ little (variation up to this bound: isotropic noise, bumps, fine scratches
-// and brushed maps, 0.15-0.27 at their first exact level) that blend is closer to the reference
-// than the clustered lobes (at 1.5 x the level's sigma, 0.010-0.020 against 0.029-0.054); where
-// the glints dominate (flakes and leather, 0.88-0.90) it is farther (0.064-0.116 against
-// 0.023-0.044): measured on the real maps of the README.
-constexpr double kGlintyVariation = 0.5;
+// The shape of one pyramid level, for probeExactLevelHandover: its footprint std (texels) and its
+// grid of centres over the map (formats/SPEC.md 10.1: strides map size / grid, origins half a stride).
+struct PyramidLevelShape {
+  double sigma = 0.0;
+  int grid_width = 0, grid_height = 0;
+};
+
+// What probeExactLevelHandover measured at footprint std `sigma`: the median relative L1 against
+// the exact flakes of the pyramid's blend and of the clustered lobes, and of the smooth baseline;
+// ran is false when the lobes cannot answer there (beyond their window or the exact flakes', or
+// beyond the footprint from which a repeating map's pyramid answers alone, capAtFlatFootprint).
+// The pyramid costs a tenth of the lobes' time there (README, "Figures"), so it answers wherever
+// its blend is faithful, within kHandoverBlendMaxError and kHandoverBlendMaxRatio times the
+// baseline (the lobes' own probe allows 0.08 and 0.2: the blend is measured at the sigma where the
+// two hand-overs differ most, and keeps a wider margin for the positions the probe does not see),
+// and wherever the lobes are no closer; elsewhere the lobes answer.
+constexpr double kHandoverBlendMaxError = 0.04;
+constexpr double kHandoverBlendMaxRatio = 0.2;
+struct HandoverProbe {
+  bool ran = false;
+  double sigma = 0.0;
+  double blend_error = 0.0;
+  double lobes_error = 0.0;
+  double baseline = 0.0;
+  bool lobesAnswer() const {
+    const bool faithful = blend_error <= kHandoverBlendMaxError && blend_error <= kHandoverBlendMaxRatio * baseline;
+    return ran && !faithful && lobes_error < blend_error;
+  }
+};
+
+// Above an exact level the pyramid blends the stored images of its centres (and, as the spread
+// grows, of the next level's); the clustered lobes could answer there instead. Which is closer
+// depends on the map, not on how much its images vary: where a footprint holds many similar
+// texels the blend's small error in each centre's weight averages out (bumps, fine scratches,
+// brushed and rough isotropic maps), where a few glints dominate, or a footprint holds few texels
+// across (a strip a few texels wide), it does not. So it is measured, on the map: at
+// kHandoverProbePositions positions (a golden-ratio sequence over the map) at sqrt(2) times the
+// level's sigma (where the two hand-overs compressedHandover chooses between differ most), the
+// relative L1 of R = kLobeProbeResolution NDF images against the splat of the footprint (the
+// reference scripts/fidelity.py uses at these sizes), of
+//  - the pyramid's answer: format::NdfPyramidBlend's weights over `levels` (levels[0] the exact
+//    level, then those above it) applied to the splats of the centres' level footprints (with the
+//    levels' footprint partition on repeating maps: what an exact level stores), and
+//  - the lobes' at the default tile ratio;
+// and the baseline: each position's image against the mean of all of them.
+// Maps of more than max_probe_flakes flakes are probed on the window chooseLobeTileRatio uses,
+// with the levels' strides kept (rounded to tile the window). Deterministic.
+constexpr int kHandoverProbePositions = 8;
+HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
+                                      const PyramidLevelShape* levels, int count,
+                                      uint64_t max_probe_flakes = kLobeProbeMaxFlakes);
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
 // mode, rate (1..16) and sigma_r, the hand-over, and (with lobes) the tile ratio
