@@ -86,11 +86,21 @@ FlakesHandover compressedHandover(const double* level_sigmas, const double* leve
   h.lobes_per_tile = lobes_per_tile;
   const bool exact = first < levels && level_exact && level_exact[first];
   if (exact && !(blend_loses && blend_loses(first))) {
-    // The pyramid's blend above an exact level is closer to the reference from its own sigma up
-    // than the lobes (probeExactLevelHandover), so the lobes hand over at that sigma; where it is
-    // not they go on as above a compressed level (below).
+    // The pyramid's blend above an exact level is faithful from its own sigma up, or no farther
+    // from the reference than the lobes (probeExactLevelHandover), so the lobes hand over at that
+    // sigma.
     h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, level_sigmas[first]);
     h.pyramid_from = std::max(kHalfOctave * level_sigmas[first], h.lobes_up_to);
+    return h;
+  }
+  if (exact) {
+    // Where it is not, the lobes answer up to sqrt(2) times that level and the pyramid from twice
+    // it, as above a compressed level, unless the blend above the next level loses too: then the
+    // lobes go on above that level, and so on.
+    int last = first;
+    while (last + 1 < levels && blend_loses(last + 1)) ++last;
+    h.lobes_up_to = std::max(kFlakesUpTo * format::kLobesBand, level_sigmas[last] * kHalfOctave);
+    h.pyramid_from = std::max(2.0 * level_sigmas[last], h.lobes_up_to);
     return h;
   }
   if (first == 0) return defaultHandover(level_sigmas[0], lobes_per_tile);

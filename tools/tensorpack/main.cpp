@@ -403,13 +403,16 @@ void printReport(cli::Tool& t, const Options& o, const Input& in, const Json& pa
   doc["ratio"] = ratio;
   doc["relative_error"] = report.relative_error;
   doc["max_group_error"] = report.max_group_error;
-  const bake::ndf::HandoverProbe& probe = done.probe;
-  doc["handover_probe"] = probe.ran ? Json{{"sigma", probe.sigma},
-                                           {"blend_error", probe.blend_error},
-                                           {"lobes_error", probe.lobes_error},
-                                           {"baseline", probe.baseline},
-                                           {"answers", probe.lobesAnswer() ? "lobes" : "pyramid"}}
-                                    : Json(nullptr);
+  Json probes = Json::array();
+  for (const bake::ndf::HandoverProbe& p : done.probes) {
+    if (!p.ran) continue;
+    probes.push_back({{"sigma", p.sigma},
+                      {"blend_error", p.blend_error},
+                      {"lobes_error", p.lobes_error},
+                      {"baseline", p.baseline},
+                      {"answers", p.lobesAnswer() ? "lobes" : "pyramid"}});
+  }
+  doc["handover_probes"] = probes;
   doc["negative_mass_fraction"] = report.negative_mass_fraction;
   doc["warnings"] = warnings;
   doc["seconds"] = {{"ndf", report.ndf_seconds},   {"cp", report.cp_seconds},      {"write", report.write_seconds},

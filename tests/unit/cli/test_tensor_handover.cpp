@@ -87,11 +87,16 @@ TEST(TensorHandover, CompressedLevelsAnswerOnlyWhenTheirImagesAreCloseInL1) {
     glints.levels[l].grid_width = g.grid_width;
     glints.levels[l].grid_height = g.grid_height;
   }
-  bake::ndf::HandoverProbe probe;
-  const bake::ndf::FlakesHandover g = cli::tensorHandover(glints, 16, &texels, 1, 0.005, &probe);
-  ASSERT_TRUE(probe.ran);
-  EXPECT_DOUBLE_EQ(probe.sigma, 16 * kSqrt2);
-  EXPECT_TRUE(probe.lobesAnswer());
+  // The level above (32 texels) is probed next; there the blend is faithful.
+  std::vector<bake::ndf::HandoverProbe> probes;
+  const bake::ndf::FlakesHandover g = cli::tensorHandover(glints, 16, &texels, 1, 0.005, &probes);
+  ASSERT_EQ(probes.size(), 2u);
+  ASSERT_TRUE(probes[0].ran);
+  EXPECT_DOUBLE_EQ(probes[0].sigma, 16 * kSqrt2);
+  EXPECT_TRUE(probes[0].lobesAnswer());
+  ASSERT_TRUE(probes[1].ran);
+  EXPECT_DOUBLE_EQ(probes[1].sigma, 32 * kSqrt2);
+  EXPECT_FALSE(probes[1].lobesAnswer());
   EXPECT_DOUBLE_EQ(g.lobes_up_to, 16 * kSqrt2);
   EXPECT_DOUBLE_EQ(g.pyramid_from, 32.0);
 

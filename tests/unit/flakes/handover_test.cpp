@@ -25,6 +25,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace glintbake {
 namespace {
@@ -244,27 +245,33 @@ TEST(Handover, CompressedPyramidsHandOverAtTheirFirstFaithfulLevel) {
   h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact);
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
-  // An exact level whose blend the probe finds farther than the lobes hands over as a compressed
-  // one does; the probe is asked once, for that level only.
-  int asked = 0, level_asked = -1;
-  auto probe = [&](bool loses) {
-    return [&asked, &level_asked, loses](int level) {
-      ++asked;
-      level_asked = level;
-      return loses;
+  // An exact level whose blend the probe finds unfaithful hands over as a compressed one does, and
+  // the level above is probed next; the probe is asked for those levels only, in order.
+  std::vector<int> asked;
+  auto probe = [&asked](int losing_up_to) {
+    return [&asked, losing_up_to](int level) {
+      asked.push_back(level);
+      return level <= losing_up_to;
     };
   };
-  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(false));
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(-1));
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(h.pyramid_from, 32.0 * std::sqrt(2.0));
-  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(true));
+  EXPECT_EQ(asked, std::vector<int>({2}));
+  asked.clear();
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(2));
   EXPECT_DOUBLE_EQ(h.lobes_up_to, 32.0 * std::sqrt(2.0));
   EXPECT_DOUBLE_EQ(h.pyramid_from, 64.0);
-  EXPECT_EQ(asked, 2);
-  EXPECT_EQ(level_asked, 2);
+  EXPECT_EQ(asked, std::vector<int>({2, 3}));
+  asked.clear();
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, exact, probe(3));
+  EXPECT_DOUBLE_EQ(h.lobes_up_to, 64.0 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(h.pyramid_from, 128.0);
+  EXPECT_EQ(asked, std::vector<int>({2, 3}));
+  asked.clear();
   // A compressed first faithful level is not probed.
-  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, nullptr, probe(true));
-  EXPECT_EQ(asked, 2);
+  h = bake::ndf::compressedHandover(sigmas, mixed, 4, 1.0, 16, nullptr, probe(3));
+  EXPECT_TRUE(asked.empty());
   const double none[4] = {2.0, 2.0, 2.0, 2.0};
   h = bake::ndf::compressedHandover(sigmas, none, 4, 1.0, 16);
   EXPECT_GE(h.lobes_up_to, 1e6);

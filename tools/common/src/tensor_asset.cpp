@@ -126,7 +126,7 @@ Json rankHistogramJson(const tensor::TensorPackReport& r) {
 
 bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report, int lobes_per_tile,
                                          const runtime::TexelSource* texels, int rate, double sigma_r,
-                                         bake::ndf::HandoverProbe* probe) {
+                                         std::vector<bake::ndf::HandoverProbe>* probes) {
   std::vector<double> sigmas, errors;
   std::unique_ptr<bool[]> exact(new bool[std::max<size_t>(report.levels.size(), 1)]);
   for (size_t l = 0; l < report.levels.size(); ++l) {
@@ -138,8 +138,8 @@ bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report,
     // below the default.
     exact[l] = report.levels[l].exact && l > 0;
   }
-  // Above the first faithful level, when it is exact: whether the lobes or the pyramid's blend is
-  // closer to the exact flakes, measured on the map.
+  // Above the first faithful level, when it is exact (and above the next while the lobes win):
+  // whether the lobes or the pyramid's blend should answer, measured on the map.
   auto blend_loses = [&](int first) {
     if (!texels) return false;
     std::vector<bake::ndf::PyramidLevelShape> shapes;
@@ -147,7 +147,7 @@ bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report,
       shapes.push_back({report.levels[l].sigma, report.levels[l].grid_width, report.levels[l].grid_height});
     const bake::ndf::HandoverProbe p =
         bake::ndf::probeExactLevelHandover(*texels, rate, sigma_r, lobes_per_tile, shapes.data(), int(shapes.size()));
-    if (probe) *probe = p;
+    if (probes) probes->push_back(p);
     return p.lobesAnswer();
   };
   return bake::ndf::compressedHandover(sigmas.data(), errors.data(), int(sigmas.size()), 1.0, lobes_per_tile,
@@ -166,7 +166,7 @@ TensorAssetResult finishTensorAsset(format::Writer& writer, const tensor::Tensor
     if (flakes->size() - sizeof(rec) >= normals) {
       const runtime::InterleavedTexels texels(int(rec.map_width), int(rec.map_height), rec.wrap == 0,
                                               reinterpret_cast<const float*>(flakes->data() + sizeof(rec)), 2);
-      out.handover = tensorHandover(report, end.lobes_per_tile, &texels, int(rec.rate), rec.sigma_r, &out.probe);
+      out.handover = tensorHandover(report, end.lobes_per_tile, &texels, int(rec.rate), rec.sigma_r, &out.probes);
     } else {
       out.handover = tensorHandover(report, end.lobes_per_tile);
     }

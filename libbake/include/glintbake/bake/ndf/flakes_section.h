@@ -106,10 +106,10 @@ FlakesHandover defaultHandover(double sigma0, int lobes_per_tile);
 // level exists the lobes answer every footprint they can (the runtime bounds them by their window)
 // and the pyramid only above. When that first level is stored exactly (level_exact[l], may be
 // null), the lobes answer up to its sigma and the pyramid alone from sqrt(2) times it, unless
-// blend_loses (may be empty; asked at most once, for that level) says that the lobes should
-// answer above it instead (HandoverProbe::lobesAnswer): then the
-// lobes answer up to sqrt(2) times its sigma and the pyramid alone from twice it, as above a
-// compressed level.
+// blend_loses (may be empty) says that the lobes should answer above it instead
+// (HandoverProbe::lobesAnswer): then it is asked for the levels above in turn, and the lobes answer
+// up to sqrt(2) times the last level it says so of (the pyramid alone from twice it, as above a
+// compressed level). It is asked only for that first level and the levels above it, in order.
 FlakesHandover compressedHandover(const double* level_sigmas, const double* level_errors, int levels,
                                   double max_level_error, int lobes_per_tile, const bool* level_exact = nullptr,
                                   const std::function<bool(int level)>& blend_loses = {});

@@ -36,9 +36,9 @@ struct TensorAssetResult {
   bake::ndf::FlakesHandover handover;
   GatedError gated;
   std::vector<std::string> warnings;
-  uint64_t flake_bytes = 0;        // raw size of the flakes section written (0: none)
-  bake::ndf::HandoverProbe probe;  // the hand-over's probe above an exact level (ran: false when none)
-  Json metadata;                   // the asset's metadata, complete
+  uint64_t flake_bytes = 0;                      // raw size of the flakes section written (0: none)
+  std::vector<bake::ndf::HandoverProbe> probes;  // the hand-over's probes above exact levels, in order
+  Json metadata;                                 // the asset's metadata, complete
 };
 
 // Chooses the hand-over, applies the gate (Error exit 4 naming the achieved error, before anything
@@ -62,11 +62,11 @@ void readTensorShardAssembly(const Json& assembly, bake::tensor::TensorPackOptio
 // and a quarter of the level's variation and within a mean L1 error of 0.06 of its images), the
 // clustered lobes below (bake::ndf::compressedHandover).
 // With the map's flakes (texels, rate, sigma_r; may be null) a first faithful level stored exactly
-// hands over as bake::ndf::probeExactLevelHandover measures, *probe (may be null) receiving what it
-// measured; without them as an exact level whose blend is the closer.
+// hands over as bake::ndf::probeExactLevelHandover measures, *probes (may be null) receiving what
+// it measured, level by level; without them as an exact level whose blend is faithful.
 bake::ndf::FlakesHandover tensorHandover(const bake::tensor::TensorPackReport& report, int lobes_per_tile,
                                          const runtime::TexelSource* texels = nullptr, int rate = 1,
-                                         double sigma_r = 0.0, bake::ndf::HandoverProbe* probe = nullptr);
+                                         double sigma_r = 0.0, std::vector<bake::ndf::HandoverProbe>* probes = nullptr);
 
 // The gated error and its one-line description (tensorpack's --json and messages).
 GatedError gatedError(const bake::tensor::TensorPackReport& report, const bake::ndf::FlakesHandover& handover);
