@@ -298,8 +298,8 @@ void handoverProbeBench(benchmark::State& state, size_t subject) {
     levels.push_back({g.sigma, g.grid_width, g.grid_height});
   }
   for (auto _ : state) {
-    const bake::ndf::HandoverProbe p =
-        bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), int(levels.size()));
+    const bake::ndf::HandoverProbe p = bake::ndf::probeExactLevelHandover(
+        texels, 1, 0.005, 16, levels.data(), int(levels.size()), std::sqrt(2.0) * levels[0].sigma);
     benchmark::DoNotOptimize(p);
   }
 }

@@ -304,12 +304,13 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
 }
 
 HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
-                                      const PyramidLevelShape* levels, int count, uint64_t max_probe_flakes) {
+                                      const PyramidLevelShape* levels, int count, double sigma,
+                                      uint64_t max_probe_flakes) {
   HandoverProbe out;
   if (lobes_per_tile <= 0 || count < 1 || count > format::kMaxNdfLevels || rate < 1 || texels.width() < 1 ||
-      texels.height() < 1 || !(levels[0].sigma > 0.0))
+      texels.height() < 1 || !(levels[0].sigma > 0.0) || !(sigma > levels[0].sigma) || !std::isfinite(sigma))
     return out;
-  out.sigma = kHalfOctave * levels[0].sigma;
+  out.sigma = sigma;
   const ProbeWindow probe(texels, rate, max_probe_flakes);
   const bool repeat = probe.repeats();
   const double side = double(std::max(probe.width(), probe.height()));

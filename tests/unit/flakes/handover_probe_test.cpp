@@ -46,7 +46,7 @@ bake::ndf::HandoverProbe probe(const bake::NormalMap& map, const std::vector<bak
   const runtime::InterleavedTexels texels(map.width, map.height, map.wrap == bake::Wrap::kRepeat, map.normals.data(),
                                           3);
   return bake::ndf::probeExactLevelHandover(texels, 1, reference::kDefaultSigmaR, bake::ndf::kDefaultLobesPerTile,
-                                            levels.data(), int(levels.size()));
+                                            levels.data(), int(levels.size()), std::sqrt(2.0) * levels[0].sigma);
 }
 
 TEST(HandoverProbe, LobesAreCloserOnAStripAFewTexelsWide) {
@@ -78,10 +78,11 @@ TEST(HandoverProbe, NothingIsProbedWhereThePyramidAnswersAlone) {
   const bake::NormalMap map = beckmann(128, 0.3, 1.0);
   const runtime::InterleavedTexels texels(map.width, map.height, true, map.normals.data(), 3);
   std::vector<bake::ndf::PyramidLevelShape> levels = levelsFrom(map, 1, 2);
-  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 0, levels.data(), 2).ran);
-  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), 0).ran);
+  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 0, levels.data(), 2, 1.5 * levels[0].sigma).ran);
+  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), 0, 1.5 * levels[0].sigma).ran);
+  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), 2, levels[0].sigma).ran);
   std::swap(levels[0], levels[1]);
-  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), 2).ran);
+  EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 16, levels.data(), 2, 1.5 * levels[0].sigma).ran);
 }
 
 }  // namespace

@@ -140,13 +140,18 @@ bake::ndf::FlakesHandover tensorHandover(const tensor::TensorPackReport& report,
   }
   // Above the first faithful level, when it is exact (and above the next while the lobes win):
   // whether the lobes or the pyramid's blend should answer, measured on the map.
-  auto blend_loses = [&](int first) {
+  // The pyramid answers from the first exact level whichever level is probed (the runtime's blend
+  // takes the finest level whose spread allows it, which above twice a level is often that one).
+  int from = -1;
+  auto blend_loses = [&](int level) {
     if (!texels) return false;
+    if (from < 0) from = level;
     std::vector<bake::ndf::PyramidLevelShape> shapes;
-    for (size_t l = size_t(first); l < report.levels.size(); ++l)
+    for (size_t l = size_t(from); l < report.levels.size(); ++l)
       shapes.push_back({report.levels[l].sigma, report.levels[l].grid_width, report.levels[l].grid_height});
     const bake::ndf::HandoverProbe p =
-        bake::ndf::probeExactLevelHandover(*texels, rate, sigma_r, lobes_per_tile, shapes.data(), int(shapes.size()));
+        bake::ndf::probeExactLevelHandover(*texels, rate, sigma_r, lobes_per_tile, shapes.data(), int(shapes.size()),
+                                           std::sqrt(2.0) * report.levels[size_t(level)].sigma);
     if (probes) probes->push_back(p);
     return p.lobesAnswer();
   };

@@ -150,12 +150,14 @@ struct HandoverProbe {
 // texels the blend's small error in each centre's weight averages out (bumps, fine scratches,
 // brushed and rough isotropic maps), where a few glints dominate, or a footprint holds few texels
 // across (a strip a few texels wide), it does not. So it is measured, on the map: at
-// kHandoverProbePositions positions (a golden-ratio sequence over the map) at sqrt(2) times the
-// level's sigma (where the two hand-overs compressedHandover chooses between differ most), the
+// kHandoverProbePositions positions (a golden-ratio sequence over the map) at footprint std sigma
+// (sqrt(2) times the level probed: where the two hand-overs compressedHandover chooses between
+// differ most), the
 // relative L1 of R = kLobeProbeResolution NDF images against the splat of the footprint (the
 // reference scripts/fidelity.py uses at these sizes), of
-//  - the pyramid's answer: format::NdfPyramidBlend's weights over `levels` (levels[0] the exact
-//    level, then those above it) applied to the splats of the centres' level footprints (with the
+//  - the pyramid's answer: format::NdfPyramidBlend's weights over `levels` (levels[0] the finest
+//    level the pyramid answers from, the first exact one, then those above it; the runtime's blend
+//    takes the finest of them whose spread allows it) applied to the splats of the centres' level footprints (with the
 //    levels' footprint partition on repeating maps: what an exact level stores), and
 //  - the lobes' at the default tile ratio;
 // and the baseline: each position's image against the mean of all of them.
@@ -163,7 +165,7 @@ struct HandoverProbe {
 // with the levels' strides kept (rounded to tile the window). Deterministic.
 constexpr int kHandoverProbePositions = 8;
 HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
-                                      const PyramidLevelShape* levels, int count,
+                                      const PyramidLevelShape* levels, int count, double sigma,
                                       uint64_t max_probe_flakes = kLobeProbeMaxFlakes);
 
 // Appends the flakes section (key 0) to a container: the map's (n_x, n_y) as float32, its wrap
