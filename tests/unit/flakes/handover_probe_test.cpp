@@ -19,7 +19,7 @@
 namespace glintbake {
 namespace {
 
-bake::NormalMap beckmann(int size, double alpha, double cell) { return testing::beckmannMap(size, alpha, cell, 5); }
+bake::NormalMap noiseMap(int size, double alpha, double cell) { return testing::beckmannMap(size, alpha, cell, 5); }
 
 // The first `columns` columns of a map, as a map of their own (repeating).
 bake::NormalMap columns(const bake::NormalMap& map, int count) {
@@ -50,7 +50,7 @@ bake::ndf::HandoverProbe probe(const bake::NormalMap& map, const std::vector<bak
 }
 
 TEST(HandoverProbe, LobesAreCloserOnAStripAFewTexelsWide) {
-  const bake::NormalMap strip = columns(beckmann(512, 0.3, 1.0), 3);
+  const bake::NormalMap strip = columns(noiseMap(512, 0.3, 1.0), 3);
   const bake::ndf::HandoverProbe p = probe(strip, levelsFrom(strip, 1, 3));
   ASSERT_TRUE(p.ran);
   EXPECT_DOUBLE_EQ(p.sigma, 16.0 * std::sqrt(2.0));
@@ -61,7 +61,7 @@ TEST(HandoverProbe, LobesAreCloserOnAStripAFewTexelsWide) {
 }
 
 TEST(HandoverProbe, ThePyramidAnswersTheSameNoiseOverASquare) {
-  const bake::NormalMap bumps = beckmann(256, 0.3, 1.0);
+  const bake::NormalMap bumps = noiseMap(256, 0.3, 1.0);
   const bake::ndf::HandoverProbe p = probe(bumps, levelsFrom(bumps, 1, 3));
   ASSERT_TRUE(p.ran);
   EXPECT_FALSE(p.lobesAnswer()) << "blend " << p.blend_error << ", lobes " << p.lobes_error << ", baseline "
@@ -72,10 +72,10 @@ TEST(HandoverProbe, ThePyramidAnswersTheSameNoiseOverASquare) {
 TEST(HandoverProbe, NothingIsProbedWhereThePyramidAnswersAlone) {
   // sqrt(2) x 16 texels is beyond the flat footprint of a 32^2 repeating map (0.62 x 32): the
   // pyramid answers there whatever the probe would say (capAtFlatFootprint).
-  const bake::NormalMap small = beckmann(32, 0.3, 1.0);
+  const bake::NormalMap small = noiseMap(32, 0.3, 1.0);
   EXPECT_FALSE(probe(small, levelsFrom(small, 1, 2)).ran);
   // No lobes, no levels, or levels out of order: nothing is probed either.
-  const bake::NormalMap map = beckmann(128, 0.3, 1.0);
+  const bake::NormalMap map = noiseMap(128, 0.3, 1.0);
   const runtime::InterleavedTexels texels(map.width, map.height, true, map.normals.data(), 3);
   std::vector<bake::ndf::PyramidLevelShape> levels = levelsFrom(map, 1, 2);
   EXPECT_FALSE(bake::ndf::probeExactLevelHandover(texels, 1, 0.005, 0, levels.data(), 2, 1.5 * levels[0].sigma).ran);
