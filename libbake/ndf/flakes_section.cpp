@@ -303,6 +303,19 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   return kLobeTileRatioCandidates[kCandidates - 1];
 }
 
+namespace {
+// Relative L1 distance of an image from a reference image of the same size: sum |a - ref| / sum |ref|.
+template <typename A>
+double imageL1(const std::vector<A>& a, const std::vector<float>& ref) {
+  double norm = 0.0, d = 0.0;
+  for (size_t k = 0; k < ref.size(); ++k) {
+    norm += std::fabs(double(ref[k]));
+    d += std::fabs(double(a[k]) - double(ref[k]));
+  }
+  return norm > 0.0 ? d / norm : 0.0;
+}
+}  // namespace
+
 HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int rate, double sigma_r, int lobes_per_tile,
                                       const PyramidLevelShape* levels, int count, double sigma,
                                       uint64_t max_probe_flakes) {
@@ -406,28 +419,15 @@ HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int ra
                      centre.data(), part.empty() ? nullptr : &part);
       for (size_t k = 0; k < bins; ++k) mixed[k] += w * double(centre[k]);
     });
-    double norm = 0.0, db = 0.0, dl = 0.0;
-    for (size_t k = 0; k < bins; ++k) {
-      norm += std::fabs(double(ref[k]));
-      db += std::fabs(mixed[k] - double(ref[k]));
-      dl += std::fabs(double(lobe[k]) - double(ref[k]));
-    }
-    blend_errors[size_t(i)] = norm > 0.0 ? db / norm : 0.0;
-    lobes_errors[size_t(i)] = norm > 0.0 ? dl / norm : 0.0;
+    blend_errors[size_t(i)] = imageL1(mixed, ref);
+    lobes_errors[size_t(i)] = imageL1(lobe, ref);
     refs[size_t(i)] = std::move(ref);
   });
   // The smooth baseline: each position's image against the mean of them all.
   std::vector<double> mean(bins, 0.0), spread(kPositions);
   for (const std::vector<float>& r : refs)
     for (size_t k = 0; k < bins; ++k) mean[k] += double(r[k]) / kPositions;
-  for (int i = 0; i < kPositions; ++i) {
-    double norm = 0.0, d = 0.0;
-    for (size_t k = 0; k < bins; ++k) {
-      norm += std::fabs(double(refs[size_t(i)][k]));
-      d += std::fabs(mean[k] - double(refs[size_t(i)][k]));
-    }
-    spread[size_t(i)] = norm > 0.0 ? d / norm : 0.0;
-  }
+  for (int i = 0; i < kPositions; ++i) spread[size_t(i)] = imageL1(mean, refs[size_t(i)]);
   out.baseline = median(spread);
   out.blend_error = median(blend_errors);
   out.lobes_error = median(lobes_errors);
