@@ -5,6 +5,8 @@
 #include <glintbake/cli/tensor_asset.h>
 #include <glintbake/runtime/texel_source.h>
 
+#include "../flakes/flakes_asset.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -68,22 +70,18 @@ TEST(TensorHandover, CompressedLevelsAnswerOnlyWhenTheirImagesAreCloseInL1) {
   EXPECT_DOUBLE_EQ(unprobed.lobes_up_to, 32.0);
   EXPECT_DOUBLE_EQ(unprobed.pyramid_from, 32 * kSqrt2);
 
-  // With them, as the probe finds: on a repeating strip 3 texels wide the blend above an exact level
-  // of 16 texels is far off and the lobes closer, so they answer up to sqrt(2) times it and the
-  // pyramid from twice it.
+  // With them, as the probe finds: on a map of sharp flakes 12 texels across (a few dozen glints
+  // per footprint) the blend above an exact level of 16 texels is far off and the lobes closer, so
+  // they answer up to sqrt(2) times it and the pyramid from twice it.
   glints.levels[1] = level(16, 0, 0, 0.4, true);
-  bake::MapParams mp;
-  mp.size = 512;
-  mp.seed = 5;
-  mp.cell = 1.0;
-  const bake::NormalMap noise = bake::generateMap(bake::MapKind::kBeckmann, mp);
-  std::vector<float> strip;
-  for (int y = 0; y < noise.height; ++y)
-    for (int x = 0; x < 3; ++x) strip.insert(strip.end(), noise.at(x, y), noise.at(x, y) + 2);
-  const runtime::InterleavedTexels texels(3, noise.height, true, strip.data(), 2);
+  const bake::NormalMap flakes = glintbake::testing::flakesMap(256, 12.0, 15.0, 5);
+  std::vector<float> normals;
+  for (int y = 0; y < flakes.height; ++y)
+    for (int x = 0; x < flakes.width; ++x) normals.insert(normals.end(), flakes.at(x, y), flakes.at(x, y) + 2);
+  const runtime::InterleavedTexels texels(flakes.width, flakes.height, true, normals.data(), 2);
   for (size_t l = 0; l < glints.levels.size(); ++l) {
     const bake::ndf::LevelGeometry g =
-        bake::ndf::levelGeometry(3, noise.height, bake::ndf::PyramidOptions{}, int(l), true);
+        bake::ndf::levelGeometry(flakes.width, flakes.height, bake::ndf::PyramidOptions{}, int(l), true);
     glints.levels[l].grid_width = g.grid_width;
     glints.levels[l].grid_height = g.grid_height;
   }

@@ -28,6 +28,17 @@ inline bake::NormalMap beckmannMap(int size, double alpha, double cell, uint64_t
   return bake::generateMap(bake::MapKind::kBeckmann, p);
 }
 
+// A map of sharp flakes of the procedural generator: cells of mean size `cell` texels, each of one
+// normal within `cone_degrees` of the z axis.
+inline bake::NormalMap flakesMap(int size, double cell, double cone_degrees, uint64_t seed) {
+  bake::MapParams p;
+  p.size = size;
+  p.seed = seed;
+  p.cell = cell;
+  p.cone_degrees = cone_degrees;
+  return bake::generateMap(bake::MapKind::kFlakes, p);
+}
+
 // The pyramid of these assets: sigma0 4, stride 8, `levels` levels of R x R images.
 inline bake::ndf::PyramidOptions smallPyramid(int res, int levels) {
   bake::ndf::PyramidOptions o;

@@ -438,6 +438,64 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
   std::printf("[ figures  ] ramp error %.2g, weight error %.2g\n", worst, worst_w);
 }
 
+// A repeating strip narrower than a stride has one centre across it at every level: its centre
+// weighs 1 at any spread, so only the spread along the strip picks the level. A 5 x 700 strip at
+// 45 texels is answered by its level of sigma 16 (spread 1.25 strides along it), not by the level
+// above the footprint (sigma 64) that the width's spread (8 strides of 5 texels) would pick. A
+// clamped strip has no such centre: its edges' falloff depends on the spread, which still counts.
+TEST(NdfPyramidBlendWeights, AStripSpreadsAlongItsLengthOnly) {
+  auto records = [](uint32_t wrap) {
+    std::vector<format::NdfLevelRecord> r(3);
+    const uint32_t grid[3] = {22, 11, 5};
+    for (int l = 0; l < 3; ++l) {
+      r[l].level = uint32_t(l);
+      r[l].ndf_res = 8;
+      r[l].grid_width = 1;
+      r[l].grid_height = grid[l];
+      r[l].wrap = wrap;
+      r[l].map_width = 5;
+      r[l].map_height = 700;
+      r[l].stride_x = 5.0;
+      r[l].stride_y = 700.0 / grid[l];
+      r[l].origin_x = 2.5;
+      r[l].origin_y = r[l].stride_y / 2.0;
+      r[l].sigma_texels = 16.0 * (1 << l);
+      r[l].sigma_r = 0.005;
+    }
+    return r;
+  };
+  for (const uint32_t wrap : {0u, 1u}) {
+    const std::vector<format::NdfLevelRecord> r = records(wrap);
+    format::NdfPyramidBlend blend;
+    blend.init(r.data(), 3);
+    const double sigma = 45.0, y = 350.0;
+    int level = -1;
+    double total = 0.0;
+    blend.blend(2.5, y, sigma, [&](int l, size_t, double w) {
+      if (level < 0) level = l;
+      EXPECT_EQ(l, level);
+      total += w;
+    });
+    if (wrap == 0) {
+      EXPECT_EQ(level, 0);
+      EXPECT_NEAR(total, 1.0, 1e-9);
+      // Along the strip the weights are those of one repeating axis of 22 centres.
+      format::NdfBlendAxis axis;
+      axis.set(700.0, r[0].origin_y, r[0].stride_y, 22, true, 16.0);
+      EXPECT_NEAR(axis.spread(sigma, 16.0), 1.25, 0.01);
+      int idx[format::kMaxBlendAxis];
+      double w[format::kMaxBlendAxis];
+      const int n = axis.gaussianWeights(y, sigma, 16.0, format::NdfPyramidBlend::kMaxSpread, idx, w);
+      std::vector<double> expected(22, 0.0), got(22, 0.0);
+      for (int e = 0; e < n; ++e) expected[size_t(idx[e])] = w[e];
+      blend.blend(2.5, y, sigma, [&](int, size_t c, double wc) { got[c] += wc; });
+      for (int k = 0; k < 22; ++k) EXPECT_NEAR(got[size_t(k)], expected[size_t(k)], 1e-12) << k;
+    } else {
+      EXPECT_EQ(level, 2);  // the clamped width's spread moves it to the level of sigma 64
+    }
+  }
+}
+
 // Wang-tiles tile assets hold their edge centres beyond the edges (holdEdges).
 TEST(NdfPyramidClamp, HeldEdgesUseTheEdgeCentres) {
   const std::vector<uint8_t> bytes = makePyramid({{4, 4.0}}, 2, 1);

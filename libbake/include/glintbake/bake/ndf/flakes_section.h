@@ -148,8 +148,8 @@ struct HandoverProbe {
 // grows, of the next level's); the clustered lobes could answer there instead. Which is closer
 // depends on the map, not on how much its images vary: where a footprint holds many similar
 // texels the blend's small error in each centre's weight averages out (bumps, fine scratches,
-// brushed and rough isotropic maps), where a few glints dominate, or a footprint holds few texels
-// across (a strip a few texels wide), it does not. So it is measured, on the map: at
+// brushed and rough isotropic maps), where a few glints dominate (sharp flakes, leather) it does
+// not. So it is measured, on the map: at
 // kHandoverProbePositions positions (a golden-ratio sequence over the map) at footprint std sigma
 // (sqrt(2) times the level probed: where the two hand-overs compressedHandover chooses between
 // differ most), the
