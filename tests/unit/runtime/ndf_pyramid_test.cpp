@@ -52,10 +52,12 @@ struct LevelSpec {
   double sigma;
 };
 
-// The mass over [0, kMap] of a normalised 1-D Gaussian of std s centred at c.
-double massOverMap(double c, double s) {
-  return 0.5 * std::erfc((c - kMap) / (s * std::sqrt(2.0))) - 0.5 * std::erfc(c / (s * std::sqrt(2.0)));
+// The mass over [0, width] of a normalised 1-D Gaussian of std s centred at c.
+double massOverWidth(double c, double s, double width) {
+  return 0.5 * std::erfc((c - width) / (s * std::sqrt(2.0))) - 0.5 * std::erfc(c / (s * std::sqrt(2.0)));
 }
+// The same over [0, kMap].
+double massOverMap(double c, double s) { return massOverWidth(c, s, kMap); }
 // A stored footprint's spatial std at rate 1: sigma_l with the flakes' own sigma_h = 1.5 / sqrt 12.
 double storedStd(double sigma) { return std::sqrt(sigma * sigma + 1.5 * 1.5 / 12.0); }
 
@@ -438,11 +440,12 @@ TEST(NdfPyramidBlendWeights, RampAndWeightsMatchTheClosedForm) {
   std::printf("[ figures  ] ramp error %.2g, weight error %.2g\n", worst, worst_w);
 }
 
-// A repeating strip narrower than a stride has one centre across it at every level: its centre
-// weighs 1 at any spread, so only the spread along the strip picks the level. A 5 x 700 strip at
-// 45 texels is answered by its level of sigma 16 (spread 1.25 strides along it), not by the level
-// above the footprint (sigma 64) that the width's spread (8 strides of 5 texels) would pick. A
-// clamped strip has no such centre: its edges' falloff depends on the spread, which still counts.
+// A strip narrower than a stride has one centre across it at every level, spread to any width,
+// so only the spread along the strip picks the level: a 5 x 700 strip at 45 texels is answered by
+// its level of sigma 16 (spread 1.25 strides along it), not by the level above the footprint
+// (sigma 64) that the width's spread (8 strides of 5 texels) would pick. Across the strip the
+// centre weighs 1 on a repeating map, and on a clamped one the footprint's mass across the strip
+// relative to the centre's (the edge falloff spread to the footprint's width).
 TEST(NdfPyramidBlendWeights, AStripSpreadsAlongItsLengthOnly) {
   auto records = [](uint32_t wrap) {
     std::vector<format::NdfLevelRecord> r(3);
@@ -476,8 +479,11 @@ TEST(NdfPyramidBlendWeights, AStripSpreadsAlongItsLengthOnly) {
       EXPECT_EQ(l, level);
       total += w;
     });
-    if (wrap == 0) {
-      EXPECT_EQ(level, 0);
+    EXPECT_EQ(level, 0);
+    if (wrap == 1) {
+      const double across = massOverWidth(2.5, storedStd(sigma), 5.0) / massOverWidth(2.5, storedStd(16.0), 5.0);
+      EXPECT_NEAR(total / across, 1.0, 0.02) << "clamped: " << total << " against " << across;
+    } else {
       EXPECT_NEAR(total, 1.0, 1e-9);
       // Along the strip the weights are those of one repeating axis of 22 centres.
       format::NdfBlendAxis axis;
@@ -490,8 +496,6 @@ TEST(NdfPyramidBlendWeights, AStripSpreadsAlongItsLengthOnly) {
       for (int e = 0; e < n; ++e) expected[size_t(idx[e])] = w[e];
       blend.blend(2.5, y, sigma, [&](int, size_t c, double wc) { got[c] += wc; });
       for (int k = 0; k < 22; ++k) EXPECT_NEAR(got[size_t(k)], expected[size_t(k)], 1e-12) << k;
-    } else {
-      EXPECT_EQ(level, 2);  // the clamped width's spread moves it to the level of sigma 64
     }
   }
 }

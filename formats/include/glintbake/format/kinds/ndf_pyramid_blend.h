@@ -208,8 +208,9 @@ struct NdfBlendAxis {
     }
   }
 
-  // A repeating axis of one centre: every footprint weighs it 1 along this axis, whatever its spread.
-  bool oneRepeatingCentre() const { return repeat && n == 1; }
+  // An axis of one centre (not held): whatever the spread, its one weight is 1 on a repeating map
+  // and the footprint's mass over the map relative to the centre's (the falloff) on a clamped one.
+  bool oneCentre() const { return n == 1 && !hold; }
 
   // tau' / stride along this axis for a footprint of std sigma over a level of std sigma_l (0 when
   // the footprint is no wider than the level's plus its tent).
@@ -520,16 +521,16 @@ class NdfPyramidBlend {
   int firstLevel() const { return first_; }
 
   // Spread of level l for a footprint of std sigma: the larger of tau' / stride over both axes
-  // (0 where the footprint is not wider than the level's own plus its tent). A repeating axis of
-  // one centre (a map narrower than about 1.5 strides: a strip) has nothing to spread over, its
-  // centre weighs 1 at any spread, so it does not count: otherwise its stride, the map's width,
+  // (0 where the footprint is not wider than the level's own plus its tent). An axis of one centre
+  // (a map narrower than about 1.5 strides: a strip) has no centres to spread over, it is spread
+  // to any width (gaussianLevel), so it does not count: otherwise its stride, the map's width,
   // would move a footprint a few times that width to a level far coarser than the other axis needs
-  // (a 5 x 700 strip at 40 texels was answered by its level of sigma 64, 0.090 relative L1 against
-  // the reference where the smooth baseline is 0.169; from its level of sigma 16, 0.003).
+  // (a repeating 5 x 700 strip at 40 texels was answered by its level of sigma 64, 0.090 relative
+  // L1 against the reference where the smooth baseline is 0.169; from its level of sigma 16, 0.003).
   double spread(int l, double sigma) const {
     const Level& g = level_[l];
-    const double qx = g.x.oneRepeatingCentre() ? 0.0 : g.x.spread(sigma, g.sigma);
-    const double qy = g.y.oneRepeatingCentre() ? 0.0 : g.y.spread(sigma, g.sigma);
+    const double qx = g.x.oneCentre() ? 0.0 : g.x.spread(sigma, g.sigma);
+    const double qy = g.y.oneCentre() ? 0.0 : g.y.spread(sigma, g.sigma);
     return std::fmax(qx, qy);
   }
 
@@ -541,7 +542,11 @@ class NdfPyramidBlend {
     // a repeating map a footprint far wider than the map sees the mean of every centre, on a
     // clamped one their Gaussian-weighted sum with the mass the footprint keeps over the map.
     // A level of one centre answers up to the next level's sigma, however far that spreads it.
-    auto reach = [&](const NdfBlendAxis& a) { return unboundedAbove(l, a) || singleCentre(l) ? 1e300 : kMaxSpread; };
+    // An axis of one centre spreads to any width too: on a clamped map its weight is then the
+    // footprint's mass across the map relative to the centre's, as for a level of one centre.
+    auto reach = [&](const NdfBlendAxis& a) {
+      return unboundedAbove(l, a) || singleCentre(l) || a.oneCentre() ? 1e300 : kMaxSpread;
+    };
     out->level = l;
     out->grid_width = g.grid_width;
     out->rule = NdfBlendLevel::kGaussian;
