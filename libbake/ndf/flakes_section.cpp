@@ -171,6 +171,18 @@ double densityAt(const Source& source, const runtime::Footprint& fp, const runti
   return source.eval(fp, s, &v) == runtime::RuntimeStatus::kOk ? v : 0.0;
 }
 
+// Footprint i (0-based) of a probe over a w x h map: a two-dimensional golden-ratio sequence.
+runtime::Footprint probePosition(int i, int w, int h, double sigma) {
+  const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
+  const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
+  return {fx * w, fy * h, sigma};
+}
+
+// The widest footprint (std, texels) whose exact flakes fit the runtime's window at this rate.
+double flakeWindowMaxSigma(int rate) {
+  return (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+}
+
 // What the probe builds its flakes and lobes from: the whole map when it holds at most max_flakes
 // flakes, else a window at its centre of at most sqrt(max_flakes) flakes per side, clamped (no
 // texel beyond it stands in for the map's). The window's sides and origin are whole multiples of
@@ -215,7 +227,7 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   // window (and the lobes', below). Nothing is built when no probe footprint is left.
   const double side = double(std::max(width, height));
   const double flat_max = repeat ? kFlatAxisSigma * side / kHalfOctave : kClampedFlatSigma * side;
-  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
+  const double window_max = flakeWindowMaxSigma(rate);
   auto probed = [&](double sigma) { return sigma < pyramid_from && sigma <= flat_max && sigma <= window_max; };
   if (std::none_of(std::begin(kLobeProbeSigmas), std::end(kLobeProbeSigmas), probed))
     return format::kDefaultFlakesTileRatioMilli;
@@ -236,13 +248,10 @@ uint32_t chooseLobeTileRatio(const runtime::TexelSource& texels, int rate, doubl
   constexpr int kPositions = kLobeProbePositions;
   for (double sigma : kLobeProbeSigmas) {
     if (!(probed(sigma) && sigma <= lobes_max)) continue;
-    // Positions of a two-dimensional golden-ratio sequence over the map.
     std::vector<runtime::Footprint> fps;
     std::vector<double> masses;
     for (int i = 0; i < kPositions; ++i) {
-      const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
-      const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
-      fps.push_back({fx * probe.width(), fy * probe.height(), sigma});
+      fps.push_back(probePosition(i, probe.width(), probe.height(), sigma));
       double m = 0.0;
       exact.mass(fps.back(), &m);
       masses.push_back(m);
@@ -327,8 +336,7 @@ HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int ra
   const ProbeWindow probe(texels, rate, max_probe_flakes);
   const bool repeat = probe.repeats();
   const double side = double(std::max(probe.width(), probe.height()));
-  const double window_max = (double(runtime::kMaxFlakeWindow) - 4.0) / (2.0 * runtime::kFlakeWindowSigmas * rate);
-  if (out.sigma > window_max || (repeat && !(out.sigma < kFlatAxisSigma * side))) return out;
+  if (out.sigma > flakeWindowMaxSigma(rate) || (repeat && !(out.sigma < kFlatAxisSigma * side))) return out;
   // The levels' records over the probed map: the map's strides, rounded to tile the window.
   std::vector<format::NdfLevelRecord> recs(static_cast<size_t>(count));
   for (int l = 0; l < count; ++l) {
@@ -401,9 +409,7 @@ HandoverProbe probeExactLevelHandover(const runtime::TexelSource& texels, int ra
   std::vector<double> blend_errors(kPositions), lobes_errors(kPositions);
   std::vector<std::vector<float>> refs(kPositions);
   tbb::parallel_for(0, kPositions, [&](int i) {
-    const double fx = std::fmod(0.5 + 0.7548776662466927 * (i + 1), 1.0);
-    const double fy = std::fmod(0.5 + 0.5698402909980532 * (i + 1), 1.0);
-    const runtime::Footprint fp{fx * probe.width(), fy * probe.height(), out.sigma};
+    const runtime::Footprint fp = probePosition(i, probe.width(), probe.height(), out.sigma);
     Splatter splatter(set, params);
     std::vector<float> ref(bins, 0.0f), lobe(bins, 0.0f), centre(bins, 0.0f);
     std::vector<double> mixed(bins, 0.0);
