@@ -70,9 +70,9 @@ TEST(HandoverProbe, ThePyramidAnswersNoiseOverASquareAndOverAStrip) {
   std::printf("[ figures  ] square: blend %.3f, lobes %.3f, baseline %.3f\n", p.blend_error, p.lobes_error, p.baseline);
   EXPECT_FALSE(p.lobesAnswer());
   EXPECT_LT(p.blend_error, bake::ndf::kHandoverBlendMaxError);
-  // A strip 3 texels wide of the same noise: a level has one centre across it, and the blend
+  // A strip 5 texels wide of the same noise: a level has one centre across it, and the blend
   // spreads along the strip only (format::NdfPyramidBlend::spread), so it stays on the level probed.
-  const bake::NormalMap strip = columns(noiseMap(512, 0.3, 1.0), 3);
+  const bake::NormalMap strip = columns(noiseMap(512, 0.3, 1.0), 5);
   const bake::ndf::HandoverProbe s = probe(strip, levelsFrom(strip, 1, 3));
   ASSERT_TRUE(s.ran);
   std::printf("[ figures  ] strip: blend %.3f, lobes %.3f, baseline %.3f\n", s.blend_error, s.lobes_error, s.baseline);
