@@ -30,20 +30,43 @@ const bake::NormalMap& benchMap() {
   return map;
 }
 
-void BM_SplatImage(benchmark::State& state) {
-  static const ndf::FlakeSet flakes = ndf::buildFlakes(benchMap(), 1).value();
+// Splats the image of a footprint of sigma = the benchmark's argument at one position.
+void splatImages(benchmark::State& state, const ndf::FlakeSet& flakes) {
   ndf::SplatParams params;  // R = 128, sigma_r = 0.005
   ndf::Splatter splatter(flakes, params);
   std::vector<float> img(size_t(params.ndf_res) * params.ndf_res);
   const double sigma = double(state.range(0));
-  int64_t flakes_used = 0;
+  int64_t lobes = 0;
   for (auto _ : state) {
-    flakes_used = splatter.image(100.3, 57.8, sigma, img.data());
+    lobes = splatter.image(100.3, 57.8, sigma, img.data());
     benchmark::DoNotOptimize(img.data());
   }
-  state.counters["flakes"] = double(flakes_used);
+  state.counters["lobes"] = double(lobes);
 }
-BENCHMARK(BM_SplatImage)->Arg(2)->Arg(8)->Arg(32)->Unit(benchmark::kMillisecond);
+
+// Sigma 128 on the 256^2 map: a footprint wider than the map, whose flakes' periodic images are
+// folded into one lobe each.
+void BM_SplatImage(benchmark::State& state) {
+  static const ndf::FlakeSet flakes = ndf::buildFlakes(benchMap(), 1).value();
+  splatImages(state, flakes);
+}
+BENCHMARK(BM_SplatImage)->Arg(2)->Arg(8)->Arg(32)->Arg(128)->Unit(benchmark::kMillisecond);
+
+// The same on dense sharp flakes (a normal cone of 60 degrees, cells of 3 texels): nearly every
+// texel straddles an edge between flakes, so its lobe is a streak across much of the image (or a
+// wide lobe where three or four flakes meet), the splat's most expensive case.
+void BM_SplatImageSharpFlakes(benchmark::State& state) {
+  static const ndf::FlakeSet flakes = [] {
+    bake::MapParams p;
+    p.size = 256;
+    p.seed = 9;
+    p.cone_degrees = 60.0;
+    p.cell = 3.0;
+    return ndf::buildFlakes(bake::generateMap(bake::MapKind::kFlakes, p), 1).value();
+  }();
+  splatImages(state, flakes);
+}
+BENCHMARK(BM_SplatImageSharpFlakes)->Arg(8)->Arg(32)->Arg(128)->Unit(benchmark::kMillisecond);
 
 void BM_ReferenceImage(benchmark::State& state) {
   static const glintbake::reference::FlakeSet flakes = glintbake::reference::buildFlakes(benchMap(), 1);

@@ -19,6 +19,10 @@ constexpr double kWideLobeBins = 1.5;
 // standard deviations at most (splat.h, "Truncation").
 constexpr double kTailExponent = 3.0;
 constexpr double kTailLobeTruncation = 3.0;
+// Largest spread of a flake's periodic images' lobe means, in units of the lobe's std, at which
+// their lobes are splatted as one (Splatter::accumulate, footprints wider than the map). The
+// one lobe differs from their sum by the shifts' third cumulant, below kFoldSpread^3 relative.
+constexpr double kFoldSpread = 0.1;
 
 // Standard normal CDF and density by linear interpolation of tables (step 1/512 over [-8, 8], built
 // once from std::erfc and std::exp at start-up). Interpolation error: h^2/8 max|phi'| = 1.2e-7 for
@@ -101,7 +105,13 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
   const double cond_sd_a = std::sqrt(det / cbb);  // std of a given b
   const int j0 = std::max(0, int(std::floor((mean_b - truncation * sd_b + 1.0) / h)));
   const int j1 = std::min(res - 1, int(std::floor((mean_b + truncation * sd_b + 1.0) / h)));
-  const double g = std::exp(-pa * h * h);
+  const double g = std::exp(-pa * h * h), inv_g = 1.0 / g;
+  // r (below) from one row to the next: q's step along a row grows by 2 pab h^2 per row and by
+  // 2 pa h^2 per bin that i0 moves, so r takes a factor c_row and one of g (or 1 / g) per bin. The
+  // start of the row's first chain (e) still takes an exp: one per row instead of two.
+  const double c_row = std::exp(-pab * h * h);
+  int i_prev = -1, j_prev = -1;
+  double r_prev = 0.0;
   for (int j = j0; j <= j1; ++j) {
     const double db = -1.0 + (j + 0.5) * h - mean_b;
     const double ma = mean_a + slope * db;
@@ -112,23 +122,42 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
     const double q = pa * da * da + 2.0 * pab * da * db + pb * db * db;
     double e = bin_mass * std::exp(-0.5 * q);
     // q(i + 1) - q(i) = pa (2 da h + h^2) + 2 pab h db, growing by 2 pa h^2 per step.
-    double r = std::exp(-0.5 * (pa * (2.0 * da * h + h * h) + 2.0 * pab * h * db));
-    // Two interleaved chains (even and odd bins) halve the multiply latency of the recurrence:
-    // over two steps the ratio is r(i) r(i + 1) and grows by g^4.
-    double* row = acc + size_t(j) * size_t(res);
-    double e_even = e, e_odd = e * r;
-    double r_even = r * r * g, r_odd = r * r * g * g * g;
-    const double g4 = (g * g) * (g * g);
-    int i = i0;
-    for (; i < i1; i += 2) {
-      row[i] += e_even;
-      row[i + 1] += e_odd;
-      e_even *= r_even;
-      e_odd *= r_odd;
-      r_even *= g4;
-      r_odd *= g4;
+    const int di = i0 - i_prev;
+    double r;
+    if (i_prev >= 0 && j == j_prev + 1 && di >= -2 && di <= 2) {
+      r = r_prev * c_row;
+      for (int k = 0; k < di; ++k) r *= g;
+      for (int k = 0; k > di; --k) r *= inv_g;
+    } else {
+      r = std::exp(-0.5 * (pa * (2.0 * da * h + h * h) + 2.0 * pab * h * db));
     }
-    if (i == i1) row[i] += e_even;
+    i_prev = i0;
+    j_prev = j;
+    r_prev = r;
+    // Four interleaved chains (bins i0 + 4m + c, c = 0..3) take the multiply latency off the
+    // recurrence and vectorise: over four steps the ratio is r(i) r(i + 1) r(i + 2) r(i + 3) =
+    // r(i)^4 g^6, and it grows by g^16 from one step to the next.
+    double* row = acc + size_t(j) * size_t(res);
+    const double r2 = r * r, g2 = g * g, g4 = g2 * g2, g8 = g4 * g4;
+    double ec[4], rc[4];
+    ec[0] = e;
+    ec[1] = e * r;
+    ec[2] = ec[1] * (r * g);
+    ec[3] = ec[2] * (r * g2);
+    rc[0] = (r2 * r2) * (g4 * g2);
+    rc[1] = rc[0] * g4;
+    rc[2] = rc[1] * g4;
+    rc[3] = rc[2] * g4;
+    const double g16 = g8 * g8;
+    int i = i0;
+    for (; i + 3 <= i1; i += 4) {
+      for (int c = 0; c < 4; ++c) {
+        row[i + c] += ec[c];
+        ec[c] *= rc[c];
+        rc[c] *= g16;
+      }
+    }
+    for (int c = 0; i <= i1; ++i, ++c) row[i] += ec[c];
   }
 }
 
@@ -197,6 +226,8 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
     }
     n = 0;
   };
+  // A column starts where the one before it ended: its first CDF and density are that column's last.
+  double end_a = 2.0, end_z = 0.0, end_cdf = 0.0, end_pdf = 0.0;
   for (int k = k0; k <= k1; ++k) {
     const double a0 = std::max(lo, -1.0 + k * h);
     const double a1 = std::min(hi, -1.0 + (k + 1) * h);
@@ -205,10 +236,11 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
     int subs = int(std::ceil(std::abs(slope) * (a1 - a0) * inv_cond_sd));
     subs = std::clamp(subs, 1, kMaxSubIntervals);
     const double da = (a1 - a0) / subs;
-    double z_prev = (a0 - mean_a) * inv_sd_a;
-    double cdf_prev = phiCdf(z_prev), pdf_prev = phiPdf(z_prev);
+    const bool carried = a0 == end_a;
+    double z_prev = carried ? end_z : (a0 - mean_a) * inv_sd_a;
+    double cdf_prev = carried ? end_cdf : phiCdf(z_prev), pdf_prev = carried ? end_pdf : phiPdf(z_prev);
     for (int s = 0; s < subs; ++s) {
-      const double z_next = (a0 + (s + 1) * da - mean_a) * inv_sd_a;
+      const double z_next = ((s + 1 == subs ? a1 : a0 + (s + 1) * da) - mean_a) * inv_sd_a;
       const double cdf_next = phiCdf(z_next), pdf_next = phiPdf(z_next);
       const double w = cdf_next - cdf_prev;
       if (w > 1e-300) {
@@ -237,6 +269,10 @@ void Splatter::splatLobe(double* acc, int res, double mean_x, double mean_y, dou
       cdf_prev = cdf_next;
       pdf_prev = pdf_next;
     }
+    end_a = a1;
+    end_z = z_prev;
+    end_cdf = cdf_prev;
+    end_pdf = pdf_prev;
   }
   flush();
 }
@@ -330,13 +366,126 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
   // Partition factors apply to repeating maps only (footprintPartition leaves clamped ones alone).
   const double* part_x = partition && repeat && !partition->x.empty() ? partition->x.data() : nullptr;
   const double* part_y = partition && repeat && !partition->y.empty() ? partition->y.data() : nullptr;
+  // One lobe: the flake k seen from the footprint at offset (dx, dy) = u_k - u_Q, d2 = |.|^2.
+  auto lobe = [&](const float* k, double dx, double dy, double d2, double factor) {
+    const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
+    // mu_k = n_k + J_k t (u_Q - u_k), with u_Q - u_k = (-dx, -dy).
+    const double mx = k[0] - t * (j00 * dx + j01 * dy);
+    const double my = k[1] - t * (j10 * dx + j11 * dy);
+    // C_k = sigma_r^2 I + kc J J^T.
+    const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
+    const double cxy = kc * (j00 * j10 + j01 * j11);
+    const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+    // Factors of 1 leave the mass's bits as they are.
+    const double mass = spatial_norm * std::exp(-d2 * inv_2s2) * factor;
+    splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
+  };
+  const int64_t width = f.grid_width, height = f.grid_height;
+  if (repeat && (2.0 * radius > double(width) * f.step || 2.0 * radius > double(height) * f.step)) {
+    // The footprint is wider than the map: it sees each flake at several of its periodic images,
+    // whose lobes differ only in mass and in a mean shift t J_k (u_Q - u_k). Their sum is the one
+    // lobe of their summed mass whose mean and covariance are the mixture's (the shifts' weighted
+    // mean, and C_k plus t^2 J_k V J_k^T, V the weighted covariance of the offsets) up to the
+    // shifts' third and higher cumulants. Since C_k >= kc J_k J_k^T, the shifts' spread in C_k's
+    // metric is at most t sqrt(|V| / kc), about sigma_h / sigma (0.1 at sigma = 4 sigma_h, 0.002
+    // at sigma 256 on rate 1): each flake is folded where that spread is below kFoldSpread, and
+    // splatted image by image otherwise. A top level whose footprints span P periods of the map
+    // splats each flake once instead of about P^2 times.
+    std::vector<int64_t> x_start(size_t(width) + 1), y_start(size_t(height) + 1);
+    std::vector<double> x_off, y_off;
+    auto offsets = [&](int64_t n, bool along_x, double centre, std::vector<int64_t>& start, std::vector<double>& off) {
+      const double period = double(n) * f.step;
+      for (int64_t w = 0; w < n; ++w) {
+        start[size_t(w)] = int64_t(off.size());
+        const double p = (along_x ? f.positionX(w) : f.positionY(w)) - centre;
+        const int64_t m0 = int64_t(std::floor((-radius - p) / period)) - 1;
+        const int64_t m1 = int64_t(std::ceil((radius - p) / period)) + 1;
+        for (int64_t m = m0; m <= m1; ++m) {
+          const int64_t g = w + m * n;
+          const double d = (along_x ? f.positionX(g) : f.positionY(g)) - centre;
+          if (d * d <= radius2) off.push_back(d);
+        }
+      }
+      start[size_t(n)] = int64_t(off.size());
+    };
+    offsets(width, true, x, x_start, x_off);
+    offsets(height, false, y, y_start, y_off);
+    struct Image {
+      double dx, dy, d2, w;
+    };
+    std::vector<Image> images;
+    int64_t used = 0;
+    for (int64_t wy = part; wy < height; wy += parts) {
+      const double row_factor = part_y ? part_y[wy] : 1.0;
+      for (int64_t wx = 0; wx < width; ++wx) {
+        images.clear();
+        for (int64_t b = y_start[size_t(wy)]; b < y_start[size_t(wy) + 1]; ++b) {
+          const double dy = y_off[size_t(b)], dy2 = dy * dy;
+          for (int64_t a = x_start[size_t(wx)]; a < x_start[size_t(wx) + 1]; ++a) {
+            const double dx = x_off[size_t(a)], d2 = dx * dx + dy2;
+            if (d2 <= radius2) images.push_back(Image{dx, dy, d2, 0.0});
+          }
+        }
+        if (images.empty()) continue;
+        const float* k = f.flake(int(wx), int(wy));
+        const double factor = row_factor * (part_x ? part_x[wx] : 1.0);
+        if (images.size() == 1) {  // as the unfolded loop, bit for bit
+          lobe(k, images[0].dx, images[0].dy, images[0].d2, factor);
+          ++used;
+          continue;
+        }
+        double sum = 0.0, sx = 0.0, sy = 0.0, d2_min = radius2;
+        for (Image& m : images) {
+          m.w = std::exp(-m.d2 * inv_2s2);
+          sum += m.w;
+          sx += m.w * m.dx;
+          sy += m.w * m.dy;
+          d2_min = std::min(d2_min, m.d2);
+        }
+        const double mdx = sx / sum, mdy = sy / sum;
+        double vxx = 0.0, vxy = 0.0, vyy = 0.0;
+        for (const Image& m : images) {
+          const double ex = m.dx - mdx, ey = m.dy - mdy;
+          vxx += m.w * ex * ex;
+          vxy += m.w * ex * ey;
+          vyy += m.w * ey * ey;
+        }
+        vxx /= sum;
+        vxy /= sum;
+        vyy /= sum;
+        const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
+        const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
+        const double cxy = kc * (j00 * j10 + j01 * j11);
+        const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+        // S = t^2 J V J^T, the covariance of the images' lobe means.
+        const double ax = j00 * vxx + j01 * vxy, ay = j00 * vxy + j01 * vyy;  // row 0 of J V
+        const double bx = j10 * vxx + j11 * vxy, by = j10 * vxy + j11 * vyy;  // row 1 of J V
+        const double t2 = t * t;
+        const double sxx = t2 * (ax * j00 + ay * j01), sxy = t2 * (ax * j10 + ay * j11);
+        const double syy = t2 * (bx * j10 + by * j11);
+        // tr(C^-1 S) bounds the largest eigenvalue of C^-1 S: the spread squared in C's metric.
+        const double spread2 = (cyy * sxx - 2.0 * cxy * sxy + cxx * syy) / (cxx * cyy - cxy * cxy);
+        if (sum > 0.0 && spread2 <= kFoldSpread * kFoldSpread) {
+          const double mx = k[0] - t * (j00 * mdx + j01 * mdy);
+          const double my = k[1] - t * (j10 * mdx + j11 * mdy);
+          splatLobe(acc, res, mx, my, cxx + sxx, cxy + sxy, cyy + syy, spatial_norm * sum * factor,
+                    d2_min > tail_d2 ? tail_trunc : trunc);
+          ++used;
+          continue;
+        }
+        for (const Image& m : images) lobe(k, m.dx, m.dy, m.d2, factor);
+        used += int64_t(images.size());
+      }
+    }
+    return used;
+  }
   int64_t used = 0;
   for (int64_t gy = gy0 + part; gy <= gy1; gy += parts) {
     int64_t wy = gy;
     if (repeat) {
-      wy %= f.grid_height;
-      if (wy < 0) wy += f.grid_height;
-    } else if (gy < 0 || gy >= f.grid_height) {
+      wy %= height;
+      if (wy < 0) wy += height;
+    } else if (gy < 0 || gy >= height) {
       continue;
     }
     const double dy = f.positionY(gy) - y;
@@ -349,23 +498,12 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
       if (d2 > radius2) continue;
       int64_t wx = gx;
       if (repeat) {
-        wx %= f.grid_width;
-        if (wx < 0) wx += f.grid_width;
-      } else if (gx < 0 || gx >= f.grid_width) {
+        wx %= width;
+        if (wx < 0) wx += width;
+      } else if (gx < 0 || gx >= width) {
         continue;
       }
-      const float* k = f.flake(int(wx), int(wy));
-      const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
-      // mu_k = n_k + J_k t (u_Q - u_k), with u_Q - u_k = (-dx, -dy).
-      const double mx = k[0] - t * (j00 * dx + j01 * dy);
-      const double my = k[1] - t * (j10 * dx + j11 * dy);
-      // C_k = sigma_r^2 I + kc J J^T.
-      const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
-      const double cxy = kc * (j00 * j10 + j01 * j11);
-      const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
-      // Factors of 1 leave the mass's bits as they are.
-      const double mass = spatial_norm * std::exp(-d2 * inv_2s2) * (row_factor * (part_x ? part_x[wx] : 1.0));
-      splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
+      lobe(f.flake(int(wx), int(wy)), dx, dy, d2, row_factor * (part_x ? part_x[wx] : 1.0));
       ++used;
     }
   }
