@@ -31,6 +31,16 @@
 // s_x = -1; each bin stores its average density (mass / bin area); bins whose centre lies outside
 // the unit disk hold 0. Wrap::kRepeat maps contribute every periodic image of every flake within the
 // radius; Wrap::kClamp maps have no flakes outside the map.
+//
+// Footprints wider than a repeating map (the top levels) see each flake at several periodic
+// images, whose lobes differ only in mass and in a mean shift t J_k (u_Q - u_k). Each flake's
+// images are splatted as one lobe with the mixture's mass, mean and covariance where the shifts'
+// spread is below 0.1 of the lobe's std (at most about sigma_h / sigma, so every flake from a few
+// texels up), else image by image. On a 256^2 map at sigma 48-200 that is 13 times faster and
+// moves the images by 1e-5 to 1.5e-4 relative L1 (the folded lobes are truncated as their nearest
+// image's); on 24^2 maps at sigma 5-20 the folded images are within 3e-4 of the reference's sum
+// over every image. A 1024^2 map's level of sigma 512 (2 x 2 centres) took 26 s of an ndfgen bake
+// of sharp flakes before.
 #pragma once
 
 #include <glintbake/bake/ndf/flakes.h>
