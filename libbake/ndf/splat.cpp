@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace glintbake::bake::ndf {
 namespace {
 
@@ -150,6 +154,23 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
     rc[3] = rc[2] * g4;
     const double g16 = g8 * g8;
     int i = i0;
+#if defined(__SSE2__)
+    // Two chains per register: the same IEEE operations lane by lane as the loop below, so the
+    // same bits on every x86-64 machine.
+    __m128d e01 = _mm_loadu_pd(ec), e23 = _mm_loadu_pd(ec + 2);
+    __m128d r01 = _mm_loadu_pd(rc), r23 = _mm_loadu_pd(rc + 2);
+    const __m128d step = _mm_set1_pd(g16);
+    for (; i + 3 <= i1; i += 4) {
+      _mm_storeu_pd(row + i, _mm_add_pd(_mm_loadu_pd(row + i), e01));
+      _mm_storeu_pd(row + i + 2, _mm_add_pd(_mm_loadu_pd(row + i + 2), e23));
+      e01 = _mm_mul_pd(e01, r01);
+      e23 = _mm_mul_pd(e23, r23);
+      r01 = _mm_mul_pd(r01, step);
+      r23 = _mm_mul_pd(r23, step);
+    }
+    _mm_storeu_pd(ec, e01);
+    _mm_storeu_pd(ec + 2, e23);
+#else
     for (; i + 3 <= i1; i += 4) {
       for (int c = 0; c < 4; ++c) {
         row[i + c] += ec[c];
@@ -157,6 +178,7 @@ static void splatWideLobe(double* acc, int res, double mean_a, double mean_b, do
         rc[c] *= g16;
       }
     }
+#endif
     for (int c = 0; i <= i1; ++i, ++c) row[i] += ec[c];
   }
 }
