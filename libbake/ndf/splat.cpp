@@ -77,6 +77,15 @@ inline double phiPdf(double z) {
   return kNormalTable.pdf[i][0] + (u - i) * kNormalTable.pdf[i][1];
 }
 
+// C_k = sigma_r^2 I + kc J_k J_k^T, the lobe covariance of flake k (its record: n_x, n_y, then J
+// column-major), for both the per-image and the folded lobes.
+inline void lobeCovariance(const float* k, double sr2, double kc, double* cxx, double* cxy, double* cyy) {
+  const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
+  *cxx = sr2 + kc * (j00 * j00 + j01 * j01);
+  *cxy = kc * (j00 * j10 + j01 * j11);
+  *cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+}
+
 }  // namespace
 
 Splatter::Splatter(const FlakeSet& flakes, const SplatParams& params) : flakes_(flakes), params_(params) {
@@ -394,10 +403,8 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
     // mu_k = n_k + J_k t (u_Q - u_k), with u_Q - u_k = (-dx, -dy).
     const double mx = k[0] - t * (j00 * dx + j01 * dy);
     const double my = k[1] - t * (j10 * dx + j11 * dy);
-    // C_k = sigma_r^2 I + kc J J^T.
-    const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
-    const double cxy = kc * (j00 * j10 + j01 * j11);
-    const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+    double cxx, cxy, cyy;
+    lobeCovariance(k, sr2, kc, &cxx, &cxy, &cyy);
     // Factors of 1 leave the mass's bits as they are.
     const double mass = spatial_norm * std::exp(-d2 * inv_2s2) * factor;
     splatLobe(acc, res, mx, my, cxx, cxy, cyy, mass, d2 > tail_d2 ? tail_trunc : trunc);
@@ -476,9 +483,8 @@ int64_t Splatter::accumulate(double x, double y, double sigma, int part, int par
         vxy /= sum;
         vyy /= sum;
         const double j00 = k[2], j10 = k[3], j01 = k[4], j11 = k[5];
-        const double cxx = sr2 + kc * (j00 * j00 + j01 * j01);
-        const double cxy = kc * (j00 * j10 + j01 * j11);
-        const double cyy = sr2 + kc * (j10 * j10 + j11 * j11);
+        double cxx, cxy, cyy;
+        lobeCovariance(k, sr2, kc, &cxx, &cxy, &cyy);
         // S = t^2 J V J^T, the covariance of the images' lobe means.
         const double ax = j00 * vxx + j01 * vxy, ay = j00 * vxy + j01 * vyy;  // row 0 of J V
         const double bx = j10 * vxx + j11 * vxy, by = j10 * vxy + j11 * vyy;  // row 1 of J V
