@@ -112,7 +112,7 @@ BakeStatus validatePyramidOptions(const PyramidOptions& o) {
   if (o.splat.ndf_res < 2 || o.splat.ndf_res > 4096) return bad("--ndf-res must be in [2, 4096]");
   if (!(o.splat.sigma_r > 0.0 && o.splat.sigma_r <= 1.0)) return bad("--sigma-r must be in (0, 1]");
   if (!(o.splat.footprint_truncation >= 1.0 && o.splat.footprint_truncation <= 10.0))
-    return bad("footprint truncation must be in [1, 10]");
+    return bad("--footprint-truncation must be in [1, 10]");
   if (!(o.splat.lobe_truncation >= 2.0 && o.splat.lobe_truncation <= 10.0))
     return bad("lobe truncation must be in [2, 10]");
   if (o.rate < 1 || o.rate > kMaxFlakeRate) return bad("--rate must be in [1, " + std::to_string(kMaxFlakeRate) + "]");

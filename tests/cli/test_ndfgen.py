@@ -81,11 +81,23 @@ class NdfGen(ToolTestCase):
         self.assert_fails(clitest.INVALID, "ndfgen", huge, "-o", out, *SMALL, outputs=[out])
         self.assert_fails(clitest.IO, "ndfgen", self.path("missing.png"), "-o", out, *SMALL, outputs=[out])
 
+    def test_footprint_truncation(self):
+        # Recorded in the parameters (3.5 by default); a wider cut keeps more flakes in each image.
+        m = self.mapgen("beckmann", "m.png", "--size", "32", "--seed", "3")
+        a, b = self.path("a.gbk"), self.path("b.gbk")
+        doc_a = self.run_json("ndfgen", m, "-o", a, *SMALL, schema="ndfgen.schema.json")
+        doc_b = self.run_json("ndfgen", m, "-o", b, *SMALL, "--footprint-truncation", "4",
+                              schema="ndfgen.schema.json")
+        self.assertEqual(doc_a["parameters"]["footprint_truncation"], 3.5)
+        self.assertEqual(doc_b["parameters"]["footprint_truncation"], 4.0)
+        self.assertNotEqual(clitest.file_hash(a), clitest.file_hash(b))
+
     def test_bad_arguments(self):
         m = self.mapgen("flat", "flat.png", "--size", "16")
         out = self.path("o.gbk")
         for args in (["--stride", "0"], ["--ndf-res", "1"], ["--levels", "zero"], ["--sigma-r", "-1"],
-                     ["--rate", "99"], ["--converge-mse", "0"]):
+                     ["--rate", "99"], ["--converge-mse", "0"], ["--footprint-truncation", "0.5"],
+                     ["--footprint-truncation", "11"], ["--footprint-truncation", "nan"]):
             self.assert_fails(clitest.BAD_ARGS, "ndfgen", m, "-o", out, "--quiet", *args, outputs=[out])
 
     def test_unwritable_output(self):

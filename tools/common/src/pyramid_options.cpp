@@ -30,6 +30,10 @@ void addPyramidOptions(CLI::App& app, PyramidCliOptions& p, const std::string& r
           ->capture_default_str(),
       app.add_option("--rate", o.rate, "Flakes per texel side (1..16)")->capture_default_str(),
       app.add_option("--region", o.region_size, region_help)->capture_default_str(),
+      app.add_option("--footprint-truncation", o.splat.footprint_truncation,
+                     "Footprints leave out flakes beyond this many stds, the others reweighed to unit mass "
+                     "(1..10; 4: images about 3x closer to the exact ones, for about 25% more bake time)")
+          ->capture_default_str(),
       app.add_flag("!--no-flakes", p.flakes,
                    "Leave out the flakes section (the normal map, float32) that answers footprints up to "
                    "4 texels exactly and mid-size ones from clustered lobes"),

@@ -13,19 +13,23 @@
 // lobe is correlated; on each sub-interval the other axis is a Gaussian (conditional mean at the
 // sub-interval's truncated-normal mean, variance plus the slope's share of its truncated variance)
 // integrated with erf per bin. Uncorrelated lobes (flat regions) are integrated exactly; the
-// sub-interval count bounds the shift of the conditional mean across a sub-interval to half its
-// std, which keeps the image within 1e-4..1e-3 relative L1 of the exact bin averages.
+// sub-interval count bounds the drift of the conditional mean across a sub-interval to two
+// conditional stds (a bound of one std moves the images by 7e-5 to 3e-4 relative L1 and takes
+// 20-30% longer on sharp flakes, whose lobes are streaks).
 //
 // Truncation (documented defaults):
 //  - footprint: flakes farther than footprint_truncation * sqrt(sigma_h^2 + sigma_p^2) from u_Q are
 //    skipped, and the weights of the others are divided by the share of the footprint inside that
-//    disk, 1 - exp(-T^2 / 2), so that images keep unit mass (at 4 std the flakes left out hold
-//    exp(-8) = 3.4e-4 of the weight);
+//    disk, 1 - exp(-T^2 / 2), so that images keep unit mass. At the default 3.5 std the flakes left
+//    out hold exp(-6.125) = 2.2e-3 of the weight, and images are within 6e-4 to 3.8e-3 relative L1
+//    of the exact bin averages (glintbake/reference; Beckmann and flake maps of 256^2, sigma 4-32).
+//    At 4 std they are within 2.5e-4 to 8.3e-4, for (4 / 3.5)^2 = 1.31 times the lobes and 20-25%
+//    more time (the bakers' --footprint-truncation);
 //  - lobe: each lobe is integrated over +-4 std of both conditional axes (missing mass < 1.3e-4),
-//    the lobes of flakes in the footprint's tail (weight below e^-3 of the centre's, 5% of the
-//    footprint's mass and 62% of its flakes at 4 std) over +-3 std (missing mass < 5.4e-3 of theirs,
-//    so < 2.7e-4 of the image's). That saves 16% of an image's time (bench_ndf, sigma 2-32) and
-//    38% of a 1024^2 curved-scratches bake, whose wide lobes cover the most bins.
+//    the lobes of flakes in the footprint's tail (weight below e^-3 of the centre's, 4.8% of the
+//    footprint's mass and 51% of its flakes at 3.5 std) over +-3 std (missing mass < 5.4e-3 of
+//    theirs, so < 2.6e-4 of the image's). That saved 16% of an image's time (bench_ndf, sigma 2-32)
+//    and 38% of a 1024^2 curved-scratches bake, whose wide lobes cover the most bins.
 //
 // Image layout (formats/SPEC.md): R x R bins over s in [-1,1]^2, row 0 at s_y = +1, column 0 at
 // s_x = -1; each bin stores its average density (mass / bin area); bins whose centre lies outside
@@ -52,7 +56,7 @@ namespace glintbake::bake::ndf {
 struct SplatParams {
   int ndf_res = 128;                  // R, bins per side, [2, 4096]
   double sigma_r = 0.005;             // intrinsic roughness (s-plane std), (0, 1]
-  double footprint_truncation = 4.0;  // radius in units of sqrt(sigma_h^2 + sigma_p^2), [1, 10]
+  double footprint_truncation = 3.5;  // radius in units of sqrt(sigma_h^2 + sigma_p^2), [1, 10]
   double lobe_truncation = 4.0;       // lobe extent in conditional stds, [2, 10]
 };
 
