@@ -17,8 +17,8 @@ constexpr double kInvSqrt2Pi = 0.39894228040143267794;
 constexpr int kMaxSubIntervals = 16;
 // Largest drift of a narrow lobe's conditional mean across one sub-interval, in conditional stds.
 // The sub-interval's Gaussian stands for that std convolved with a box of the drift's width, whose
-// fourth cumulant it leaves out (excess kurtosis -0.007 at 1, -0.075 at 2): images move by 7e-5 to 3e-4
-// relative L1 from 1 to 2, and streaks (sharp flakes) splat 20-30% faster (see splat.h).
+// fourth cumulant it leaves out (excess kurtosis -0.007 at 1, -0.075 at 2): images move by 7e-5
+// to 3e-4 relative L1 from 1 to 2, and streaks (sharp flakes) splat 20-30% faster (see splat.h).
 constexpr double kMaxDrift = 2.0;
 
 // Lobes whose smallest std is at least this many bins are point-evaluated (see splatWideLobe).

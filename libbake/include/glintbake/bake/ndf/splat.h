@@ -42,7 +42,7 @@
 // spread is below 0.1 of the lobe's std (at most about sigma_h / sigma, so every flake from a few
 // texels up), else image by image. On a 256^2 map at sigma 48-200 that is 13 times faster and
 // moves the images by 1e-5 to 1.5e-4 relative L1 (the folded lobes are truncated as their nearest
-// image's); on 24^2 maps at sigma 5-20 the folded images are within 3e-4 of the reference's sum
+// image's); on 24^2 maps at sigma 5-20 the folded images are within 4e-4 of the reference's sum
 // over every image. A 1024^2 map's level of sigma 512 (2 x 2 centres) took 26 s of an ndfgen bake
 // of sharp flakes before.
 #pragma once
